@@ -1,0 +1,86 @@
+"""The atomic action catalogue: names, argument schemas and expected cost.
+
+This module is pure data (no simulator import) so that graph validation, the
+agents and the forward-moving filter can reason about actions without a world.
+The tick-level programs that realise these actions live beside it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from pydantic import BaseModel, ConfigDict, Field
+
+Vec3 = tuple[float, float, float]
+
+
+class _Args(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+
+class GraspArgs(_Args):
+    """Approach ``obj`` from its side, close on it, lift it clear of the table."""
+
+    obj: str
+    pre_grasp_dis: float = Field(0.08, ge=0.0, le=0.3, description="Stand-off before the final approach (m).")
+    height: float = Field(0.5, ge=0.1, le=0.9, description="Grasp height as a fraction of the object's height.")
+    lift: float = Field(0.06, ge=0.0, le=0.3, description="Lift after closing (m).")
+
+
+class MoveToObjArgs(_Args):
+    """Move the held object (or the tool) to an offset from ``obj``'s top point."""
+
+    obj: str
+    offset: Vec3 = (0.0, 0.0, 0.1)
+
+
+class RotateEefArgs(_Args):
+    """Roll the tool about its approach axis (tilt-to-pour and back)."""
+
+    angle: float = Field(..., ge=-180.0, le=180.0, description="Degrees; positive tips the object's top toward -y of the tool.")
+
+
+class PlaceArgs(_Args):
+    """Lower the held object onto the table at ``target`` (x, y), then release and retreat."""
+
+    obj: str
+    target: tuple[float, float] | None = Field(None, description="Table position (m); None = straight down.")
+    z_offset: float = Field(0.0, ge=-0.05, le=0.2)
+
+
+class NoArgs(_Args):
+    """No arguments."""
+
+
+@dataclass(frozen=True)
+class ActionSpec:
+    """What the catalogue knows about one atomic action.
+
+    Attributes:
+        name: The action's name in graph files.
+        args: Pydantic model that validates the action's ``args``.
+        expected_ticks: Nominal duration in control ticks (50 Hz); the edge
+            weight of the forward-moving principle (Eq. 8).
+        object_fields: Argument names that must name a scene object.
+        holds_object: Whether the arm holds an object while the action runs.
+    """
+
+    name: str
+    args: type[BaseModel]
+    expected_ticks: int
+    object_fields: tuple[str, ...] = ()
+    holds_object: bool = False
+
+
+ACTIONS: dict[str, ActionSpec] = {
+    spec.name: spec
+    for spec in (
+        ActionSpec("grasp", GraspArgs, 190, ("obj",)),
+        ActionSpec("move_to_obj", MoveToObjArgs, 110, ("obj",), holds_object=True),
+        ActionSpec("rotate_eef", RotateEefArgs, 80, holds_object=True),
+        ActionSpec("place", PlaceArgs, 170, ("obj",), holds_object=True),
+        ActionSpec("back", NoArgs, 100),
+        ActionSpec("open_gripper", NoArgs, 25),
+        ActionSpec("close_gripper", NoArgs, 25),
+    )
+}
