@@ -1,0 +1,106 @@
+"""The robot controller between atomic actions and the world.
+
+Actions set per-arm targets (a tool pose for the IK, or joint targets for a
+joint-space move, and a gripper target); once per tick the controller solves
+the IK for both arms together and sends joint targets to the world. The
+commanded pose persists: an interrupted action leaves the arm holding still.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from agentchord.features.frame import FeatureFrame
+from agentchord.solvers.ik import BimanualIK, PoseTarget
+from agentchord.worlds.sim.scene import ARM_PREFIX
+from agentchord.worlds.sim.world import ArmCommand, SimWorld
+
+
+@dataclass
+class ArmTarget:
+    """The current target of one arm.
+
+    Attributes:
+        pose: Tool-centre pose target (used when ``joints`` is None).
+        joints: Joint-space target; overrides the pose for one tick.
+        grip: Gripper target in [0, 1] (0 open).
+        grip_closed_settled: The gripper was commanded closed and has stopped
+            moving (the robot's "grasp done" signal, latched until opened).
+    """
+
+    pose: PoseTarget
+    joints: np.ndarray | None = None
+    grip: float = 0.0
+    grip_closed_settled: bool = False
+
+
+class RobotController:
+    """Turns per-arm targets into joint commands every tick.
+
+    Args:
+        world: The simulated (or real) world to command.
+        ik: The bimanual IK solver.
+    """
+
+    def __init__(self, world: SimWorld, ik: BimanualIK | None = None) -> None:
+        self.world = world
+        self.ik = ik or BimanualIK()
+        self.targets: dict[str, ArmTarget] = {}
+        #: The latest feature frame: what actions perceive (set by the executor each tick).
+        self.frame: FeatureFrame | None = None
+        self.sync_from_world()
+
+    def sync_from_world(self) -> None:
+        """Take the measured robot state as the commanded state (after a reset)."""
+        q = self.ik.configuration.q.copy()
+        for arm in ARM_PREFIX:
+            q[self.ik._arm_qadr[arm]] = self.world.arm_q(arm)
+        self.ik.reset(q)
+        for arm in ARM_PREFIX:
+            grip = self.world.commands[arm].grip
+            self.targets[arm] = ArmTarget(pose=self.ik.tcp_pose(arm), grip=grip)
+
+    # --------------------------------------------------------------- queries
+    def commanded_pose(self, arm: str) -> PoseTarget:
+        """The arm's commanded tool pose (the start of any new motion)."""
+        pose = self.targets[arm].pose
+        return PoseTarget(pos=pose.pos.copy(), quat=pose.quat.copy())
+
+    def rotation(self, arm: str) -> np.ndarray:
+        """Rotation matrix of the commanded tool pose."""
+        w, x, y, z = self.targets[arm].pose.quat
+        return Rotation.from_quat([x, y, z, w]).as_matrix()
+
+    # ------------------------------------------------------------- commands
+    def set_pose(self, arm: str, pose: PoseTarget) -> None:
+        """Target a tool pose for this tick."""
+        self.targets[arm].pose = pose
+        self.targets[arm].joints = None
+
+    def set_joints(self, arm: str, q: np.ndarray) -> None:
+        """Target joint positions directly for this tick (joint-space moves)."""
+        self.targets[arm].joints = np.asarray(q, dtype=float)
+
+    def set_grip(self, arm: str, grip: float) -> None:
+        """Gripper target in [0, 1]; opening clears the grasp-done signal."""
+        target = self.targets[arm]
+        if grip < target.grip or grip < 0.5:
+            target.grip_closed_settled = False
+        target.grip = float(np.clip(grip, 0.0, 1.0))
+
+    def step(self) -> None:
+        """Solve the IK, send joint and gripper targets, advance the world one tick."""
+        cartesian = {arm: t.pose for arm, t in self.targets.items() if t.joints is None}
+        for arm, target in self.targets.items():
+            if target.joints is not None:
+                self.ik.set_arm_q(arm, target.joints)
+        solution = self.ik.solve(cartesian)
+        for arm, target in self.targets.items():
+            if target.joints is not None:
+                # Keep the pose target consistent with where the joints are sent.
+                target.pose = self.ik.tcp_pose(arm)
+            self.world.command(arm, ArmCommand(q=solution[arm], grip=target.grip))
+        self.world.step()

@@ -1,0 +1,110 @@
+"""Motion primitives the atomic actions are written with.
+
+Each primitive is a generator that sets targets on the controller and yields
+once per control tick, so an action script reads as a plain sequence:
+``yield from move_to(robot, arm, pose)``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+import numpy as np
+from scipy.spatial.transform import Rotation, Slerp
+
+from agentchord.actions.controller import RobotController
+from agentchord.solvers.ik import PoseTarget
+from agentchord.worlds.sim.scene import TABLE_HALF
+
+#: Cartesian speed limits of the tool (m/s, rad/s).
+LINEAR_SPEED = 0.30
+ANGULAR_SPEED = 1.6
+#: Workspace every pose target is clipped to (m): above the table, within reach.
+WORKSPACE_LOW = np.array([-TABLE_HALF[0] + 0.05, 0.22, 0.015])
+WORKSPACE_HIGH = np.array([TABLE_HALF[0] - 0.05, 0.95, 0.55])
+UP = np.array([0.0, 0.0, 1.0])
+
+
+def _to_rotation(quat: np.ndarray) -> Rotation:
+    w, x, y, z = quat
+    return Rotation.from_quat([x, y, z, w])
+
+
+def _to_quat(rotation: Rotation) -> np.ndarray:
+    x, y, z, w = rotation.as_quat()
+    return np.array([w, x, y, z])
+
+
+def pose_from_matrix(pos: np.ndarray, matrix: np.ndarray) -> PoseTarget:
+    """Pose target from a position and a rotation matrix."""
+    return PoseTarget(pos=np.asarray(pos, dtype=float), quat=_to_quat(Rotation.from_matrix(matrix)))
+
+
+def grasp_frame(approach: np.ndarray) -> np.ndarray:
+    """Tool rotation for a side grasp: x along the horizontal approach, z up."""
+    x = np.array([approach[0], approach[1], 0.0])
+    x /= np.linalg.norm(x)
+    y = np.cross(UP, x)
+    return np.column_stack([x, y, UP])
+
+
+def clip_to_workspace(pos: np.ndarray) -> np.ndarray:
+    """Clip a tool position to the stated workspace."""
+    return np.clip(pos, WORKSPACE_LOW, WORKSPACE_HIGH)
+
+
+def min_jerk(s: float) -> float:
+    """Minimum-jerk time scaling of a phase in [0, 1]."""
+    return s * s * s * (10.0 - 15.0 * s + 6.0 * s * s)
+
+
+def move_to(robot: RobotController, arm: str, goal: PoseTarget, speed: float = LINEAR_SPEED) -> Iterator[None]:
+    """Move the tool to ``goal`` along a straight line, position and orientation together."""
+    start = robot.commanded_pose(arm)
+    goal_pos = clip_to_workspace(goal.pos)
+    r0, r1 = _to_rotation(start.quat), _to_rotation(goal.quat)
+    angle = (r0.inv() * r1).magnitude()
+    distance = float(np.linalg.norm(goal_pos - start.pos))
+    # Min-jerk peaks at 1.875x the mean speed: size the duration for the peak.
+    ticks = max(int(np.ceil(1.875 * max(distance / speed, angle / ANGULAR_SPEED) * 50)), 5)
+    slerp = Slerp([0.0, 1.0], Rotation.concatenate([r0, r1]))
+    for k in range(1, ticks + 1):
+        s = min_jerk(k / ticks)
+        robot.set_pose(arm, PoseTarget(pos=start.pos + s * (goal_pos - start.pos), quat=_to_quat(slerp(s))))
+        yield
+
+
+def settle(robot: RobotController, arm: str, tolerance: float = 0.004, max_ticks: int = 20) -> Iterator[None]:
+    """Hold the target until the measured tool is within ``tolerance`` (or time runs out)."""
+    target = robot.commanded_pose(arm).pos
+    for _ in range(max_ticks):
+        if np.linalg.norm(robot.world.tcp_pose(arm)[0] - target) < tolerance:
+            return
+        yield
+
+
+def grip(robot: RobotController, arm: str, value: float, ticks: int = 12, max_wait: int = 20) -> Iterator[None]:
+    """Ramp the gripper to ``value`` (0 open, 1 closed), then wait for the fingers to stop."""
+    start = robot.targets[arm].grip
+    for k in range(1, ticks + 1):
+        robot.set_grip(arm, start + (value - start) * k / ticks)
+        yield
+    previous = robot.world.gripper_width(arm)
+    for _ in range(max_wait):
+        yield
+        width = robot.world.gripper_width(arm)
+        if abs(width - previous) < 2e-4:
+            break
+        previous = width
+    if value >= 0.5:
+        robot.targets[arm].grip_closed_settled = True
+
+
+def move_joints(robot: RobotController, arm: str, q_goal: np.ndarray, speed: float = 1.0) -> Iterator[None]:
+    """Joint-space move at ``speed`` rad/s for the largest joint change."""
+    q0 = robot.ik.arm_q(arm)
+    span = float(np.max(np.abs(q_goal - q0)))
+    ticks = max(int(np.ceil(1.875 * span / speed * 50)), 5)
+    for k in range(1, ticks + 1):
+        robot.set_joints(arm, q0 + min_jerk(k / ticks) * (q_goal - q0))
+        yield

@@ -1,0 +1,313 @@
+"""The executor (paper Algorithm 1): run the augmented graph, tick by tick.
+
+Every control tick: refresh the feature frame, let disturbances act, evaluate
+the active edge's compiled monitors, and on a persistent violation switch at
+once to what the recovery strategy says -- for AgentChord a pre-compiled
+forward-moving recovery edge that starts from the robot's current state, for
+the backtracking ablation a return to an earlier node's keyframe. Budgets end
+an episode as a failure with a reason, never as a hang.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from agentchord.actions.base import ArmAction, Status
+from agentchord.actions.catalog import ACTIONS
+from agentchord.actions.controller import RobotController
+from agentchord.execution.edge_program import EdgeProgram
+from agentchord.execution.strategies import RecoveryStrategy
+from agentchord.execution.trace import Trace
+from agentchord.expr import Vocabulary, compile_expr
+from agentchord.features.frame import FeatureFrame
+from agentchord.features.oracle import OracleExtractor
+from agentchord.graph.models import TaskGraph
+from agentchord.graph.progress import forward_filter, nominal_path
+from agentchord.monitor import Detection, EdgeMonitors, RecoveryMap
+from agentchord.worlds.sim.disturbances import RandomDrop
+from agentchord.worlds.sim.tasks import SuccessTracker
+from agentchord.worlds.sim.world import CONTROL_HZ, SimWorld
+
+
+@dataclass
+class ExecutorConfig:
+    """Budgets of one episode.
+
+    Attributes:
+        tick_limit: Ticks before the episode ends as a failure (50 Hz).
+        failure_budget: Times one failure mode may fire per episode.
+    """
+
+    tick_limit: int = 4000
+    failure_budget: int = 3
+
+
+@dataclass
+class EpisodeResult:
+    """What an episode did: the metrics of DESIGN section 7."""
+
+    success: bool
+    reason: str
+    steps: int
+    time_s: float
+    wall_s: float
+    path: list[str]
+    failures_detected: int
+    recoveries: int
+    drops_injected: int
+    drops_detected: int
+    drops_recovered: int
+    reaction_latency_ticks: list[int]
+    trace: Trace = field(repr=False)
+
+    def summary(self) -> dict:
+        """The JSON summary of ``agentchord run --json``."""
+        return {
+            "success": self.success,
+            "reason": self.reason,
+            "steps": self.steps,
+            "time_s": round(self.time_s, 3),
+            "wall_s": round(self.wall_s, 3),
+            "failures_detected": self.failures_detected,
+            "recoveries": self.recoveries,
+            "drops_injected": self.drops_injected,
+            "drops_detected": self.drops_detected,
+            "drops_recovered": self.drops_recovered,
+            "reaction_latency_ticks": self.reaction_latency_ticks,
+            "path": self.path,
+        }
+
+
+class Executor:
+    """Runs one episode of a graph on a world with a recovery strategy.
+
+    Args:
+        graph: The recovery-augmented graph (the forward-moving filter is applied here).
+        world: The world to act in.
+        strategy: What to do when a monitor fires.
+        tracker: Judges task success from the frames.
+        disturbance: Seeded disturbance schedule (None: undisturbed).
+        config: Budgets.
+        on_tick: Called after every tick (video recording).
+    """
+
+    def __init__(
+        self,
+        graph: TaskGraph,
+        world: SimWorld,
+        strategy: RecoveryStrategy,
+        tracker: SuccessTracker,
+        disturbance: RandomDrop | None = None,
+        config: ExecutorConfig | None = None,
+        on_tick: Callable[[Executor], None] | None = None,
+    ) -> None:
+        filtered = forward_filter(graph)
+        self.graph = filtered.graph
+        self.world = world
+        self.strategy = strategy
+        self.tracker = tracker
+        self.disturbance = disturbance
+        self.config = config or ExecutorConfig()
+        self.on_tick = on_tick
+        self.trace = Trace()
+        for removed in filtered.removed:
+            self.trace.add(0, "branch_removed", failure=removed.failure, edge=removed.edge, reason=removed.reason)
+        self.robot = RobotController(world)
+        self.extractor = OracleExtractor(world, grasp_signal=lambda arm: self.robot.targets[arm].grip_closed_settled)
+        self.robot.frame = self.extractor.frame
+        vocabulary = Vocabulary(frozenset(self.graph.objects))
+        # Compile once, before execution: the tick loop only evaluates closures.
+        self.monitors = {edge.id: EdgeMonitors.compile(edge, vocabulary) for edge in self.graph.edges}
+        self.constraints = {
+            node.id: [compile_expr(c, vocabulary) for c in node.constraints] for node in self.graph.nodes
+        }
+        self.recovery_map = RecoveryMap(self.graph)
+        self.nominal_next = {self.graph.edge(e).source: e for e in nominal_path(self.graph)}
+        # Per reached nominal node: the robot's keyframe (arm joints and grips), for backtracking.
+        self.keyframes: dict[str, dict[str, tuple[np.ndarray, float]]] = {}
+        self.visited_nominal: list[str] = []
+        self.path: list[str] = []
+        self.program: EdgeProgram | None = None
+        self.armed: EdgeMonitors | None = None
+        self.recovering_from: str | None = None
+        self.fire_counts: dict[tuple[str, str], int] = {}
+        self.node = self.graph.start
+        self._open_drop: dict | None = None
+        self._latencies: list[int] = []
+        self._drops_detected = 0
+        self._drops_recovered = 0
+        self._recovery_drop: dict | None = None
+
+    # ------------------------------------------------------------- queries
+    @property
+    def frame(self) -> FeatureFrame:
+        """The current feature frame."""
+        return self.extractor.frame
+
+    def constraints_hold(self, node_id: str) -> bool:
+        """Whether a node's sub-goal constraints all hold on the current frame (Eq. 3)."""
+        return all(c.scalar(self.frame) <= 0.0 for c in self.constraints[node_id])
+
+    def violated_constraints(self, node_id: str) -> list[str]:
+        """The source text of a node's constraints that do not hold now."""
+        return [c.source for c in self.constraints[node_id] if c.scalar(self.frame) > 0.0]
+
+    # ------------------------------------------------------------ episode
+    def run(self) -> EpisodeResult:
+        """Execute until the goal, a failure or a budget ends the episode."""
+        wall0 = time.perf_counter()
+        self.trace.add(self.world.tick, "episode_start", task=self.graph.task, strategy=self.strategy.name, start=self.graph.start)
+        self._arrive(self.graph.start)
+        success, reason = False, ""
+        while True:
+            outcome = self._tick()
+            if outcome is not None:
+                success, reason = outcome
+                break
+        result = EpisodeResult(
+            success=success,
+            reason=reason,
+            steps=self.world.tick,
+            time_s=self.world.tick / CONTROL_HZ,
+            wall_s=time.perf_counter() - wall0,
+            path=self.path,
+            failures_detected=len(self.trace.of("failure_detected")),
+            recoveries=len(self.trace.of("recovery_switch")),
+            drops_injected=len(self.disturbance.events) if self.disturbance else 0,
+            drops_detected=self._drops_detected,
+            drops_recovered=self._drops_recovered,
+            reaction_latency_ticks=self._latencies,
+            trace=self.trace,
+        )
+        self.trace.add(self.world.tick, "episode_end", success=success, reason=reason, steps=result.steps)
+        return result
+
+    def _tick(self) -> tuple[bool, str] | None:
+        frame = self.extractor.update()
+        self.tracker.observe(frame)
+        if self.disturbance is not None:
+            drop = self.disturbance.apply(self.world, frame)
+            if drop is not None:
+                self._open_drop = {"tick": drop.tick, "obj": drop.obj}
+                self.trace.add(drop.tick, "disturbance", kind="drop", arm=drop.arm, obj=drop.obj, action=drop.action)
+        if self.world.tick >= self.config.tick_limit:
+            return False, f"tick limit {self.config.tick_limit} reached at {self._where()}"
+        if self.armed is not None:
+            detection = self.armed.evaluate(frame)
+            if detection is not None:
+                outcome = self._on_failure(detection)
+                if outcome is not None:
+                    return outcome
+        status = self.program.update(self.robot)
+        if status == Status.FAILURE:
+            return False, f"{self._where()}: {self.program.failure_reason}"
+        if status == Status.SUCCESS:
+            outcome = self._on_program_done()
+            if outcome is not None:
+                return outcome
+        self.robot.step()
+        if self.on_tick is not None:
+            self.on_tick(self)
+        return None
+
+    def _where(self) -> str:
+        return f"edge {self.program.edge_id}" if self.program else f"node {self.node}"
+
+    # ------------------------------------------------------- transitions
+    def _arrive(self, node_id: str) -> tuple[bool, str] | None:
+        """Reach a node: record it, then start the next edge (or finish at the goal)."""
+        node = self.graph.node(node_id)
+        held = self.constraints_hold(node_id)
+        self.node = node_id
+        self.path.append(node_id)
+        self.trace.add(self.world.tick, "node_reached", node=node_id, kind=node.kind, constraints_hold=held,
+                       violated=[] if held else self.violated_constraints(node_id))
+        if node.kind == "nominal":
+            self.visited_nominal.append(node_id)
+            self.keyframes[node_id] = {arm: (self.robot.ik.arm_q(arm), t.grip) for arm, t in self.robot.targets.items()}
+            if self.recovering_from is not None:
+                self.recovering_from = None
+                self.trace.add(self.world.tick, "recovery_merged", node=node_id)
+                if self._recovery_drop is not None:
+                    self._drops_recovered += 1
+                    self._recovery_drop = None
+        if node_id == self.graph.goal:
+            verdict = self.tracker.verdict(self.frame, self.world)
+            return verdict.success, verdict.reason
+        next_edge = self.strategy.next_edge(self, node_id)
+        if next_edge is None:
+            return False, f"no edge leaves node {node_id} toward the goal"
+        self._start(EdgeProgram.from_edge(self.graph.edge(next_edge)))
+        return None
+
+    def _start(self, program: EdgeProgram) -> None:
+        """Start an edge program from the robot's current state."""
+        self.program = program
+        program.on_action_start = self._action_started
+        program.on_action_end = self._action_ended
+        edge_monitors = self.monitors.get(program.edge_id)
+        if edge_monitors is not None and edge_monitors.monitors:
+            self.armed = edge_monitors
+        elif program.kind == "nominal" or self.recovering_from is None:
+            self.armed = None
+        else:
+            # A recovery keeps the failed edge's monitors armed: a second drop re-enters recovery.
+            self.armed = self.monitors[self.recovering_from]
+        if self.armed is not None:
+            self.armed.reset()
+        self.frame.capture_refs()
+        self.path.append(program.edge_id)
+        self.trace.add(self.world.tick, "edge_start", edge=program.edge_id, kind=program.kind, target=program.target)
+        program.initialise(self.robot)
+
+    def _on_program_done(self) -> tuple[bool, str] | None:
+        program = self.program
+        self.trace.add(self.world.tick, "edge_end", edge=program.edge_id)
+        self.program = None
+        target = self.graph.node(program.target) if program.kind != "backtrack" else None
+        if target is not None and target.kind == "recovery":
+            self.path.append(target.id)
+            self.trace.add(self.world.tick, "node_reached", node=target.id, kind="recovery", constraints_hold=self.constraints_hold(target.id))
+            exits = self.recovery_map.exit_edges(target.id)
+            if not exits:
+                return False, f"recovery node {target.id} has no exit edge"
+            self._start(EdgeProgram.from_edge(exits[0]))
+            return None
+        return self._arrive(program.target)
+
+    def _on_failure(self, detection: Detection) -> tuple[bool, str] | None:
+        key = (detection.edge_id, detection.failure.name)
+        self.fire_counts[key] = self.fire_counts.get(key, 0) + 1
+        self.trace.add(detection.tick, "failure_detected", edge=detection.edge_id, failure=detection.failure.name,
+                       onset_tick=detection.onset_tick, value=detection.value, count=self.fire_counts[key])
+        if self._open_drop is not None:
+            self._drops_detected += 1
+            self._latencies.append(detection.tick - self._open_drop["tick"])
+            self._recovery_drop, self._open_drop = self._open_drop, None
+        if self.fire_counts[key] > self.config.failure_budget:
+            return False, f"failure budget exhausted: {detection.failure.name} on {detection.edge_id} fired {self.fire_counts[key]} times"
+        self.program.terminate(Status.INVALID)
+        failed_nominal = self.recovering_from or detection.edge_id
+        program = self.strategy.recover(self, detection)
+        if program is None:
+            return False, f"no recovery for {detection.failure.name} on {detection.edge_id}"
+        self.recovering_from = failed_nominal
+        self.trace.add(self.world.tick, "recovery_switch", failure=detection.failure.name, edge=detection.edge_id,
+                       to=program.edge_id, strategy=self.strategy.name, latency_ticks=self.world.tick - detection.onset_tick)
+        self._start(program)
+        return None
+
+    # --------------------------------------------------------- hooks
+    def _action_started(self, arm: str, action: ArmAction) -> None:
+        self.trace.add(self.world.tick, "action_start", arm=arm, action=action.describe())
+        if self.disturbance is not None:
+            spec = ACTIONS.get(action.name)
+            self.disturbance.action_started(arm, action.name, spec.expected_ticks if spec else 100, self.world.tick)
+
+    def _action_ended(self, arm: str, action: ArmAction) -> None:
+        if self.disturbance is not None:
+            self.disturbance.action_ended(arm)

@@ -1,0 +1,74 @@
+"""Recovery strategies compared on one executor (DESIGN section 6).
+
+A strategy answers two questions: which edge follows a node, and what to run
+when a monitor fires. AgentChord answers the second with a dictionary lookup
+into the pre-compiled recovery map; the backtracking ablation returns to an
+earlier node's keyframe and re-runs the nominal edges from there.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from agentchord.execution.edge_program import EdgeProgram, ReturnToKeyframe
+
+if TYPE_CHECKING:
+    from agentchord.execution.executor import Executor
+    from agentchord.monitor import Detection
+
+
+class RecoveryStrategy:
+    """Base: follow the nominal path; subclasses decide how to recover."""
+
+    name = "base"
+
+    def next_edge(self, executor: Executor, node_id: str) -> str | None:
+        """The nominal edge to run from a nominal node."""
+        return executor.nominal_next.get(node_id)
+
+    def recover(self, executor: Executor, detection: Detection) -> EdgeProgram | None:
+        """The program to switch to when ``detection`` fired (None: give up)."""
+        raise NotImplementedError
+
+
+class AgentChordStrategy(RecoveryStrategy):
+    """Switch to the pre-compiled forward-moving recovery edge (Eq. 13): no re-planning."""
+
+    name = "agentchord"
+
+    def recover(self, executor: Executor, detection: Detection) -> EdgeProgram | None:
+        entry = executor.recovery_map.entry(detection.edge_id, detection.failure.name)
+        return None if entry is None else EdgeProgram.from_edge(entry)
+
+
+class BacktrackStrategy(RecoveryStrategy):
+    """AgentChord-BT (paper Appendix E-C): back to the latest earlier nominal node that holds.
+
+    The robot returns to that node's keyframe (joint-space), then the nominal
+    edges run again from there.
+    """
+
+    name = "agentchord-bt"
+
+    def recover(self, executor: Executor, detection: Detection) -> EdgeProgram | None:
+        for node_id in reversed(executor.visited_nominal):
+            if executor.constraints_hold(node_id):
+                keyframe = executor.keyframes[node_id]
+                actions = [ReturnToKeyframe(arm, q, grip) for arm, (q, grip) in keyframe.items()]
+                return EdgeProgram(f"backtrack_to_{node_id}", node_id, [actions], kind="backtrack")
+        return None
+
+
+STRATEGIES: dict[str, type[RecoveryStrategy]] = {s.name: s for s in (AgentChordStrategy, BacktrackStrategy)}
+
+
+def make_strategy(name: str) -> RecoveryStrategy:
+    """A strategy by name.
+
+    Raises:
+        ValueError: Unknown strategy name.
+    """
+    try:
+        return STRATEGIES[name]()
+    except KeyError:
+        raise ValueError(f"unknown strategy {name!r} (choose from: {', '.join(STRATEGIES)})") from None

@@ -1,0 +1,79 @@
+"""Oracle feature extraction: the feature frame read from the simulator state.
+
+What a perfect perception stack would report (the paper's simulation setting,
+Sec. IV-B): object poses from the physics, the grasp from finger contacts.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+from agentchord.features.frame import ARMS, ArmFeatures, FeatureFrame, ObjectFeatures
+from agentchord.worlds.sim.world import SimWorld
+
+
+class OracleExtractor:
+    """Builds a :class:`FeatureFrame` from a :class:`SimWorld` every tick.
+
+    The same frame object is updated in place, so the references captured with
+    ``capture_refs`` survive between ticks.
+
+    Args:
+        world: The simulated world to read.
+        grasp_signal: Callable ``arm -> bool``: the robot's latched "grasp done"
+            signal (the controller knows it, the world does not).
+    """
+
+    def __init__(self, world: SimWorld, grasp_signal=None) -> None:
+        self.world = world
+        self.grasp_signal = grasp_signal or (lambda arm: False)
+        self.frame = FeatureFrame(objects={}, arms={})
+        self._half_heights = {}
+        for name in world.object_names:
+            spec = world.object_spec(name)
+            if spec.shape == "cylinder":
+                extent = np.array([2 * spec.size[0], 2 * spec.size[0], 2 * spec.size[1]])
+            else:
+                extent = 2 * np.asarray(spec.size, dtype=float)
+            self._half_heights[name] = 0.5 * extent[2]
+            self.frame.objects[name] = ObjectFeatures(
+                pos=np.zeros(3), quat=np.zeros(4), axis=np.zeros(3), extent=extent, top=np.zeros(3), bottom=np.zeros(3)
+            )
+        for arm in ARMS:
+            self.frame.arms[arm] = ArmFeatures(ee=np.zeros(3), ee_quat=np.zeros(4), q=np.zeros(6), width=0.0, closed=0.0)
+        self.update()
+        self.frame.capture_refs()
+
+    def update(self) -> FeatureFrame:
+        """Refresh the frame from the current simulator state."""
+        world, frame = self.world, self.frame
+        for name, feats in frame.objects.items():
+            pos, rot = world.object_pose(name)
+            axis = rot[:, 2]
+            half = self._half_heights[name] * axis
+            feats.pos = pos
+            feats.quat = world.object_quat(name)
+            feats.axis = axis
+            feats.top = pos + half
+            feats.bottom = pos - half
+        holding = set()
+        for arm, feats in frame.arms.items():
+            ee, rot = world.tcp_pose(arm)
+            feats.ee = ee
+            feats.ee_quat = _quat_from_matrix(rot)
+            feats.q = world.arm_q(arm)
+            feats.width = world.gripper_width(arm)
+            feats.closed = 1.0 if self.grasp_signal(arm) else 0.0
+            for name in frame.objects:
+                if world.holding(arm, name):
+                    holding.add((arm, name))
+        frame.holding = holding
+        frame.tick = world.tick
+        return frame
+
+
+def _quat_from_matrix(rot: np.ndarray) -> np.ndarray:
+    quat = np.empty(4)
+    mujoco.mju_mat2Quat(quat, rot.reshape(-1))
+    return quat

@@ -1,0 +1,68 @@
+"""Compiled monitors: a failure mode's expression plus its persistence trigger."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from agentchord.expr import CompiledExpr, Vocabulary, compile_expr
+from agentchord.features.frame import FeatureFrame
+from agentchord.graph.models import Edge, FailureMode
+from agentchord.monitor.trigger import PersistenceTrigger
+
+
+@dataclass
+class CompiledMonitor:
+    """One failure mode of one edge, ready to evaluate every tick (paper Eq. 11-12)."""
+
+    edge_id: str
+    failure: FailureMode
+    expr: CompiledExpr
+    trigger: PersistenceTrigger = field(init=False)
+
+    def __post_init__(self) -> None:
+        self.trigger = PersistenceTrigger(self.failure.margin, self.failure.window)
+
+
+@dataclass
+class Detection:
+    """A failure mode that fired.
+
+    Attributes:
+        edge_id: The edge that was active.
+        failure: The failure mode that fired.
+        tick: Tick it fired at.
+        onset_tick: First tick of the run of violations that made it fire.
+        value: The monitor's value when it fired.
+    """
+
+    edge_id: str
+    failure: FailureMode
+    tick: int
+    onset_tick: int
+    value: float
+
+
+class EdgeMonitors:
+    """The monitors of the active edge, evaluated together every tick."""
+
+    def __init__(self, monitors: list[CompiledMonitor]) -> None:
+        self.monitors = monitors
+
+    @classmethod
+    def compile(cls, edge: Edge, vocabulary: Vocabulary) -> EdgeMonitors:
+        """Compile every failure mode of an edge."""
+        return cls([CompiledMonitor(edge.id, f, compile_expr(f.monitor, vocabulary)) for f in edge.failures])
+
+    def reset(self) -> None:
+        """Clear the persistence history (the edge (re)starts)."""
+        for monitor in self.monitors:
+            monitor.trigger.reset()
+
+    def evaluate(self, frame: FeatureFrame) -> Detection | None:
+        """Evaluate all monitors on a frame; the first that fires, if any."""
+        fired = None
+        for monitor in self.monitors:
+            value = monitor.expr.scalar(frame)
+            if monitor.trigger.update(value, frame.tick) and fired is None:
+                fired = Detection(monitor.edge_id, monitor.failure, frame.tick, monitor.trigger.first_violation_tick, value)
+        return fired

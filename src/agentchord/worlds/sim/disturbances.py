@@ -1,0 +1,85 @@
+"""Seeded disturbances. Issue 2 ships the paper's simulated one: the random drop.
+
+The schedule is a stream drawn from the seed, consumed once per atomic action
+started, so two strategies run with the same seed see the same draws for
+their n-th action: the same disturbances until their paths diverge.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from agentchord.features.frame import FeatureFrame
+from agentchord.worlds.sim.world import SimWorld
+
+
+@dataclass
+class DropEvent:
+    """One injected drop.
+
+    Attributes:
+        tick: Tick the gripper was forced open.
+        arm: The arm that lost its object.
+        obj: The object that was dropped.
+        action: The atomic action that was running.
+    """
+
+    tick: int
+    arm: str
+    obj: str
+    action: str
+
+
+@dataclass
+class RandomDrop:
+    """With probability ``p`` per atomic action, the held object is dropped at a random moment.
+
+    The drop is a gripper fault: the fingers are forced open for ``fault_ticks``
+    ticks, then control returns to the program. If the arm holds nothing at
+    the drawn moment, nothing happens (there is nothing to drop).
+
+    Args:
+        p: Probability per atomic action.
+        seed: Seed of the schedule.
+        fault_ticks: How long the fingers are forced open.
+    """
+
+    p: float
+    seed: int
+    fault_ticks: int = 12
+    events: list[DropEvent] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        if not 0.0 <= self.p <= 1.0:
+            raise ValueError(f"drop probability must be in [0, 1], got {self.p}")
+        self._rng = np.random.default_rng([self.seed, 0xD209])
+        self._pending: dict[str, tuple[int, str]] = {}
+
+    def action_started(self, arm: str, action: str, expected_ticks: int, tick: int) -> None:
+        """Draw whether (and when) this action will suffer a drop."""
+        # Always draw both numbers so the stream stays aligned across strategies.
+        drop, moment = self._rng.random() < self.p, self._rng.random()
+        if drop:
+            self._pending[arm] = (tick + 1 + int(moment * expected_ticks), action)
+        else:
+            self._pending.pop(arm, None)
+
+    def action_ended(self, arm: str) -> None:
+        """The action ended (or was interrupted) before its drawn moment: no drop."""
+        self._pending.pop(arm, None)
+
+    def apply(self, world: SimWorld, frame: FeatureFrame) -> DropEvent | None:
+        """Inject a drop that is due now."""
+        for arm, (due, action) in list(self._pending.items()):
+            if world.tick < due:
+                continue
+            del self._pending[arm]
+            held = sorted(obj for a, obj in frame.holding if a == arm)
+            if held:
+                world.inject_gripper_fault(arm, self.fault_ticks)
+                event = DropEvent(tick=world.tick, arm=arm, obj=held[0], action=action)
+                self.events.append(event)
+                return event
+        return None

@@ -1,0 +1,227 @@
+"""Build the MuJoCo scene: the ALOHA bimanual ViperX on a table, plus task objects.
+
+The robot's XML and meshes are loaded by path from the installed ``gym-aloha``
+package (we neither import its environments nor copy its files) and edited
+through ``mujoco.MjSpec``: a tool-centre site between the fingers, gravity
+compensation, lighter joint friction, our own actuators, a thick collision
+table and a floor. Objects are added as free bodies with explicit inertia.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+
+import mujoco
+import numpy as np
+
+from agentchord.worlds.sim.exceptions import SceneError
+
+ARM_PREFIX = {"left": "vx300s_left", "right": "vx300s_right"}
+ARM_JOINTS = ("waist", "shoulder", "elbow", "forearm_roll", "wrist_angle", "wrist_rotate")
+#: Position gains of the arm joint actuators (N m / rad). Higher than gym-aloha's
+#: so that a 0.4 kg bottle does not sag the wrist during a pour.
+ARM_KP = (800.0, 1600.0, 800.0, 300.0, 300.0, 200.0)
+ARM_FORCE = (150.0, 300.0, 150.0, 60.0, 60.0, 40.0)
+FINGER_KP = 400.0
+FINGER_FORCE = 12.0
+#: Finger joint range; the pad gap is ``2 q - FINGER_GAP_OFFSET``.
+FINGER_RANGE = (0.021, 0.057)
+FINGER_GAP_OFFSET = 0.0448
+#: Tool centre point: between the finger pads, along the gripper's x (approach) axis.
+TCP_OFFSET = 0.115
+TABLE_HALF = (0.61, 0.381, 0.02)
+TABLE_CENTER = (0.0, 0.6)
+#: Home configuration of one arm (gym-aloha's keyframe, arm joints only).
+HOME_Q = np.array([0.0, -0.96, 1.16, 0.0, -0.3, 0.0])
+
+
+def aloha_assets_dir() -> str:
+    """The folder of the ALOHA model files inside the installed gym-aloha package."""
+    try:
+        import gym_aloha  # noqa: PLC0415  (imported for its data files only)
+    except ImportError as exc:  # pragma: no cover - install problem
+        raise SceneError("gym-aloha is not installed: run `make install` (it ships the ALOHA model)") from exc
+    path = os.path.join(os.path.dirname(gym_aloha.__file__), "assets")
+    if not os.path.isfile(os.path.join(path, "vx300s_right.xml")):
+        raise SceneError(f"{path}: the ALOHA model files are missing from the gym-aloha package")
+    return path
+
+
+@dataclass
+class ObjectSpec:
+    """A rigid object of the scene.
+
+    Attributes:
+        name: Object name (also the MuJoCo body name).
+        shape: ``cylinder`` (radius, half-height) or ``box`` (half-sizes).
+        size: Shape parameters as MuJoCo expects them.
+        mass: Mass in kg.
+        pos: Initial (x, y) on the table; z is set from the size.
+        yaw: Initial rotation about z (rad).
+        rgba: Colour.
+        friction: Sliding friction coefficient.
+    """
+
+    name: str
+    shape: str
+    size: tuple[float, ...]
+    mass: float
+    pos: tuple[float, float]
+    yaw: float = 0.0
+    rgba: tuple[float, float, float, float] = (0.2, 0.5, 0.9, 1.0)
+    friction: float = 1.0
+
+    @property
+    def height(self) -> float:
+        """Full height of the object standing upright."""
+        return 2.0 * (self.size[1] if self.shape == "cylinder" else self.size[2])
+
+    @property
+    def width(self) -> float:
+        """Smallest horizontal width (what a gripper closes on)."""
+        return 2.0 * self.size[0] if self.shape == "cylinder" else 2.0 * min(self.size[0], self.size[1])
+
+
+@dataclass
+class SceneSpec:
+    """Everything needed to build one trial's scene."""
+
+    objects: list[ObjectSpec] = field(default_factory=list)
+    timestep: float = 0.002
+
+
+def _edit_robot(spec: mujoco.MjSpec) -> None:
+    for arm, prefix in ARM_PREFIX.items():
+        for body in spec.bodies:
+            if body.name.startswith(prefix + "/"):
+                # Gravity compensation: hold error 2.4 mm -> 0.5 mm in the prototype.
+                body.gravcomp = 1.0
+        for joint_name in ARM_JOINTS:
+            joint = spec.joint(f"{prefix}/{joint_name}")
+            # gym-aloha's 30-60 N m of friction loss made the arm lag and knock objects over.
+            joint.frictionloss = 1.0
+            joint.damping = [2.0, 0.0, 0.0]
+            joint.armature = 0.01
+        for finger in ("left_finger", "right_finger"):
+            joint = spec.joint(f"{prefix}/{finger}")
+            joint.frictionloss = 0.2
+            joint.damping = [5.0, 0.0, 0.0]
+        gripper = spec.body(f"{prefix}/gripper_link")
+        gripper.add_site(name=f"{arm}_tcp", pos=[TCP_OFFSET, 0.0, 0.0], size=[0.004, 0.004, 0.004], rgba=[1, 0, 0, 0])
+        for joint_name, kp, force in zip(ARM_JOINTS, ARM_KP, ARM_FORCE):
+            joint = spec.joint(f"{prefix}/{joint_name}")
+            spec.add_actuator(
+                name=f"{arm}_{joint_name}",
+                target=joint.name,
+                trntype=mujoco.mjtTrn.mjTRN_JOINT,
+                gaintype=mujoco.mjtGain.mjGAIN_FIXED,
+                biastype=mujoco.mjtBias.mjBIAS_AFFINE,
+                gainprm=[kp] + [0] * 9,
+                biasprm=[0, -kp, -0.05 * kp] + [0] * 7,
+                ctrlrange=list(joint.range),
+                ctrllimited=True,
+                forcerange=[-force, force],
+                forcelimited=True,
+            )
+        for finger, sign in (("left_finger", 1.0), ("right_finger", -1.0)):
+            lo, hi = FINGER_RANGE
+            spec.add_actuator(
+                name=f"{arm}_{finger}",
+                target=f"{prefix}/{finger}",
+                trntype=mujoco.mjtTrn.mjTRN_JOINT,
+                gaintype=mujoco.mjtGain.mjGAIN_FIXED,
+                biastype=mujoco.mjtBias.mjBIAS_AFFINE,
+                gainprm=[FINGER_KP] + [0] * 9,
+                biasprm=[0, -FINGER_KP, -0.1 * FINGER_KP] + [0] * 7,
+                ctrlrange=[lo, hi] if sign > 0 else [-hi, -lo],
+                ctrllimited=True,
+                forcerange=[-FINGER_FORCE, FINGER_FORCE],
+                forcelimited=True,
+            )
+            # Friction high enough to hold a 0.4 kg bottle with a 12 N squeeze.
+            geom = spec.geom(f"{prefix}/10_{finger.split('_')[0]}_gripper_finger")
+            geom.friction = [1.5, 0.01, 0.001]
+            geom.condim = 4
+            geom.solimp = [0.95, 0.99, 0.001, 0.5, 2.0]
+            geom.solref = [0.01, 1.0]
+
+
+def _add_environment(spec: mujoco.MjSpec) -> None:
+    world = spec.worldbody
+    world.add_geom(name="floor", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[2, 2, 0.1], pos=[0, 0.6, -0.75], rgba=[0.35, 0.35, 0.38, 1])
+    table = world.add_body(name="table", pos=[TABLE_CENTER[0], TABLE_CENTER[1], -TABLE_HALF[2]])
+    # A thick box, not the thin mesh: objects resting on a mesh skin were launched.
+    table.add_geom(name="table", type=mujoco.mjtGeom.mjGEOM_BOX, size=list(TABLE_HALF), rgba=[0.55, 0.45, 0.35, 1], friction=[1.0, 0.005, 0.0001])
+    for xyz, direction in (((-1, -1, 1.5), (1, 1, -1.5)), ((1, -1, 1.5), (-1, 1, -1.5))):
+        world.add_light(pos=list(xyz), dir=list(direction), type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL, diffuse=[0.45, 0.45, 0.45], castshadow=0)
+    world.add_camera(name="front", pos=[0.0, -0.45, 0.75], xyaxes=[1, 0, 0, 0, 0.72, 0.7])
+    world.add_camera(name="top", pos=[0.0, 0.6, 1.35], xyaxes=[1, 0, 0, 0, 1, 0])
+    world.add_camera(name="side", pos=[1.15, 0.35, 0.55], xyaxes=[0.3, 0.95, 0, -0.35, 0.1, 0.93])
+    spec.visual.quality.offsamples = 0
+    spec.visual.quality.shadowsize = 0
+    spec.visual.headlight.ambient = [0.35, 0.35, 0.35]
+
+
+def _add_object(spec: mujoco.MjSpec, obj: ObjectSpec) -> None:
+    # Spawn 1 mm above the table: exact contact with the table launched cylinders.
+    z = 0.5 * obj.height + 0.001
+    quat = [np.cos(obj.yaw / 2), 0.0, 0.0, np.sin(obj.yaw / 2)]
+    body = spec.worldbody.add_body(name=obj.name, pos=[obj.pos[0], obj.pos[1], z], quat=quat)
+    body.add_freejoint(name=f"{obj.name}_free")
+    geom_type = mujoco.mjtGeom.mjGEOM_CYLINDER if obj.shape == "cylinder" else mujoco.mjtGeom.mjGEOM_BOX
+    body.add_geom(
+        name=obj.name,
+        type=geom_type,
+        size=list(obj.size) + [0.0] * (3 - len(obj.size)),
+        rgba=list(obj.rgba),
+        friction=[obj.friction, 0.005, 0.0001],
+        condim=4,
+        solimp=[0.95, 0.99, 0.001, 0.5, 2.0],
+        solref=[0.01, 1.0],
+        # Group-0 geoms get no mass from inertiagrouprange="4 5": inertia is explicit.
+        mass=0.0,
+    )
+    if obj.shape == "cylinder":
+        r, h = obj.size[0], obj.size[1]
+        inertia = [obj.mass * (3 * r * r + 4 * h * h) / 12] * 2 + [0.5 * obj.mass * r * r]
+    else:
+        a, b, c = (2 * s for s in obj.size)
+        inertia = [obj.mass * (b * b + c * c) / 12, obj.mass * (a * a + c * c) / 12, obj.mass * (a * a + b * b) / 12]
+    body.mass = obj.mass
+    body.ipos = [0.0, 0.0, 0.0]
+    body.iquat = [1.0, 0.0, 0.0, 0.0]
+    body.inertia = inertia
+    body.explicitinertial = True
+
+
+def build_model(scene: SceneSpec) -> mujoco.MjModel:
+    """Compile the robot, the table and the scene's objects into one model.
+
+    Raises:
+        SceneError: If the ALOHA assets are missing or the model does not compile.
+    """
+    assets = aloha_assets_dir()
+    xml = f"""<mujoco model="agentchord_aloha">
+  <compiler meshdir="{assets}" angle="radian"/>
+  <option timestep="{scene.timestep}" integrator="implicitfast" cone="elliptic" noslip_iterations="3"/>
+  <include file="{assets}/vx300s_dependencies.xml"/>
+  <worldbody>
+    <include file="{assets}/vx300s_left.xml"/>
+    <include file="{assets}/vx300s_right.xml"/>
+  </worldbody>
+</mujoco>"""
+    try:
+        spec = mujoco.MjSpec.from_string(xml)
+        _edit_robot(spec)
+        _add_environment(spec)
+        for obj in scene.objects:
+            _add_object(spec, obj)
+        return spec.compile()
+    except ValueError as exc:
+        raise SceneError(f"the scene does not compile: {exc}") from exc
+
+
+def build_robot_model() -> mujoco.MjModel:
+    """The robot alone: what the IK solver works on (no free-floating objects)."""
+    return build_model(SceneSpec(objects=[]))

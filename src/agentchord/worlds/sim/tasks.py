@@ -1,0 +1,124 @@
+"""Simulated tasks: randomised trial scenes and success checks (paper Appendix B).
+
+A task knows how to sample one trial's scene from a seeded generator (object
+instances within a category, table poses) and how to judge success from the
+feature frames of the episode. The task *graph* lives in the task library
+(:mod:`agentchord.tasks`); this module is the world side only.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from agentchord.features.frame import FeatureFrame
+from agentchord.worlds.sim.scene import ObjectSpec, SceneSpec
+from agentchord.worlds.sim.world import SimWorld
+
+
+@dataclass
+class Verdict:
+    """Whether the task succeeded, and why not."""
+
+    success: bool
+    reason: str
+
+
+@dataclass
+class SuccessTracker:
+    """Success of single-arm pour water, judged from the episode's frames.
+
+    The bottle must reach a pouring orientation with its mouth above the cup
+    (an event during the episode), and at the end stand upright on the table,
+    released and at rest.
+
+    Attributes:
+        pour_tilt_deg: Tilt that counts as pouring.
+        poured: Whether the pouring event happened.
+        poured_tick: Tick of the first pouring event.
+    """
+
+    pour_tilt_deg: float = 70.0
+    poured: bool = False
+    poured_tick: int | None = None
+    events: list[str] = field(default_factory=list)
+
+    def observe(self, frame: FeatureFrame) -> None:
+        """Watch one tick for the pouring event."""
+        if self.poured:
+            return
+        bottle, cup = frame.objects["bottle"], frame.objects["cup"]
+        if not frame.is_holding("right", "bottle"):
+            return
+        tilt = np.degrees(np.arccos(np.clip(bottle.axis[2], -1.0, 1.0)))
+        lateral = np.linalg.norm((bottle.top - cup.top)[:2])
+        if tilt >= self.pour_tilt_deg and lateral <= 0.5 * cup.extent[0] + 0.01 and bottle.top[2] > cup.top[2]:
+            self.poured = True
+            self.poured_tick = frame.tick
+
+    def verdict(self, frame: FeatureFrame, world: SimWorld) -> Verdict:
+        """Judge the end state."""
+        bottle = frame.objects["bottle"]
+        tilt = np.degrees(np.arccos(np.clip(bottle.axis[2], -1.0, 1.0)))
+        if not self.poured:
+            return Verdict(False, "the bottle never reached a pouring orientation above the cup")
+        if any(arm == "right" or arm == "left" for arm, obj in frame.holding if obj == "bottle"):
+            return Verdict(False, "the bottle is still held")
+        if tilt > 10.0:
+            return Verdict(False, f"the bottle is not upright (tilt {tilt:.0f} deg)")
+        if bottle.bottom[2] > 0.01 or not world.on_table("bottle"):
+            return Verdict(False, "the bottle is not standing on the table")
+        if world.object_velocity("bottle") > 0.02:
+            return Verdict(False, "the bottle is still moving")
+        return Verdict(True, "poured, then placed upright and released")
+
+
+class SingleArmPourWater:
+    """Pour from a bottle into a cup with the right arm, then put the bottle down."""
+
+    name = "single_arm_pour_water"
+    description = "Right arm grasps a bottle, pours into a cup, places the bottle upright."
+
+    #: Sampling ranges (m, kg): bottle and cup instances and their table positions.
+    BOTTLE_RADIUS = (0.024, 0.030)
+    BOTTLE_HALF_HEIGHT = (0.08, 0.10)
+    BOTTLE_MASS = (0.15, 0.35)
+    BOTTLE_XY = ((0.04, 0.12), (0.48, 0.60))
+    CUP_RADIUS = (0.035, 0.045)
+    CUP_HALF_HEIGHT = (0.04, 0.055)
+    CUP_MASS = (0.15, 0.30)
+    CUP_XY = ((-0.14, -0.06), (0.52, 0.64))
+
+    def sample_scene(self, rng: np.random.Generator) -> SceneSpec:
+        """One trial's scene: object instances and poses drawn from the stated ranges."""
+
+        def uniform(bounds: tuple[float, float]) -> float:
+            return float(rng.uniform(*bounds))
+
+        bottle = ObjectSpec(
+            name="bottle",
+            shape="cylinder",
+            size=(uniform(self.BOTTLE_RADIUS), uniform(self.BOTTLE_HALF_HEIGHT)),
+            mass=uniform(self.BOTTLE_MASS),
+            pos=(uniform(self.BOTTLE_XY[0]), uniform(self.BOTTLE_XY[1])),
+            rgba=(*rng.uniform(0.1, 0.6, 2), rng.uniform(0.6, 1.0), 1.0),
+            friction=uniform((0.8, 1.2)),
+        )
+        cup = ObjectSpec(
+            name="cup",
+            shape="cylinder",
+            size=(uniform(self.CUP_RADIUS), uniform(self.CUP_HALF_HEIGHT)),
+            mass=uniform(self.CUP_MASS),
+            pos=(uniform(self.CUP_XY[0]), uniform(self.CUP_XY[1])),
+            rgba=(rng.uniform(0.7, 1.0), *rng.uniform(0.1, 0.5, 2), 1.0),
+            friction=uniform((0.8, 1.2)),
+        )
+        return SceneSpec(objects=[bottle, cup])
+
+    def success_tracker(self) -> SuccessTracker:
+        """A fresh success tracker for one episode."""
+        return SuccessTracker()
+
+
+SIM_TASKS = {task.name: task for task in (SingleArmPourWater(),)}

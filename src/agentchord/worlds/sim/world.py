@@ -1,0 +1,193 @@
+"""The MuJoCo world: physics, 50 Hz position control, contacts, gripper faults.
+
+Objects move only through contact: a grasp holds because finger pads squeeze
+the object with friction, and a drop happens because the fingers open.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from agentchord.worlds.sim.exceptions import UnknownObjectError
+from agentchord.worlds.sim.scene import (
+    ARM_JOINTS,
+    ARM_PREFIX,
+    FINGER_GAP_OFFSET,
+    FINGER_RANGE,
+    HOME_Q,
+    SceneSpec,
+    build_model,
+)
+
+#: Control rate of the robot (Hz); physics runs at 1 / timestep.
+CONTROL_HZ = 50
+
+
+@dataclass
+class ArmCommand:
+    """What one arm is told to do for one control tick.
+
+    Attributes:
+        q: Joint position targets of the 6 arm joints (rad).
+        grip: Gripper target in [0, 1]: 0 fully open, 1 closed.
+    """
+
+    q: np.ndarray
+    grip: float
+
+
+class SimWorld:
+    """One trial's MuJoCo world.
+
+    Args:
+        scene: The objects and their initial placement.
+    """
+
+    def __init__(self, scene: SceneSpec) -> None:
+        self.scene = scene
+        self.model = build_model(scene)
+        self.data = mujoco.MjData(self.model)
+        self.substeps = round(1.0 / (CONTROL_HZ * self.model.opt.timestep))
+        self.tick = 0
+        m = self.model
+        self._arm_qadr = {a: np.array([m.joint(f"{p}/{j}").qposadr[0] for j in ARM_JOINTS]) for a, p in ARM_PREFIX.items()}
+        self._arm_dofadr = {a: np.array([m.joint(f"{p}/{j}").dofadr[0] for j in ARM_JOINTS]) for a, p in ARM_PREFIX.items()}
+        self._arm_act = {a: np.array([m.actuator(f"{a}_{j}").id for j in ARM_JOINTS]) for a in ARM_PREFIX}
+        self._finger_qadr = {a: m.joint(f"{p}/left_finger").qposadr[0] for a, p in ARM_PREFIX.items()}
+        self._finger_act = {a: (m.actuator(f"{a}_left_finger").id, m.actuator(f"{a}_right_finger").id) for a in ARM_PREFIX}
+        self._finger_geoms = {
+            a: (m.geom(f"{p}/10_left_gripper_finger").id, m.geom(f"{p}/10_right_gripper_finger").id) for a, p in ARM_PREFIX.items()
+        }
+        self._tcp_site = {a: m.site(f"{a}_tcp").id for a in ARM_PREFIX}
+        self._object_body = {o.name: m.body(o.name).id for o in scene.objects}
+        self._object_geom = {o.name: m.geom(o.name).id for o in scene.objects}
+        self._object_spec = {o.name: o for o in scene.objects}
+        self._fault_until: dict[str, int] = {}
+        self.commands: dict[str, ArmCommand] = {}
+        self._contacts: set[tuple[int, int]] = set()
+        self.reset()
+
+    # ------------------------------------------------------------------ set-up
+    def reset(self) -> None:
+        """Both arms home, grippers open, objects at rest on the table."""
+        mujoco.mj_resetData(self.model, self.data)
+        for arm in ARM_PREFIX:
+            self.data.qpos[self._arm_qadr[arm]] = HOME_Q
+            self.commands[arm] = ArmCommand(q=HOME_Q.copy(), grip=0.0)
+            self._set_fingers_qpos(arm, FINGER_RANGE[1])
+        self._apply_commands()
+        mujoco.mj_forward(self.model, self.data)
+        for _ in range(25):  # let objects settle onto the table
+            self.step()
+        self.tick = 0
+
+    def _set_fingers_qpos(self, arm: str, q: float) -> None:
+        adr = self._finger_qadr[arm]
+        self.data.qpos[adr] = q
+        self.data.qpos[adr + 1] = -q
+
+    # ----------------------------------------------------------------- control
+    def command(self, arm: str, command: ArmCommand) -> None:
+        """Set one arm's targets for the next ticks."""
+        self.commands[arm] = command
+
+    def inject_gripper_fault(self, arm: str, ticks: int) -> None:
+        """Force ``arm``'s gripper open for ``ticks`` control ticks (the drop disturbance)."""
+        self._fault_until[arm] = self.tick + ticks
+
+    def gripper_faulted(self, arm: str) -> bool:
+        """Whether a gripper fault is forcing ``arm`` open now."""
+        return self._fault_until.get(arm, -1) > self.tick
+
+    def _apply_commands(self) -> None:
+        ctrl = self.data.ctrl
+        lo, hi = FINGER_RANGE
+        for arm, cmd in self.commands.items():
+            ctrl[self._arm_act[arm]] = cmd.q
+            grip = 0.0 if self.gripper_faulted(arm) else cmd.grip
+            q_finger = hi - grip * (hi - lo)
+            left, right = self._finger_act[arm]
+            ctrl[left] = q_finger
+            ctrl[right] = -q_finger
+
+    def step(self) -> None:
+        """Advance one control tick (``substeps`` physics steps)."""
+        self._apply_commands()
+        for _ in range(self.substeps):
+            mujoco.mj_step(self.model, self.data)
+        self.tick += 1
+        geoms = self.data.contact.geom[: self.data.ncon]
+        self._contacts = {(int(a), int(b)) for a, b in geoms}
+
+    # ------------------------------------------------------------------ state
+    @property
+    def time(self) -> float:
+        """Robot time since reset (s)."""
+        return self.tick / CONTROL_HZ
+
+    @property
+    def object_names(self) -> list[str]:
+        """Names of the scene's objects."""
+        return list(self._object_body)
+
+    def object_spec(self, name: str):
+        """The object's specification (shape, size, mass)."""
+        try:
+            return self._object_spec[name]
+        except KeyError:
+            raise UnknownObjectError(f"no object {name!r} in the scene (objects: {', '.join(self._object_body)})") from None
+
+    def object_pose(self, name: str) -> tuple[np.ndarray, np.ndarray]:
+        """Position and rotation matrix of an object's body."""
+        self.object_spec(name)
+        body = self._object_body[name]
+        return self.data.xpos[body].copy(), self.data.xmat[body].reshape(3, 3).copy()
+
+    def object_quat(self, name: str) -> np.ndarray:
+        """Orientation quaternion (w, x, y, z) of an object."""
+        return self.data.xquat[self._object_body[name]].copy()
+
+    def object_velocity(self, name: str) -> float:
+        """Linear speed of an object (m/s)."""
+        vel = np.zeros(6)
+        mujoco.mj_objectVelocity(self.model, self.data, mujoco.mjtObj.mjOBJ_BODY, self._object_body[name], vel, 0)
+        return float(np.linalg.norm(vel[3:]))
+
+    def arm_q(self, arm: str) -> np.ndarray:
+        """Measured arm joint positions."""
+        return self.data.qpos[self._arm_qadr[arm]].copy()
+
+    def tcp_pose(self, arm: str) -> tuple[np.ndarray, np.ndarray]:
+        """Measured tool-centre position and rotation matrix."""
+        site = self._tcp_site[arm]
+        return self.data.site_xpos[site].copy(), self.data.site_xmat[site].reshape(3, 3).copy()
+
+    def gripper_width(self, arm: str) -> float:
+        """Gap between the finger pads (m)."""
+        q = self.data.qpos[self._finger_qadr[arm]] - self.data.qpos[self._finger_qadr[arm] + 1]
+        return float(max(q - FINGER_GAP_OFFSET, 0.0))
+
+    def in_contact(self, geom_a: int, geom_b: int) -> bool:
+        """Whether two geoms touch at the last tick."""
+        return (geom_a, geom_b) in self._contacts or (geom_b, geom_a) in self._contacts
+
+    def holding(self, arm: str, obj: str) -> bool:
+        """Contact-based grasp: both finger pads touch the object."""
+        geom = self._object_geom[obj]
+        left, right = self._finger_geoms[arm]
+        return self.in_contact(left, geom) and self.in_contact(right, geom)
+
+    def touching(self, obj_a: str, obj_b: str) -> bool:
+        """Whether two objects touch."""
+        return self.in_contact(self._object_geom[obj_a], self._object_geom[obj_b])
+
+    def on_table(self, obj: str) -> bool:
+        """Whether the object rests on the table."""
+        return self.in_contact(self._object_geom[obj], self.model.geom("table").id)
+
+    def arm_base(self, arm: str) -> np.ndarray:
+        """Position of the arm's shoulder (its waist axis) in the world."""
+        return self.data.xpos[self.model.body(f"{ARM_PREFIX[arm]}/shoulder_link").id].copy()
