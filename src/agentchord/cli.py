@@ -1,11 +1,23 @@
-"""The ``agentchord`` command line."""
+"""The ``agentchord`` command line.
+
+Exit statuses: 0 success, 1 task failure (``run``) or invalid graph
+(``graph check``), 2 bad input (click's usage errors, unreadable files).
+"""
 
 from __future__ import annotations
 
+import json
+import sys
+from pathlib import Path
+
 import click
+from rich.console import Console
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
 from agentchord import __version__
 from agentchord.graph.cli import graph_group, schema_command
+
+STRATEGY_NAMES = ("agentchord", "agentchord-bt")
 
 
 @click.group()
@@ -16,3 +28,147 @@ def main() -> None:
 
 main.add_command(schema_command)
 main.add_command(graph_group)
+
+
+def _load_graph_option(graph_path: str | None):
+    if graph_path is None:
+        return None
+    from agentchord.graph.exceptions import GraphFileError  # noqa: PLC0415
+    from agentchord.graph.loader import load_graph  # noqa: PLC0415
+    from agentchord.graph.validation import check_graph  # noqa: PLC0415
+
+    try:
+        graph = load_graph(graph_path)
+    except GraphFileError as exc:
+        raise click.UsageError(str(exc)) from exc
+    problems = check_graph(graph)
+    if problems:
+        lines = "\n".join(f"{graph_path}: {p.path}: {p.message}" for p in problems)
+        raise click.UsageError(f"the graph is not valid:\n{lines}")
+    return graph
+
+
+@main.command()
+@click.argument("task")
+@click.option("--strategy", type=click.Choice(STRATEGY_NAMES), default="agentchord", show_default=True)
+@click.option("--p", "p", type=click.FloatRange(0.0, 1.0), default=0.0, show_default=True, help="Drop probability per atomic action.")
+@click.option("--seed", type=int, default=0, show_default=True)
+@click.option("--graph", "graph_path", type=click.Path(exists=True, dir_okay=False), help="Graph file (default: the task library's).")
+@click.option("--trace", "trace_path", type=click.Path(dir_okay=False), help="Write the trace as JSON lines.")
+@click.option("--json", "json_path", type=click.Path(dir_okay=False), help="Write the episode summary as JSON.")
+@click.option("--video", "video_path", type=click.Path(dir_okay=False), help="Write an MP4 of the episode.")
+@click.option("--camera", default="front", show_default=True, help="Scene camera for --video.")
+def run(task, strategy, p, seed, graph_path, trace_path, json_path, video_path, camera) -> None:
+    """Run one episode of TASK and print its path through the graph.
+
+    Exit status 0 when the task succeeded, 1 when it failed, 2 on bad input.
+    """
+    from agentchord.execution.episode import EpisodeSpec, run_episode  # noqa: PLC0415
+    from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: PLC0415
+
+    if task not in SIM_TASKS:
+        raise click.BadParameter(f"unknown task {task!r} (tasks: {', '.join(SIM_TASKS)})", param_hint="TASK")
+    graph = _load_graph_option(graph_path)
+    console = Console()
+    recorder = {}
+
+    def on_tick(executor) -> None:
+        if video_path is None:
+            return
+        if "video" not in recorder:
+            from agentchord.worlds.sim.render import VideoRecorder  # noqa: PLC0415
+
+            recorder["video"] = VideoRecorder(executor.world, video_path, camera=camera)
+            recorder["seen"] = 0
+        video = recorder["video"]
+        for event in executor.trace.events[recorder["seen"]:]:
+            if event["event"] == "failure_detected":
+                video.announce(f"FAILURE {event['failure']} on {event['edge']}")
+            elif event["event"] == "recovery_switch":
+                video.announce(f"RECOVERY -> {event['to']}")
+            elif event["event"] == "disturbance":
+                video.announce(f"DISTURBANCE: {event['obj']} dropped", ticks=10)
+        recorder["seen"] = len(executor.trace.events)
+        program = executor.program
+        caption = f"{task}  node {executor.node}  edge {program.edge_id if program else '-'} ({program.kind if program else ''})"
+        video.capture(caption)
+
+    result = run_episode(EpisodeSpec(task=task, strategy=strategy, p=p, seed=seed, graph=graph), on_tick=on_tick)
+    _print_episode(console, result)
+    if trace_path:
+        result.trace.write(trace_path)
+        console.print(f"trace: {trace_path}")
+    if json_path:
+        Path(json_path).parent.mkdir(parents=True, exist_ok=True)
+        Path(json_path).write_text(json.dumps(result.summary(), indent=2) + "\n")
+        console.print(f"summary: {json_path}")
+    if video_path and "video" in recorder:
+        console.print(f"video: {recorder['video'].write()}")
+    sys.exit(0 if result.success else 1)
+
+
+def _print_episode(console: Console, result) -> None:
+    for event in result.trace.events:
+        kind = event["event"]
+        tick = f"[dim]{event['tick']:5d}[/dim]"
+        if kind == "edge_start":
+            colour = "blue" if event["kind"] == "nominal" else "magenta"
+            console.print(f"{tick}  [{colour}]{event['edge']}[/{colour}] -> {event['target']}  ({event['kind']})")
+        elif kind == "node_reached":
+            mark = "ok" if event["constraints_hold"] else f"constraints violated: {event.get('violated')}"
+            console.print(f"{tick}  node [bold]{event['node']}[/bold]  {mark}")
+        elif kind == "disturbance":
+            console.print(f"{tick}  [yellow]disturbance[/yellow]: {event['obj']} dropped by {event['arm']} during {event['action']}")
+        elif kind == "failure_detected":
+            console.print(f"{tick}  [red]failure detected[/red]: {event['failure']} on {event['edge']} (violated since tick {event['onset_tick']})")
+        elif kind == "recovery_switch":
+            console.print(f"{tick}  [magenta]recovery switch[/magenta] -> {event['to']} ({event['latency_ticks']} ticks after onset)")
+        elif kind == "branch_removed":
+            console.print(f"{tick}  forward-moving filter removed {event['failure']} on {event['edge']}: {event['reason']}")
+    verdict = "[green]SUCCESS[/green]" if result.success else "[red]FAILURE[/red]"
+    console.print(f"{verdict}: {result.reason}")
+    console.print(f"steps {result.steps}  robot time {result.time_s:.2f} s  wall {result.wall_s:.2f} s  "
+                  f"failures detected {result.failures_detected}  recoveries {result.recoveries}")
+    console.print("path: " + " -> ".join(result.path))
+
+
+@main.command()
+@click.option("--task", default="single_arm_pour_water", show_default=True)
+@click.option("--trials", type=click.IntRange(1, 10000), default=20, show_default=True)
+@click.option("--p", "p", type=click.FloatRange(0.0, 1.0), default=0.1, show_default=True)
+@click.option("--strategies", default=",".join(STRATEGY_NAMES), show_default=True, help="Comma-separated strategies to compare.")
+@click.option("--workers", type=click.IntRange(1, 64), default=None, help="Worker processes (default: one per core).")
+@click.option("--json", "json_path", type=click.Path(dir_okay=False), help="Write the aggregates as JSON.")
+def demo(task, trials, p, strategies, workers, json_path) -> None:
+    """Seeded episodes of each strategy under random drops, then a table per strategy."""
+    from agentchord.bench.report import aggregate, print_tables  # noqa: PLC0415
+    from agentchord.bench.runner import run_many  # noqa: PLC0415
+    from agentchord.execution.episode import EpisodeSpec  # noqa: PLC0415
+    from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: PLC0415
+
+    names = [s.strip() for s in strategies.split(",") if s.strip()]
+    unknown = [s for s in names if s not in STRATEGY_NAMES]
+    if unknown or not names:
+        raise click.BadParameter(f"unknown strategy {unknown} (choose from {', '.join(STRATEGY_NAMES)})", param_hint="--strategies")
+    if task not in SIM_TASKS:
+        raise click.BadParameter(f"unknown task {task!r} (tasks: {', '.join(SIM_TASKS)})", param_hint="--task")
+    console = Console()
+    console.print(f"[bold]{task}[/bold]: {trials} seeded episodes per strategy, drop probability p = {p}")
+    specs = [EpisodeSpec(task=task, strategy=name, p=p, seed=seed) for name in names for seed in range(trials)]
+    summaries: dict[str, list[dict]] = {name: [] for name in names}
+    with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(), console=console) as bar:
+        job = bar.add_task("episodes", total=len(specs))
+        for spec, summary in run_many(specs, workers=workers):
+            summaries[spec.strategy].append(summary)
+            bar.advance(job)
+    results = {name: aggregate(summaries[name]) for name in names}
+    print_tables(results, console)
+    if json_path:
+        payload = {"task": task, "p": p, "trials": trials, "strategies": results}
+        Path(json_path).parent.mkdir(parents=True, exist_ok=True)
+        Path(json_path).write_text(json.dumps(payload, indent=2) + "\n")
+        console.print(f"aggregates: {json_path}")
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()

@@ -28,41 +28,93 @@ def _tilt_deg(axis: np.ndarray) -> float:
 
 
 class Grasp(ArmAction):
-    """Side grasp of an upright object wherever it stands, then lift it."""
+    """Grasp an object wherever it is, then lift it; a fallen object is set upright in hand.
+
+    Upright object: side grasp at ``height`` of the object, approached from
+    the arm's base. Fallen object (lying on its side): top-down grasp across
+    its middle, lift, swing its top away from the robot and up, so the action
+    ends, like the upright case, with the object held upright in a side grasp.
+    """
 
     name = "grasp"
     args: catalog.GraspArgs
 
-    def _grasp_point(self, robot: RobotController) -> tuple[np.ndarray, float]:
-        feats = robot.frame.objects[self.args.obj]
-        if _tilt_deg(feats.axis) > UPRIGHT_TOLERANCE_DEG:
-            raise ActionFailed(f"{self.args.obj} is not upright (tilt {_tilt_deg(feats.axis):.0f} deg)")
-        height = float(np.linalg.norm(feats.top - feats.bottom))
-        point = feats.bottom + self.args.height * height * feats.axis
-        return point, float(feats.extent[0])
+    #: Tilt (deg) beyond which the object is treated as lying on its side.
+    FALLEN_DEG = 60.0
 
     def script(self, robot: RobotController) -> Iterator[None]:
+        robot.set_grip(self.arm, 0.0)
+        tilt = _tilt_deg(robot.frame.objects[self.args.obj].axis)
+        if tilt <= UPRIGHT_TOLERANCE_DEG:
+            yield from self._side_grasp(robot)
+        elif tilt >= self.FALLEN_DEG:
+            yield from self._fallen_grasp(robot)
+        else:
+            raise ActionFailed(f"{self.args.obj} is leaning (tilt {tilt:.0f} deg): neither upright nor lying")
+
+    def _side_point(self, robot: RobotController) -> np.ndarray:
+        feats = robot.frame.objects[self.args.obj]
+        height = float(np.linalg.norm(feats.top - feats.bottom))
+        return feats.bottom + self.args.height * height * feats.axis
+
+    def _clear_from_below(self, robot: RobotController, height: float) -> Iterator[None]:
+        # Coming from low (a recovery after a drop): rise first so the fingers clear the object.
+        start = robot.commanded_pose(self.arm).pos
+        if start[2] < height:
+            yield from move_to(robot, self.arm, pose_from_matrix(np.r_[start[:2], height], robot.rotation(self.arm)))
+
+    def _close_and_check(self, robot: RobotController) -> Iterator[None]:
+        yield from settle(robot, self.arm)
+        yield from grip(robot, self.arm, 1.0)
+        if not robot.frame.is_holding(self.arm, self.args.obj):
+            raise ActionFailed(f"fingers closed but {self.args.obj} is not held")
+
+    def _side_grasp(self, robot: RobotController) -> Iterator[None]:
         arm = self.arm
-        robot.set_grip(arm, 0.0)
-        point, _ = self._grasp_point(robot)
-        approach = point - robot.world.arm_base(arm)
-        rotation = grasp_frame(approach)
-        x_axis = rotation[:, 0]
-        pre = point - self.args.pre_grasp_dis * x_axis
-        start = robot.commanded_pose(arm).pos
-        if start[2] < pre[2] + 0.03 and np.linalg.norm(start[:2] - pre[:2]) > 0.05:
-            # Coming from low (a recovery after a drop): rise first so the fingers clear the object.
-            yield from move_to(robot, arm, pose_from_matrix(np.r_[start[:2], pre[2] + 0.08], robot.rotation(arm)))
+        point = self._side_point(robot)
+        rotation = grasp_frame(point - robot.world.arm_base(arm))
+        pre = point - self.args.pre_grasp_dis * rotation[:, 0]
+        if np.linalg.norm(robot.commanded_pose(arm).pos[:2] - pre[:2]) > 0.05:
+            yield from self._clear_from_below(robot, pre[2] + 0.08)
         yield from move_to(robot, arm, pose_from_matrix(pre, rotation))
         # Re-observe: the object may have moved while the arm approached.
-        point, _ = self._grasp_point(robot)
+        point = self._side_point(robot)
         yield from move_to(robot, arm, pose_from_matrix(point, rotation), speed=0.15)
-        yield from settle(robot, arm)
-        yield from grip(robot, arm, 1.0)
-        if not robot.frame.is_holding(arm, self.args.obj):
-            raise ActionFailed(f"fingers closed but {self.args.obj} is not held")
+        yield from self._close_and_check(robot)
         lift = robot.commanded_pose(arm).pos + np.array([0.0, 0.0, self.args.lift])
         yield from move_to(robot, arm, pose_from_matrix(lift, rotation), speed=0.15)
+
+    def _fallen_grasp(self, robot: RobotController) -> Iterator[None]:
+        arm = self.arm
+        feats = robot.frame.objects[self.args.obj]
+        top_dir = np.array([feats.axis[0], feats.axis[1], 0.0])
+        top_dir /= np.linalg.norm(top_dir)
+        # Tool frame for a top-down grasp: approach down, fingers across the object's axis.
+        down = np.array([0.0, 0.0, -1.0])
+        rotation = np.column_stack([down, np.cross(top_dir, down), top_dir])
+        radius = 0.5 * float(feats.extent[0])
+        # The finger tips reach ~4 cm past the tool centre: stay high enough to miss the table.
+        point = np.r_[feats.pos[:2], max(feats.pos[2] + 0.35 * radius, 0.045)]
+        yield from self._clear_from_below(robot, point[2] + self.args.pre_grasp_dis + 0.05)
+        yield from move_to(robot, arm, pose_from_matrix(point + np.array([0, 0, self.args.pre_grasp_dis]), rotation))
+        # A top-down tool often flips the forearm roll: let the IK converge before descending.
+        yield from settle(robot, arm, tolerance=0.003, max_ticks=60)
+        feats = robot.frame.objects[self.args.obj]
+        point[:2] = feats.pos[:2]
+        yield from move_to(robot, arm, pose_from_matrix(point, rotation), speed=0.08)
+        yield from self._close_and_check(robot)
+        half_length = 0.5 * float(np.linalg.norm(feats.top - feats.bottom))
+        lifted = point + np.array([0.0, 0.0, half_length + 0.06])
+        yield from move_to(robot, arm, pose_from_matrix(lifted, rotation), speed=0.15)
+        # Swing the object's top to point away from the robot, then pitch it up: the tool
+        # ends in the usual side-grasp frame with the object upright between the fingers.
+        outward = grasp_frame(lifted - robot.world.arm_base(arm))[:, 0]
+        yaw = np.arctan2(np.cross(top_dir, outward)[2], float(np.dot(top_dir, outward)))
+        swung = Rotation.from_euler("z", yaw).as_matrix() @ rotation
+        yield from move_to(robot, arm, pose_from_matrix(lifted, swung))
+        upright = swung @ Rotation.from_euler("y", -90.0, degrees=True).as_matrix()
+        yield from move_to(robot, arm, pose_from_matrix(lifted, upright), speed=0.15)
+        yield from settle(robot, arm)
 
 
 class MoveToObj(ArmAction):
@@ -104,6 +156,8 @@ class Place(ArmAction):
 
     def script(self, robot: RobotController) -> Iterator[None]:
         arm = self.arm
+        if not robot.frame.is_holding(arm, self.args.obj):
+            raise ActionFailed(f"{self.args.obj} is not held: nothing to place")
         obj = robot.frame.objects[self.args.obj]
         tool = robot.commanded_pose(arm)
         rotation = grasp_frame(robot.rotation(arm)[:, 0])

@@ -43,7 +43,10 @@ def pose_from_matrix(pos: np.ndarray, matrix: np.ndarray) -> PoseTarget:
 def grasp_frame(approach: np.ndarray) -> np.ndarray:
     """Tool rotation for a side grasp: x along the horizontal approach, z up."""
     x = np.array([approach[0], approach[1], 0.0])
-    x /= np.linalg.norm(x)
+    norm = np.linalg.norm(x)
+    if norm < 1e-6:
+        raise ValueError("a side grasp needs a horizontal approach direction, got a vertical one")
+    x /= norm
     y = np.cross(UP, x)
     return np.column_stack([x, y, UP])
 

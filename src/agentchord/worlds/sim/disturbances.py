@@ -77,7 +77,8 @@ class RandomDrop:
                 continue
             del self._pending[arm]
             held = sorted(obj for a, obj in frame.holding if a == arm)
-            if held:
+            # Only a closed grip can lose its object: an opening gripper is releasing anyway.
+            if held and world.commands[arm].grip >= 0.5:
                 world.inject_gripper_fault(arm, self.fault_ticks)
                 event = DropEvent(tick=world.tick, arm=arm, obj=held[0], action=action)
                 self.events.append(event)

@@ -175,8 +175,9 @@ def _add_object(spec: mujoco.MjSpec, obj: ObjectSpec) -> None:
         type=geom_type,
         size=list(obj.size) + [0.0] * (3 - len(obj.size)),
         rgba=list(obj.rgba),
-        friction=[obj.friction, 0.005, 0.0001],
-        condim=4,
+        # Rolling friction (condim 6): a fallen bottle comes to rest instead of rolling away.
+        friction=[obj.friction, 0.005, 0.003],
+        condim=6,
         solimp=[0.95, 0.99, 0.001, 0.5, 2.0],
         solref=[0.01, 1.0],
         # Group-0 geoms get no mass from inertiagrouprange="4 5": inertia is explicit.

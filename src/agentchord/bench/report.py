@@ -1,0 +1,72 @@
+"""Aggregate episode summaries into the metrics of DESIGN section 7, and print tables."""
+
+from __future__ import annotations
+
+import math
+from statistics import mean
+
+from rich.console import Console
+from rich.table import Table
+
+
+def wilson_interval(successes: int, n: int, z: float = 1.96) -> tuple[float, float]:
+    """95% Wilson score interval of a success rate."""
+    if n == 0:
+        return (0.0, 0.0)
+    p = successes / n
+    denom = 1 + z * z / n
+    centre = (p + z * z / (2 * n)) / denom
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / denom
+    return (max(centre - half, 0.0), min(centre + half, 1.0))
+
+
+def aggregate(summaries: list[dict]) -> dict:
+    """Aggregates of one strategy's episodes."""
+    n = len(summaries)
+    successes = sum(s["success"] for s in summaries)
+    latencies = [t for s in summaries for t in s["reaction_latency_ticks"]]
+    with_drop = [s for s in summaries if s["drops_injected"] > 0]
+    low, high = wilson_interval(successes, n)
+    return {
+        "episodes": n,
+        "success_rate": successes / n if n else 0.0,
+        "success_ci95": [round(low, 3), round(high, 3)],
+        "mean_time_s": round(mean(s["time_s"] for s in summaries), 3) if n else 0.0,
+        "mean_steps": round(mean(s["steps"] for s in summaries), 1) if n else 0.0,
+        "mean_steps_with_drop": round(mean(s["steps"] for s in with_drop), 1) if with_drop else None,
+        "episodes_with_drop": len(with_drop),
+        "drops_injected": sum(s["drops_injected"] for s in summaries),
+        "drops_detected": sum(s["drops_detected"] for s in summaries),
+        "drops_recovered": sum(s["drops_recovered"] for s in summaries),
+        "reaction_latency_ticks_mean": round(mean(latencies), 2) if latencies else None,
+        "reaction_latency_ticks_max": max(latencies) if latencies else None,
+        "mean_wall_s": round(mean(s["wall_s"] for s in summaries), 3) if n else 0.0,
+        "failures": sorted({s["reason"] for s in summaries if not s["success"]}),
+    }
+
+
+def strategy_table(name: str, stats: dict) -> Table:
+    """One strategy's aggregates as a rich table."""
+    table = Table(title=name, show_header=True, header_style="bold")
+    table.add_column("metric")
+    table.add_column("value", justify="right")
+    low, high = stats["success_ci95"]
+    table.add_row("success rate", f"{100 * stats['success_rate']:.0f}%  (95% CI {100 * low:.0f}-{100 * high:.0f}%)")
+    table.add_row("mean execution time (robot s)", f"{stats['mean_time_s']:.2f}")
+    table.add_row("mean steps (control ticks)", f"{stats['mean_steps']:.0f}")
+    with_drop = stats["mean_steps_with_drop"]
+    table.add_row(f"mean steps, episodes with a drop ({stats['episodes_with_drop']})", "-" if with_drop is None else f"{with_drop:.0f}")
+    table.add_row("drops injected / detected / recovered", f"{stats['drops_injected']} / {stats['drops_detected']} / {stats['drops_recovered']}")
+    lat_mean, lat_max = stats["reaction_latency_ticks_mean"], stats["reaction_latency_ticks_max"]
+    table.add_row("reaction latency mean / max (ticks)", "-" if lat_mean is None else f"{lat_mean:.1f} / {lat_max}")
+    table.add_row("mean wall time per episode (s)", f"{stats['mean_wall_s']:.2f}")
+    return table
+
+
+def print_tables(results: dict[str, dict], console: Console | None = None) -> None:
+    """Print one table per strategy and the failure reasons."""
+    console = console or Console()
+    for name, stats in results.items():
+        console.print(strategy_table(name, stats))
+        for reason in stats["failures"]:
+            console.print(f"  [red]failed:[/red] {reason}")

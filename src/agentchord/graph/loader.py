@@ -1,0 +1,247 @@
+"""Reading and writing task-graph files (YAML or JSON).
+
+Every failure to load is a :class:`GraphFileError` whose lines read
+``FILE: where: what is wrong``; all pydantic errors are reported, not the first.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import yaml
+from pydantic import BaseModel, ValidationError
+
+from agentchord.graph._hints import did_you_mean
+from agentchord.graph.exceptions import GraphFileError
+from agentchord.graph.models import ActionCall, Edge, FailureMode, Node, TaskGraph
+
+YAML_SUFFIXES = (".yaml", ".yml")
+JSON_SUFFIXES = (".json",)
+
+
+def load_graph(path: str | Path) -> TaskGraph:
+    """Load and validate a task graph from a ``.yaml``, ``.yml`` or ``.json`` file.
+
+    Args:
+        path: The graph file.
+
+    Returns:
+        The validated graph (types and ranges; see ``check_graph`` for the rest).
+
+    Raises:
+        GraphFileError: The file cannot be read or parsed, or does not match the schema.
+    """
+    path = Path(path)
+    data = _read(path)
+    if not isinstance(data, dict):
+        found = "an empty file" if data is None else f"a {type(data).__name__}"
+        raise GraphFileError(
+            path, [f"expected a task graph (a mapping with task, start, goal, nodes, edges), found {found}"]
+        )
+    try:
+        return TaskGraph.model_validate(data)
+    except ValidationError as error:
+        raise GraphFileError(path, validation_messages(error, data)) from None
+
+
+def dump_graph(graph: TaskGraph, path: str | Path) -> Path:
+    """Write ``graph`` as YAML or JSON, chosen by the suffix of ``path``.
+
+    Fields at their default value are left out; a single-step edge is written in
+    the compact ``{arm: call}`` form. ``load_graph`` gives back an equal graph.
+
+    Args:
+        graph: The graph to write.
+        path: Destination, ``.yaml``/``.yml`` or ``.json``.
+
+    Returns:
+        The path written.
+
+    Raises:
+        GraphFileError: Unsupported suffix.
+    """
+    path = Path(path)
+    data = graph.model_dump(mode="json", exclude_defaults=True)
+    suffix = path.suffix.lower()
+    if suffix in YAML_SUFFIXES:
+        for edge in data["edges"]:
+            edge["actions"] = _inline_steps(edge["actions"])
+        text = yaml.dump(data, Dumper=_Dumper, sort_keys=False, allow_unicode=True, width=100)
+    elif suffix in JSON_SUFFIXES:
+        text = json.dumps(data, indent=2, ensure_ascii=False) + "\n"
+    else:
+        raise GraphFileError(path, [_unsupported_suffix(path)])
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def format_loc(loc: Sequence[str | int], data: Any = None) -> str:
+    """Format a pydantic error location as a field path, e.g. ``edges[1].failures[0].window``.
+
+    Edges store their steps as a list; when ``data`` (the raw file content) shows
+    the compact single-step mapping form, the step index is left out so that the
+    path names what is in the file.
+
+    Args:
+        loc: The location tuple of a pydantic error.
+        data: The raw document the location refers to, if known.
+    """
+    parts: list[str] = []
+    node = data
+    skip_step_index = False
+    for item in loc:
+        if skip_step_index and item == 0:
+            skip_step_index = False
+            continue  # compact form: the file has no step index here
+        skip_step_index = False
+        if isinstance(item, int):
+            parts.append(f"[{item}]")
+        else:
+            parts.append(f".{item}" if parts else str(item))
+        node = _child(node, item)
+        if item == "actions" and isinstance(node, dict):
+            skip_step_index = True
+    return "".join(parts)
+
+
+def validation_messages(error: ValidationError, data: Any = None) -> list[str]:
+    """Turn every error of a pydantic ``ValidationError`` into ``path: message``.
+
+    Args:
+        error: The validation error.
+        data: The raw document that was validated (to name fields as written).
+    """
+    lines = []
+    for detail in error.errors(include_url=False):
+        loc = detail["loc"]
+        message = detail["msg"]
+        if detail["type"] == "extra_forbidden" and loc:
+            message += _field_hint(loc)
+        where = format_loc(loc, data)
+        lines.append(f"{where}: {message}" if where else message)
+    return lines
+
+
+def _child(node: Any, item: str | int) -> Any:
+    if isinstance(node, dict):
+        return node.get(item)
+    if isinstance(node, list) and isinstance(item, int) and 0 <= item < len(node):
+        return node[item]
+    return None
+
+
+def _model_at(parent: Sequence[str | int]) -> type[BaseModel] | None:
+    # Which model a location's parent is, from the shape of the path.
+    if not parent:
+        return TaskGraph
+    if len(parent) >= 2 and isinstance(parent[-1], int):
+        return {"nodes": Node, "edges": Edge, "failures": FailureMode}.get(str(parent[-2]))
+    if "actions" in parent:
+        return ActionCall
+    return None
+
+
+def _field_hint(loc: Sequence[str | int]) -> str:
+    model = _model_at(loc[:-1])
+    if model is None:
+        return ""
+    fields = list(model.model_fields)
+    return did_you_mean(str(loc[-1]), fields) or f" (fields: {', '.join(fields)})"
+
+
+def _read(path: Path) -> Any:
+    suffix = path.suffix.lower()
+    if suffix not in YAML_SUFFIXES + JSON_SUFFIXES:
+        raise GraphFileError(path, [_unsupported_suffix(path)])
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as error:
+        reason = error.strerror if isinstance(error, OSError) and error.strerror else str(error)
+        raise GraphFileError(path, [f"cannot read the file: {reason}"]) from None
+    if suffix in JSON_SUFFIXES:
+        try:
+            return json.loads(text, object_pairs_hook=_no_duplicate_pairs)
+        except json.JSONDecodeError as error:
+            raise GraphFileError(
+                path, [f"line {error.lineno}, column {error.colno}: invalid JSON: {error.msg}"]
+            ) from None
+        except _DuplicateKeyError as error:
+            raise GraphFileError(path, [f"invalid JSON: {error}"]) from None
+    try:
+        return yaml.load(text, Loader=_Loader)  # _Loader is a SafeLoader
+    except yaml.MarkedYAMLError as error:
+        mark = error.problem_mark or error.context_mark
+        where = f"line {mark.line + 1}, column {mark.column + 1}: " if mark else ""
+        what = " ".join(part for part in (error.context, error.problem) if part)
+        raise GraphFileError(path, [f"{where}invalid YAML: {what}"]) from None
+    except yaml.YAMLError as error:
+        raise GraphFileError(path, [f"invalid YAML: {error}"]) from None
+
+
+def _unsupported_suffix(path: Path) -> str:
+    return f"unsupported file type {path.suffix or '(none)'!r}; use .yaml, .yml or .json"
+
+
+class _DuplicateKeyError(ValueError):
+    pass
+
+
+def _no_duplicate_pairs(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    # A repeated key would silently replace the first one (e.g. two `failures:`).
+    result: dict[str, Any] = {}
+    for key, value in pairs:
+        if key in result:
+            raise _DuplicateKeyError(f"duplicate key {key!r}")
+        result[key] = value
+    return result
+
+
+class _Loader(yaml.SafeLoader):
+    """A safe YAML loader that rejects duplicate mapping keys."""
+
+    def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
+        seen: set[Any] = set()
+        for key_node, _ in node.value:
+            key = self.construct_object(key_node, deep=True)
+            if not isinstance(key, (str, int, float, bool)) and key is not None:
+                continue  # unhashable or exotic keys: SafeLoader reports them itself
+            if key in seen:
+                raise yaml.constructor.ConstructorError(
+                    "while constructing a mapping", node.start_mark, f"found duplicate key {key!r}", key_node.start_mark
+                )
+            seen.add(key)
+        return super().construct_mapping(node, deep=deep)
+
+
+class _Dumper(yaml.SafeDumper):
+    """A YAML dumper that writes steps and short lists of scalars inline.
+
+    ``actions: {right: {fn: grasp, args: {obj: bottle}}}`` and ``offset: [0.05, -0.1, 0.1]``
+    read as in DESIGN section 3.
+    """
+
+
+class _InlineStep(dict):
+    """A step mapping that the dumper writes in flow style."""
+
+
+def _inline_steps(actions: Any) -> Any:
+    if isinstance(actions, dict):
+        return _InlineStep(actions)
+    return [_InlineStep(step) for step in actions]
+
+
+def _represent_inline_step(dumper: yaml.SafeDumper, data: _InlineStep) -> yaml.Node:
+    return dumper.represent_mapping("tag:yaml.org,2002:map", data, flow_style=True)
+
+
+def _represent_list(dumper: yaml.SafeDumper, data: list[Any]) -> yaml.Node:
+    inline = all(isinstance(item, (int, float, bool)) or item is None for item in data)
+    return dumper.represent_sequence("tag:yaml.org,2002:seq", data, flow_style=inline and bool(data))
+
+
+_Dumper.add_representer(list, _represent_list)
+_Dumper.add_representer(_InlineStep, _represent_inline_step)

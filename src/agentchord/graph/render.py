@@ -1,0 +1,192 @@
+"""Pure renderers of a task graph: Graphviz DOT, Mermaid, and SVG/PNG through Graphviz.
+
+Colours follow the paper's Fig. 3: nominal edges blue, recovery edges pink.
+Recovery nodes are outlined pink, the start node is bold and the goal doubly
+outlined. A recovery entry edge is dashed and labelled with the failure modes
+that fire it (``mode: monitor > margin``); a nominal edge lists its failure
+modes with their entry edges (``! mode -> entry``).
+"""
+
+from __future__ import annotations
+
+import re
+import shutil
+import textwrap
+from pathlib import Path
+
+from agentchord.graph.exceptions import RenderError
+from agentchord.graph.models import Edge, FailureMode, Node, TaskGraph
+
+NOMINAL_COLOR = "#1f77b4"
+RECOVERY_COLOR = "#e377c2"
+FORMATS = (".dot", ".gv", ".mmd", ".svg", ".png")
+
+_ARM_LETTER = {"left": "L", "right": "R"}
+
+
+def edge_summary(edge: Edge) -> str:
+    """The edge's action calls, e.g. ``grasp(R)``, ``grasp(L) + grasp(R)``, ``grasp(R); move_to_obj(R)``."""
+    steps = []
+    for step in edge.steps:
+        calls = [f"{call.fn}({_ARM_LETTER.get(arm, arm)})" for arm, call in step.items() if call is not None]
+        steps.append(" + ".join(calls) or "idle")
+    return "; ".join(steps)
+
+
+def _entry_failures(graph: TaskGraph) -> dict[str, list[tuple[Edge, FailureMode]]]:
+    # Recovery entry edge id -> the failure modes (and their edges) that fire it.
+    entries: dict[str, list[tuple[Edge, FailureMode]]] = {}
+    for edge, failure in graph.failures():
+        entries.setdefault(failure.recovery, []).append((edge, failure))
+    return entries
+
+
+def _trigger(failure: FailureMode, edge: Edge) -> str:
+    return f"{failure.name} on {edge.id}: {failure.monitor} > {failure.margin:g}"
+
+
+def _edge_lines(edge: Edge, triggers: list[tuple[Edge, FailureMode]]) -> list[str]:
+    lines = [edge.id, edge_summary(edge)]
+    lines += [f"! {f.name} -> {f.recovery}" for f in edge.failures]
+    lines += [_trigger(f, e) for e, f in triggers]
+    return lines
+
+
+def _node_lines(node: Node, graph: TaskGraph) -> list[str]:
+    title = node.id
+    if node.id == graph.start:
+        title += " (start)"
+    if node.id == graph.goal:
+        title += " (goal)"
+    return [title, *textwrap.wrap(node.semantic, 32)]
+
+
+def _dot_quote(text: str) -> str:
+    return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
+
+
+def _dot_label(lines: list[str]) -> str:
+    # "\l" would left-align; centred lines read better in small boxes.
+    return _dot_quote("\n".join(lines)).replace("\n", "\\n")
+
+
+def to_dot(graph: TaskGraph) -> str:
+    """The graph as Graphviz DOT source."""
+    out = [
+        f"digraph {_dot_quote(graph.task)} {{",
+        "  rankdir=LR;",
+        '  node [shape=box, style="rounded", fontname="Helvetica", fontsize=10];',
+        '  edge [fontname="Helvetica", fontsize=9];',
+    ]
+    for node in graph.nodes:
+        attrs = [f"label={_dot_label(_node_lines(node, graph))}"]
+        if node.is_recovery:
+            attrs.append(f'color="{RECOVERY_COLOR}"')
+        if node.id == graph.start:
+            attrs.append('style="rounded,bold", penwidth=2')
+        if node.id == graph.goal:
+            attrs.append("peripheries=2")
+        out.append(f"  {_dot_quote(node.id)} [{', '.join(attrs)}];")
+    triggers = _entry_failures(graph)
+    for edge in graph.edges:
+        color = RECOVERY_COLOR if edge.is_recovery else NOMINAL_COLOR
+        attrs = [
+            f"label={_dot_label(_edge_lines(edge, triggers.get(edge.id, [])))}",
+            f'color="{color}"',
+            f'fontcolor="{color}"',
+        ]
+        if edge.id in triggers:
+            attrs.append('style="dashed"')
+        out.append(f"  {_dot_quote(edge.source)} -> {_dot_quote(edge.target)} [{', '.join(attrs)}];")
+    out.append("}")
+    return "\n".join(out) + "\n"
+
+
+def _mermaid_text(lines: list[str]) -> str:
+    # Mermaid labels are quoted strings: escape quotes and markup as entities.
+    escaped = (
+        line.replace("&", "#amp;").replace('"', "#quot;").replace("<", "#lt;").replace(">", "#gt;") for line in lines
+    )
+    return '"' + "<br/>".join(escaped) + '"'
+
+
+def _mermaid_ids(graph: TaskGraph) -> dict[str, str]:
+    # Mermaid ids are bare words; some words ("end", "graph") are keywords.
+    ids: dict[str, str] = {}
+    names = [n.id for n in graph.nodes] + [x for e in graph.edges for x in (e.source, e.target)]
+    for name in names:
+        if name not in ids:
+            ids[name] = f"n{len(ids)}_{re.sub(r'[^0-9A-Za-z_]', '_', name)}"
+    return ids
+
+
+def to_mermaid(graph: TaskGraph) -> str:
+    """The graph as a Mermaid flowchart, edge colours set with ``linkStyle``."""
+    ids = _mermaid_ids(graph)
+    out = ["flowchart LR"]
+    for node in graph.nodes:
+        out.append(f"  {ids[node.id]}({_mermaid_text(_node_lines(node, graph))})")
+    triggers = _entry_failures(graph)
+    styles = []
+    for index, edge in enumerate(graph.edges):
+        arrow = "-.->" if edge.id in triggers else "-->"
+        label = _mermaid_text(_edge_lines(edge, triggers.get(edge.id, [])))
+        out.append(f"  {ids[edge.source]} {arrow}|{label}| {ids[edge.target]}")
+        color = RECOVERY_COLOR if edge.is_recovery else NOMINAL_COLOR
+        styles.append(f"  linkStyle {index} stroke:{color},color:{color}")
+    out += styles
+    out.append(f"  classDef recovery stroke:{RECOVERY_COLOR},stroke-width:2px")
+    out.append("  classDef start stroke-width:3px")
+    out.append("  classDef goal stroke-width:3px,stroke-dasharray:0")
+    for cls, members in (
+        ("recovery", [n.id for n in graph.recovery_nodes()]),
+        ("start", [graph.start] if graph.start in ids else []),
+        ("goal", [graph.goal] if graph.goal in ids else []),
+    ):
+        if members:
+            out.append(f"  class {','.join(ids[m] for m in members)} {cls}")
+    return "\n".join(out) + "\n"
+
+
+def render(graph: TaskGraph, out_path: str | Path) -> Path:
+    """Write the graph to ``out_path`` in the format its suffix names.
+
+    ``.dot``/``.gv`` and ``.mmd`` are text; ``.svg`` and ``.png`` are laid out
+    by Graphviz (the ``graphviz`` Python package and the ``dot`` binary).
+
+    Returns:
+        The path written.
+
+    Raises:
+        RenderError: Unknown suffix, or Graphviz missing or failing.
+    """
+    out_path = Path(out_path)
+    suffix = out_path.suffix.lower()
+    if suffix in (".dot", ".gv"):
+        out_path.write_text(to_dot(graph), encoding="utf-8")
+    elif suffix == ".mmd":
+        out_path.write_text(to_mermaid(graph), encoding="utf-8")
+    elif suffix in (".svg", ".png"):
+        out_path.write_bytes(_graphviz_pipe(to_dot(graph), suffix[1:]))
+    else:
+        raise RenderError(
+            f"cannot render to {out_path}: unknown format {suffix or '(none)'!r}; use {', '.join(FORMATS)}"
+        )
+    return out_path
+
+
+def _graphviz_pipe(source: str, fmt: str) -> bytes:
+    if shutil.which("dot") is None:
+        raise RenderError(
+            f"rendering {fmt} needs the Graphviz `dot` binary, which is not on PATH: "
+            "install it with `apt-get install graphviz` (macOS: `brew install graphviz`), "
+            "or render to .dot or .mmd instead"
+        )
+    try:
+        import graphviz
+    except ImportError:
+        raise RenderError(f"rendering {fmt} needs the graphviz Python package: `pip install graphviz`") from None
+    try:
+        return graphviz.Source(source).pipe(format=fmt)
+    except (graphviz.ExecutableNotFound, graphviz.CalledProcessError) as error:
+        raise RenderError(f"Graphviz failed to render {fmt}: {error}") from None
