@@ -16,7 +16,7 @@ from scipy.spatial.transform import Rotation
 from agentchord.actions import catalog
 from agentchord.actions.base import ActionFailed, ArmAction
 from agentchord.actions.controller import RobotController
-from agentchord.actions.motion import grasp_frame, grip, move_joints, move_to, pose_from_matrix, settle
+from agentchord.actions.motion import grasp_frame, grip, move_joints, move_to, pose_from_matrix, settle, wait_for_rest
 from agentchord.worlds.sim.scene import HOME_Q
 
 #: Tilt (deg) beyond which an object counts as fallen for a side grasp.
@@ -43,7 +43,8 @@ class Grasp(ArmAction):
     FALLEN_DEG = 60.0
 
     def script(self, robot: RobotController) -> Iterator[None]:
-        robot.set_grip(self.arm, 0.0)
+        yield from self._let_go(robot)
+        yield from wait_for_rest(robot, self.args.obj)
         tilt = _tilt_deg(robot.frame.objects[self.args.obj].axis)
         if tilt <= UPRIGHT_TOLERANCE_DEG:
             yield from self._side_grasp(robot)
@@ -51,6 +52,17 @@ class Grasp(ArmAction):
             yield from self._fallen_grasp(robot)
         else:
             raise ActionFailed(f"{self.args.obj} is leaning (tilt {tilt:.0f} deg): neither upright nor lying")
+
+    def _let_go(self, robot: RobotController) -> Iterator[None]:
+        # After a drop the object may still rest on the fingers (a rolled tool stacks them
+        # vertically): open, roll the tool back level and back off so it falls free.
+        arm = self.arm
+        if robot.targets[arm].grip > 0.0 or robot.frame.arms[arm].width < 0.05:
+            robot.set_grip(arm, 0.0)
+            rotation = grasp_frame(robot.rotation(arm)[:, 0])
+            back = -0.12 * rotation[:, 0] + np.array([0.0, 0.0, 0.04])
+            yield from move_to(robot, arm, pose_from_matrix(robot.commanded_pose(arm).pos + back, rotation), speed=0.2)
+        robot.set_grip(arm, 0.0)
 
     def _side_point(self, robot: RobotController) -> np.ndarray:
         feats = robot.frame.objects[self.args.obj]
@@ -64,7 +76,7 @@ class Grasp(ArmAction):
             yield from move_to(robot, self.arm, pose_from_matrix(np.r_[start[:2], height], robot.rotation(self.arm)))
 
     def _close_and_check(self, robot: RobotController) -> Iterator[None]:
-        yield from settle(robot, self.arm)
+        yield from settle(robot, self.arm, max_ticks=30, required=0.015)
         yield from grip(robot, self.arm, 1.0)
         if not robot.frame.is_holding(self.arm, self.args.obj):
             raise ActionFailed(f"fingers closed but {self.args.obj} is not held")
@@ -98,7 +110,7 @@ class Grasp(ArmAction):
         yield from self._clear_from_below(robot, point[2] + self.args.pre_grasp_dis + 0.05)
         yield from move_to(robot, arm, pose_from_matrix(point + np.array([0, 0, self.args.pre_grasp_dis]), rotation))
         # A top-down tool often flips the forearm roll: let the IK converge before descending.
-        yield from settle(robot, arm, tolerance=0.003, max_ticks=60)
+        yield from settle(robot, arm, tolerance=0.003, max_ticks=60, required=0.015)
         feats = robot.frame.objects[self.args.obj]
         point[:2] = feats.pos[:2]
         yield from move_to(robot, arm, pose_from_matrix(point, rotation), speed=0.08)

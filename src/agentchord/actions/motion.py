@@ -12,6 +12,7 @@ from collections.abc import Iterator
 import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
+from agentchord.actions.base import ActionFailed
 from agentchord.actions.controller import RobotController
 from agentchord.solvers.ik import PoseTarget
 from agentchord.worlds.sim.scene import TABLE_HALF
@@ -77,13 +78,34 @@ def move_to(robot: RobotController, arm: str, goal: PoseTarget, speed: float = L
         yield
 
 
-def settle(robot: RobotController, arm: str, tolerance: float = 0.004, max_ticks: int = 20) -> Iterator[None]:
-    """Hold the target until the measured tool is within ``tolerance`` (or time runs out)."""
+def settle(
+    robot: RobotController, arm: str, tolerance: float = 0.004, max_ticks: int = 20, required: float | None = None
+) -> Iterator[None]:
+    """Hold the target until the measured tool is within ``tolerance`` (or time runs out).
+
+    Raises:
+        ActionFailed: If ``required`` is given and the tool ends farther than
+            that from its target (the target is out of reach).
+    """
     target = robot.commanded_pose(arm).pos
     for _ in range(max_ticks):
-        if np.linalg.norm(robot.world.tcp_pose(arm)[0] - target) < tolerance:
+        if np.linalg.norm(robot.frame.arms[arm].ee - target) < tolerance:
             return
         yield
+    error = float(np.linalg.norm(robot.frame.arms[arm].ee - target))
+    if required is not None and error > required:
+        raise ActionFailed(f"target {np.round(target, 3).tolist()} is out of reach (tool {100 * error:.1f} cm away)")
+
+
+def wait_for_rest(robot: RobotController, obj: str, speed: float = 0.02, max_ticks: int = 75) -> Iterator[None]:
+    """Wait until an object stops moving (a dropped bottle still rolling or falling)."""
+    previous = robot.frame.objects[obj].pos.copy()
+    for _ in range(max_ticks):
+        yield
+        current = robot.frame.objects[obj].pos
+        if np.linalg.norm(current - previous) * 50.0 < speed:
+            return
+        previous = current.copy()
 
 
 def grip(robot: RobotController, arm: str, value: float, ticks: int = 12, max_wait: int = 20) -> Iterator[None]:

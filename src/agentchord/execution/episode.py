@@ -11,7 +11,7 @@ from agentchord.execution.executor import EpisodeResult, Executor, ExecutorConfi
 from agentchord.execution.strategies import make_strategy
 from agentchord.graph.models import TaskGraph
 from agentchord.tasks import load_task_graph
-from agentchord.worlds.sim.disturbances import RandomDrop
+from agentchord.worlds.sim.disturbances import Disturbance, RandomDrop
 from agentchord.worlds.sim.tasks import SIM_TASKS
 from agentchord.worlds.sim.world import SimWorld
 
@@ -27,6 +27,7 @@ class EpisodeSpec:
         seed: Seeds the scene (object instances, poses) and the disturbance schedule.
         graph: The graph to run; None = the task library's graph.
         config: Budgets.
+        disturbance: A disturbance to use instead of the random drop of ``p``.
     """
 
     task: str
@@ -35,6 +36,7 @@ class EpisodeSpec:
     seed: int = 0
     graph: TaskGraph | None = None
     config: ExecutorConfig | None = None
+    disturbance: Disturbance | None = None
 
 
 def run_episode(spec: EpisodeSpec, on_tick: Callable[[Executor], None] | None = None) -> EpisodeResult:
@@ -55,7 +57,7 @@ def run_episode(spec: EpisodeSpec, on_tick: Callable[[Executor], None] | None = 
         world=world,
         strategy=make_strategy(spec.strategy),
         tracker=task.success_tracker(),
-        disturbance=RandomDrop(spec.p, spec.seed) if spec.p > 0 else None,
+        disturbance=spec.disturbance or (RandomDrop(spec.p, spec.seed) if spec.p > 0 else None),
         config=spec.config,
         on_tick=on_tick,
     )

@@ -28,7 +28,7 @@ from agentchord.features.oracle import OracleExtractor
 from agentchord.graph.models import TaskGraph
 from agentchord.graph.progress import forward_filter, nominal_path
 from agentchord.monitor import Detection, EdgeMonitors, RecoveryMap
-from agentchord.worlds.sim.disturbances import RandomDrop
+from agentchord.worlds.sim.disturbances import Disturbance
 from agentchord.worlds.sim.tasks import SuccessTracker
 from agentchord.worlds.sim.world import CONTROL_HZ, SimWorld
 
@@ -101,7 +101,7 @@ class Executor:
         world: SimWorld,
         strategy: RecoveryStrategy,
         tracker: SuccessTracker,
-        disturbance: RandomDrop | None = None,
+        disturbance: Disturbance | None = None,
         config: ExecutorConfig | None = None,
         on_tick: Callable[[Executor], None] | None = None,
     ) -> None:
@@ -249,14 +249,10 @@ class Executor:
         self.program = program
         program.on_action_start = self._action_started
         program.on_action_end = self._action_ended
+        # Only the active edge's own monitors are armed. A failure during a recovery edge
+        # without monitors shows at its merge node: the next edge's monitors catch it.
         edge_monitors = self.monitors.get(program.edge_id)
-        if edge_monitors is not None and edge_monitors.monitors:
-            self.armed = edge_monitors
-        elif program.kind == "nominal" or self.recovering_from is None:
-            self.armed = None
-        else:
-            # A recovery keeps the failed edge's monitors armed: a second drop re-enters recovery.
-            self.armed = self.monitors[self.recovering_from]
+        self.armed = edge_monitors if edge_monitors is not None and edge_monitors.monitors else None
         if self.armed is not None:
             self.armed.reset()
         self.frame.capture_refs()

@@ -1,0 +1,59 @@
+"""The safe constraint/monitor expression language.
+
+Constraints and monitors of task graphs are strings such as
+``"dist(bottle.pos, cup.top + [0.05, -0.10, 0.10]) - 0.03"``. They are parsed
+with :mod:`ast`, checked against a whitelist and compiled into closures over a
+:class:`~agentchord.features.frame.FeatureFrame`; nothing is ever passed to
+``eval`` or ``exec``. An expression evaluates to a float: <= 0 means satisfied
+(constraint) or normal (monitor), > 0 violated or failure present.
+
+Example:
+    >>> from agentchord.expr import Vocabulary, compile_expr
+    >>> from agentchord.features.frame import make_static_frame
+    >>> expr = compile_expr("tilt(bottle) - 20", Vocabulary(objects={"bottle"}))
+    >>> expr.scalar(make_static_frame({"bottle": {}}))
+    -20.0
+"""
+
+from agentchord.expr.compiler import (
+    CALLABLES,
+    FUNCTIONS,
+    MAX_DEPTH,
+    MAX_EXPONENT,
+    MAX_SOURCE_LENGTH,
+    CompiledExpr,
+    Vocabulary,
+    compile_expr,
+)
+from agentchord.expr.exceptions import (
+    ExprError,
+    ExprEvalError,
+    ExprForbiddenError,
+    ExprNameError,
+    ExprSyntaxError,
+    ExprTypeError,
+)
+from agentchord.expr.library import ArgKind, Function, Param
+from agentchord.expr.templates import TEMPLATES, TemplateInfo
+
+__all__ = [
+    "CALLABLES",
+    "FUNCTIONS",
+    "MAX_DEPTH",
+    "MAX_EXPONENT",
+    "MAX_SOURCE_LENGTH",
+    "TEMPLATES",
+    "ArgKind",
+    "CompiledExpr",
+    "ExprError",
+    "ExprEvalError",
+    "ExprForbiddenError",
+    "ExprNameError",
+    "ExprSyntaxError",
+    "ExprTypeError",
+    "Function",
+    "Param",
+    "TemplateInfo",
+    "Vocabulary",
+    "compile_expr",
+]

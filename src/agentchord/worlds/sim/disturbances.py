@@ -84,3 +84,52 @@ class RandomDrop:
                 self.events.append(event)
                 return event
         return None
+
+
+@dataclass
+class ScriptedDrop:
+    """A drop at a chosen moment: during the ``nth`` run of ``action`` (0-based), ``after`` ticks in.
+
+    For tests and demonstrations of one specific failure; same interface as :class:`RandomDrop`.
+    """
+
+    action: str
+    nth: int = 0
+    after: int = 20
+    fault_ticks: int = 12
+    events: list[DropEvent] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        self._seen = 0
+        self._due: tuple[str, int] | None = None
+
+    def action_started(self, arm: str, action: str, expected_ticks: int, tick: int) -> None:
+        """Arm the drop when the chosen run of the chosen action starts."""
+        if action != self.action:
+            return
+        if self._seen == self.nth:
+            self._due = (arm, tick + self.after)
+        self._seen += 1
+
+    def action_ended(self, arm: str) -> None:
+        """Disarm if the action ended before the moment."""
+        if self._due is not None and self._due[0] == arm:
+            self._due = None
+
+    def apply(self, world: SimWorld, frame: FeatureFrame) -> DropEvent | None:
+        """Force the gripper open when due, if it holds something."""
+        if self._due is None or world.tick < self._due[1]:
+            return None
+        arm = self._due[0]
+        self._due = None
+        held = sorted(obj for a, obj in frame.holding if a == arm)
+        if not held:
+            return None
+        world.inject_gripper_fault(arm, self.fault_ticks)
+        event = DropEvent(tick=world.tick, arm=arm, obj=held[0], action=self.action)
+        self.events.append(event)
+        return event
+
+
+#: Anything with the schedule interface the executor drives.
+Disturbance = RandomDrop | ScriptedDrop

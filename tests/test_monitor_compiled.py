@@ -1,0 +1,46 @@
+"""Compiled monitors of an edge and the recovery map (Eq. 11-13)."""
+
+from agentchord.expr import Vocabulary
+from agentchord.features.frame import make_static_frame
+from agentchord.monitor import EdgeMonitors, RecoveryMap
+from agentchord.tasks import load_task_graph
+
+VOCAB = Vocabulary(frozenset({"bottle", "cup"}))
+
+
+def _frame(holding: bool, closed: float = 1.0):
+    return make_static_frame(
+        objects={"bottle": {"pos": (0.1, 0.5, 0.2)}, "cup": {"pos": (-0.1, 0.6, 0.05)}},
+        arms={"right": {"closed": closed}},
+        holding={("right", "bottle")} if holding else set(),
+    )
+
+
+def test_drop_monitor_fires_after_its_window_and_names_the_failure():
+    graph = load_task_graph("single_arm_pour_water")
+    monitors = EdgeMonitors.compile(graph.edge("e2"), VOCAB)
+    held, dropped = _frame(True), _frame(False)
+    assert monitors.evaluate(held) is None
+    detections = []
+    for tick in range(3):
+        dropped.tick = 10 + tick
+        detections.append(monitors.evaluate(dropped))
+    assert detections[:2] == [None, None]
+    assert detections[2].failure.name == "bottle_dropped"
+    assert detections[2].onset_tick == 10
+
+
+def test_gated_drop_monitor_is_quiet_while_the_gripper_is_open():
+    graph = load_task_graph("single_arm_pour_water")
+    monitors = EdgeMonitors.compile(graph.edge("e1"), VOCAB)
+    open_gripper = _frame(False, closed=0.0)
+    assert all(monitors.evaluate(open_gripper) is None for _ in range(10))
+
+
+def test_recovery_map_returns_the_entry_edge_and_orders_exits_by_cost_to_go():
+    graph = load_task_graph("single_arm_pour_water")
+    recovery = RecoveryMap(graph)
+    assert recovery.entry("e2", "bottle_dropped").id == "e2_r_bottle_dropped"
+    assert recovery.entry("e2", "no_such_failure") is None
+    exits = recovery.exit_edges("r_bottle_regrasped")
+    assert [e.target for e in exits] == ["v2"]
