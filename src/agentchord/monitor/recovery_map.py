@@ -33,5 +33,7 @@ class RecoveryMap:
         The executor takes the admissible candidate with the least cost-to-go
         (DESIGN section 3): ties keep the file's order.
         """
-        exits = [e for e in self.graph.out_edges(node_id) if e.kind == "recovery"]
+        entries = set(self._entries.values())
+        # Entry edges (a failure's first response) and self-loops are not ways forward.
+        exits = [e for e in self.graph.out_edges(node_id) if e.kind == "recovery" and e.id not in entries and e.target != node_id]
         return sorted(exits, key=lambda e: self.cost_to_go.get(e.target, float("inf")))

@@ -2,17 +2,11 @@
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import numpy as np
 
 from agentchord.worlds.sim.world import CONTROL_HZ, SimWorld
-
-
-def _ensure_headless_gl() -> None:
-    # EGL renders without a display; fall back to OSMesa (software) if EGL is absent.
-    os.environ.setdefault("MUJOCO_GL", "egl")
 
 
 class VideoRecorder:
@@ -27,8 +21,7 @@ class VideoRecorder:
     """
 
     def __init__(self, world: SimWorld, path: str | Path, camera: str = "front", every: int = 2, size: tuple[int, int] = (640, 480)) -> None:
-        _ensure_headless_gl()
-        import mujoco  # noqa: PLC0415  (after MUJOCO_GL is set)
+        import mujoco  # noqa: PLC0415  (MUJOCO_GL is set by the package's __init__)
 
         self.world = world
         self.path = Path(path)

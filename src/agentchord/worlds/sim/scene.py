@@ -155,9 +155,10 @@ def _add_environment(spec: mujoco.MjSpec) -> None:
     table.add_geom(name="table", type=mujoco.mjtGeom.mjGEOM_BOX, size=list(TABLE_HALF), rgba=[0.55, 0.45, 0.35, 1], friction=[1.0, 0.005, 0.0001])
     for xyz, direction in (((-1, -1, 1.5), (1, 1, -1.5)), ((1, -1, 1.5), (-1, 1, -1.5))):
         world.add_light(pos=list(xyz), dir=list(direction), type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL, diffuse=[0.45, 0.45, 0.45], castshadow=0)
-    world.add_camera(name="front", pos=[0.0, -0.45, 0.75], xyaxes=[1, 0, 0, 0, 0.72, 0.7])
+    target = mujoco.mjtCamLight.mjCAMLIGHT_TARGETBODY
+    world.add_camera(name="front", pos=[0.0, -0.25, 0.75], mode=target, targetbody="table", fovy=55)
     world.add_camera(name="top", pos=[0.0, 0.6, 1.35], xyaxes=[1, 0, 0, 0, 1, 0])
-    world.add_camera(name="side", pos=[1.15, 0.35, 0.55], xyaxes=[0.3, 0.95, 0, -0.35, 0.1, 0.93])
+    world.add_camera(name="side", pos=[1.0, 0.1, 0.6], mode=target, targetbody="table", fovy=55)
     spec.visual.quality.offsamples = 0
     spec.visual.quality.shadowsize = 0
     spec.visual.headlight.ambient = [0.35, 0.35, 0.35]

@@ -1,0 +1,92 @@
+"""Atomic actions on the real physics: grasps hold through contact, programs are interruptible."""
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from agentchord.actions.base import Status
+from agentchord.actions.controller import RobotController
+from agentchord.actions.library import make_action
+from agentchord.features.oracle import OracleExtractor
+from agentchord.worlds.sim.world import SimWorld
+
+
+def _setup(scene):
+    world = SimWorld(scene)
+    robot = RobotController(world)
+    extractor = OracleExtractor(world, grasp_signal=lambda arm: robot.targets[arm].grip_closed_settled)
+    robot.frame = extractor.frame
+    return world, robot, extractor
+
+
+def _run(robot, extractor, action, max_ticks=1500):
+    action.initialise(robot)
+    for tick in range(max_ticks):
+        status = action.update(robot)
+        if status != Status.RUNNING:
+            return status, tick
+        robot.step()
+        extractor.update()
+    raise AssertionError("action did not finish")
+
+
+def test_grasp_lifts_the_bottle_only_through_finger_contact(pour_scene):
+    world, robot, extractor = _setup(pour_scene)
+    z0 = world.object_pose("bottle")[0][2]
+    status, _ = _run(robot, extractor, make_action("grasp", "right", {"obj": "bottle"}))
+    assert status == Status.SUCCESS
+    assert world.holding("right", "bottle")
+    assert world.object_pose("bottle")[0][2] > z0 + 0.04
+    # Open the fingers: the bottle falls back to the table.
+    status, _ = _run(robot, extractor, make_action("open_gripper", "right", {}))
+    for _ in range(60):
+        robot.step()
+    assert not world.holding("right", "bottle")
+    assert world.on_table("bottle")
+
+
+def test_interrupted_action_leaves_the_arm_holding_still(pour_scene):
+    world, robot, extractor = _setup(pour_scene)
+    action = make_action("grasp", "right", {"obj": "bottle"})
+    action.initialise(robot)
+    for _ in range(40):
+        action.update(robot)
+        robot.step()
+        extractor.update()
+    action.terminate(Status.INVALID)
+    assert action.status == Status.INVALID
+    held = robot.commanded_pose("right").pos
+    for _ in range(40):
+        robot.step()
+    # The target froze where the action was interrupted and the arm settles there.
+    assert np.array_equal(robot.commanded_pose("right").pos, held)
+    assert np.linalg.norm(world.tcp_pose("right")[0] - held) < 0.005
+
+
+def test_grasp_of_a_fallen_bottle_sets_it_upright_in_hand(pour_scene):
+    world, robot, extractor = _setup(pour_scene)
+    adr = world.model.joint("bottle_free").qposadr[0]
+    radius = pour_scene.objects[0].size[0]
+    x, y, z, w = (Rotation.from_euler("z", 1.2) * Rotation.from_euler("y", 90, degrees=True)).as_quat()
+    world.data.qpos[adr : adr + 7] = [0.08, 0.5, radius + 0.001, w, x, y, z]
+    for _ in range(40):
+        world.step()
+    extractor.update()
+    assert extractor.frame.objects["bottle"].axis[2] < 0.2  # lying down
+    status, _ = _run(robot, extractor, make_action("grasp", "right", {"obj": "bottle"}))
+    assert status == Status.SUCCESS, make_action
+    assert world.holding("right", "bottle")
+    assert extractor.frame.objects["bottle"].axis[2] > np.cos(np.radians(20))
+
+
+def test_place_without_the_object_in_hand_fails_with_a_reason(pour_scene):
+    _, robot, extractor = _setup(pour_scene)
+    action = make_action("place", "right", {"obj": "bottle", "target": [0.1, 0.42]})
+    status, _ = _run(robot, extractor, action)
+    assert status == Status.FAILURE
+    assert "not held" in action.failure_reason
+
+
+def test_unknown_action_arguments_are_refused():
+    with pytest.raises(Exception, match="angle"):
+        make_action("rotate_eef", "right", {"angel": 90})

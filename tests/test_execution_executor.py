@@ -1,0 +1,78 @@
+"""The executor (Algorithm 1) on the simulated pour-water task."""
+
+import pytest
+
+from agentchord.execution.episode import EpisodeSpec, run_episode
+from agentchord.execution.executor import ExecutorConfig
+from agentchord.worlds.sim.disturbances import ScriptedDrop
+
+TASK = "single_arm_pour_water"
+
+
+def test_nominal_episode_succeeds_along_the_nominal_path():
+    result = run_episode(EpisodeSpec(TASK, seed=1))
+    assert result.success, result.reason
+    assert [p for p in result.path if p.startswith("e")] == ["e1", "e2", "e3", "e4", "e5", "e6"]
+    assert result.recoveries == 0
+
+
+@pytest.mark.parametrize("action,nth,after,edge,entry", [
+    ("move_to_obj", 0, 30, "e2", "e2_r_bottle_dropped"),
+    ("rotate_eef", 0, 40, "e3", "e3_r_bottle_dropped"),
+])
+def test_forced_drop_is_detected_within_the_window_and_recovered_forward(action, nth, after, edge, entry):
+    drop = ScriptedDrop(action=action, nth=nth, after=after)
+    result = run_episode(EpisodeSpec(TASK, seed=1, disturbance=drop))
+    assert result.success, result.reason
+    assert result.drops_injected == result.drops_detected == result.drops_recovered == 1
+    switch = result.trace.of("recovery_switch")[0]
+    detection = result.trace.of("failure_detected")[0]
+    assert (switch["edge"], switch["to"]) == (edge, entry)
+    window = 3
+    # The switch happens the tick the trigger fires, window ticks after the violation began ...
+    assert switch["tick"] - detection["onset_tick"] <= window + 2
+    # ... and the violation begins within a couple of ticks of the drop.
+    assert result.reaction_latency_ticks[0] <= window + 2
+    # Forward-moving: no nominal node before the failure context is revisited.
+    context = {"e2": "v1", "e3": "v2"}[edge]
+    nodes_after = result.path[result.path.index(entry):]
+    assert "v0" not in nodes_after and (context == "v2" or "v1" not in nodes_after[1:])
+
+
+def test_backtracking_returns_to_an_earlier_keyframe_and_reruns_nominal_edges():
+    drop = ScriptedDrop(action="move_to_obj", nth=0, after=30)
+    result = run_episode(EpisodeSpec(TASK, strategy="agentchord-bt", seed=1, disturbance=drop))
+    assert result.success, result.reason
+    assert "backtrack_to_v0" in result.path
+    after = result.path[result.path.index("backtrack_to_v0"):]
+    assert after[:3] == ["backtrack_to_v0", "v0", "e1"]
+
+
+def test_agentchord_recovers_in_fewer_steps_than_backtracking_for_the_same_drop():
+    steps = {}
+    for strategy in ("agentchord", "agentchord-bt"):
+        drop = ScriptedDrop(action="move_to_obj", nth=0, after=30)
+        result = run_episode(EpisodeSpec(TASK, strategy=strategy, seed=1, disturbance=drop))
+        assert result.success, (strategy, result.reason)
+        steps[strategy] = result.steps
+    assert steps["agentchord"] < steps["agentchord-bt"]
+
+
+def test_same_seed_gives_the_same_trace():
+    traces = [run_episode(EpisodeSpec(TASK, p=0.3, seed=5)).trace.events for _ in range(2)]
+    assert traces[0] == traces[1]
+    assert any(e["event"] == "disturbance" for e in traces[0])
+
+
+def test_tick_limit_ends_the_episode_as_a_failure_with_a_reason():
+    result = run_episode(EpisodeSpec(TASK, seed=1, config=ExecutorConfig(tick_limit=100)))
+    assert not result.success
+    assert "tick limit 100" in result.reason
+    assert result.steps == 100
+
+
+def test_failure_budget_ends_the_episode_with_a_reason():
+    drop = ScriptedDrop(action="move_to_obj", nth=0, after=30)
+    result = run_episode(EpisodeSpec(TASK, seed=1, disturbance=drop, config=ExecutorConfig(failure_budget=0)))
+    assert not result.success
+    assert "failure budget exhausted" in result.reason
