@@ -141,7 +141,7 @@ def _print_episode(console: Console, result) -> None:
 @click.option("--json", "json_path", type=click.Path(dir_okay=False), help="Write the aggregates as JSON.")
 def demo(task, trials, p, strategies, workers, json_path) -> None:
     """Seeded episodes of each strategy under random drops, then a table per strategy."""
-    from agentchord.bench.report import aggregate, print_tables  # noqa: PLC0415
+    from agentchord.bench.report import aggregate, paired_steps, print_tables  # noqa: PLC0415
     from agentchord.bench.runner import run_many  # noqa: PLC0415
     from agentchord.execution.episode import EpisodeSpec  # noqa: PLC0415
     from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: PLC0415
@@ -161,10 +161,13 @@ def demo(task, trials, p, strategies, workers, json_path) -> None:
         for spec, summary in run_many(specs, workers=workers):
             summaries[spec.strategy].append(summary)
             bar.advance(job)
+    for runs in summaries.values():
+        runs.sort(key=lambda s: s["seed"])
     results = {name: aggregate(summaries[name]) for name in names}
-    print_tables(results, console)
+    paired = paired_steps(summaries)
+    print_tables(results, console, paired)
     if json_path:
-        payload = {"task": task, "p": p, "trials": trials, "strategies": results}
+        payload = {"task": task, "p": p, "trials": trials, "strategies": results, "paired_steps": paired}
         Path(json_path).parent.mkdir(parents=True, exist_ok=True)
         Path(json_path).write_text(json.dumps(payload, indent=2) + "\n")
         console.print(f"aggregates: {json_path}")

@@ -34,6 +34,9 @@ def aggregate(summaries: list[dict]) -> dict:
         "mean_time_s": round(mean(s["time_s"] for s in summaries), 3) if n else 0.0,
         "mean_steps": round(mean(s["steps"] for s in summaries), 1) if n else 0.0,
         "mean_steps_with_drop": round(mean(s["steps"] for s in with_drop), 1) if with_drop else None,
+        # The paper counts steps "to complete a task": failed episodes end early and would flatter a strategy that gives up.
+        "mean_steps_success_with_drop": round(mean(s["steps"] for s in with_drop if s["success"]), 1)
+        if any(s["success"] for s in with_drop) else None,
         "episodes_with_drop": len(with_drop),
         "drops_injected": sum(s["drops_injected"] for s in summaries),
         "drops_detected": sum(s["drops_detected"] for s in summaries),
@@ -43,6 +46,25 @@ def aggregate(summaries: list[dict]) -> dict:
         "mean_wall_s": round(mean(s["wall_s"] for s in summaries), 3) if n else 0.0,
         "failures": sorted({s["reason"] for s in summaries if not s["success"]}),
     }
+
+
+def paired_steps(by_strategy: dict[str, list[dict]]) -> dict | None:
+    """Mean steps of each strategy over the seeds where every strategy succeeded and some saw a drop.
+
+    The fairest step comparison: same scenes, same first disturbances, all completed.
+    """
+    names = list(by_strategy)
+    if len(names) < 2:
+        return None
+    per_seed = {name: {s["seed"]: s for s in runs} for name, runs in by_strategy.items()}
+    seeds = sorted(
+        seed for seed in per_seed[names[0]]
+        if all(seed in per_seed[n] and per_seed[n][seed]["success"] for n in names)
+        and any(per_seed[n][seed]["drops_injected"] > 0 for n in names)
+    )
+    if not seeds:
+        return {"seeds": [], "mean_steps": {n: None for n in names}}
+    return {"seeds": seeds, "mean_steps": {n: round(mean(per_seed[n][s]["steps"] for s in seeds), 1) for n in names}}
 
 
 def strategy_table(name: str, stats: dict) -> Table:
@@ -56,6 +78,8 @@ def strategy_table(name: str, stats: dict) -> Table:
     table.add_row("mean steps (control ticks)", f"{stats['mean_steps']:.0f}")
     with_drop = stats["mean_steps_with_drop"]
     table.add_row(f"mean steps, episodes with a drop ({stats['episodes_with_drop']})", "-" if with_drop is None else f"{with_drop:.0f}")
+    done = stats["mean_steps_success_with_drop"]
+    table.add_row("mean steps, successful episodes with a drop", "-" if done is None else f"{done:.0f}")
     table.add_row("drops injected / detected / recovered", f"{stats['drops_injected']} / {stats['drops_detected']} / {stats['drops_recovered']}")
     lat_mean, lat_max = stats["reaction_latency_ticks_mean"], stats["reaction_latency_ticks_max"]
     table.add_row("reaction latency mean / max (ticks)", "-" if lat_mean is None else f"{lat_mean:.1f} / {lat_max}")
@@ -63,10 +87,13 @@ def strategy_table(name: str, stats: dict) -> Table:
     return table
 
 
-def print_tables(results: dict[str, dict], console: Console | None = None) -> None:
-    """Print one table per strategy and the failure reasons."""
+def print_tables(results: dict[str, dict], console: Console | None = None, paired: dict | None = None) -> None:
+    """Print one table per strategy, the failure reasons and the paired step comparison."""
     console = console or Console()
     for name, stats in results.items():
         console.print(strategy_table(name, stats))
         for reason in stats["failures"]:
             console.print(f"  [red]failed:[/red] {reason}")
+    if paired is not None and paired["seeds"]:
+        steps = ", ".join(f"{name} {value:.0f}" for name, value in paired["mean_steps"].items())
+        console.print(f"paired: over the {len(paired['seeds'])} seeds with a drop that every strategy completed, mean steps: {steps}")

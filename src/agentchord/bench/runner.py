@@ -11,7 +11,7 @@ from agentchord.execution.episode import EpisodeSpec, run_episode
 
 def _run(spec: EpisodeSpec) -> tuple[EpisodeSpec, dict]:
     result = run_episode(spec)
-    return spec, result.summary()
+    return spec, {"seed": spec.seed, "strategy": spec.strategy, **result.summary()}
 
 
 def default_workers() -> int:

@@ -1,0 +1,38 @@
+"""Aggregates of episode summaries."""
+
+import pytest
+
+from agentchord.bench.report import aggregate, paired_steps, wilson_interval
+
+
+def _summary(seed, success, steps, drops=0, latencies=()):
+    return {"seed": seed, "success": success, "steps": steps, "time_s": steps / 50, "wall_s": 1.0, "reason": "" if success else "x",
+            "drops_injected": drops, "drops_detected": drops, "drops_recovered": drops if success else 0,
+            "reaction_latency_ticks": list(latencies)}
+
+
+def test_aggregate_counts_rates_and_latencies():
+    runs = [_summary(0, True, 700), _summary(1, True, 900, drops=1, latencies=[3]), _summary(2, False, 300, drops=1, latencies=[4])]
+    stats = aggregate(runs)
+    assert stats["success_rate"] == pytest.approx(2 / 3)
+    assert stats["mean_steps"] == pytest.approx(633.3, abs=0.1)
+    assert stats["mean_steps_with_drop"] == 600.0
+    assert stats["mean_steps_success_with_drop"] == 900.0
+    assert stats["drops_injected"] == 2 and stats["drops_recovered"] == 1
+    assert stats["reaction_latency_ticks_max"] == 4
+    assert stats["failures"] == ["x"]
+
+
+def test_paired_steps_uses_seeds_every_strategy_completed_after_a_drop():
+    by_strategy = {
+        "a": [_summary(0, True, 700), _summary(1, True, 900, drops=1), _summary(2, True, 950, drops=1)],
+        "b": [_summary(0, True, 700), _summary(1, True, 1000, drops=1), _summary(2, False, 300, drops=1)],
+    }
+    paired = paired_steps(by_strategy)
+    assert paired == {"seeds": [1], "mean_steps": {"a": 900.0, "b": 1000.0}}
+
+
+def test_wilson_interval_brackets_the_rate():
+    low, high = wilson_interval(19, 20)
+    assert low < 0.95 < high <= 1.0
+    assert wilson_interval(0, 0) == (0.0, 0.0)

@@ -1,0 +1,61 @@
+"""The ``agentchord run`` and ``agentchord demo`` commands: outputs and exit statuses."""
+
+import json
+
+from click.testing import CliRunner
+
+from agentchord.cli import main
+
+
+def test_run_prints_the_path_writes_trace_and_summary_and_exits_0(tmp_path):
+    trace, summary = tmp_path / "trace.jsonl", tmp_path / "episode.json"
+    result = CliRunner().invoke(main, ["run", "single_arm_pour_water", "--seed", "1", "--trace", str(trace), "--json", str(summary)])
+    assert result.exit_code == 0, result.output
+    assert "path: v0 -> e1 -> v1" in result.output
+    data = json.loads(summary.read_text())
+    assert {"success", "steps", "time_s", "failures_detected", "recoveries", "path"} <= set(data)
+    assert data["success"] is True and data["path"][-1] == "v6"
+    events = [json.loads(line) for line in trace.read_text().splitlines()]
+    assert events[0]["event"] == "episode_start" and events[-1]["event"] == "episode_end"
+
+
+def test_run_exits_1_when_the_task_fails(tmp_path):
+    graph = tmp_path / "stop_early.yaml"
+    # A graph whose goal is the grasp: the pour never happens, so the task check fails.
+    graph.write_text(
+        "task: single_arm_pour_water\nobjects: [bottle, cup]\nstart: v0\ngoal: v1\n"
+        "nodes: [{id: v0, semantic: start}, {id: v1, semantic: held}]\n"
+        "edges: [{id: e1, source: v0, target: v1, actions: {right: {fn: grasp, args: {obj: bottle}}}}]\n"
+    )
+    result = CliRunner().invoke(main, ["run", "single_arm_pour_water", "--graph", str(graph)])
+    assert result.exit_code == 1, result.output
+    assert "never reached a pouring orientation" in result.output
+
+
+def test_run_exits_2_on_bad_input(tmp_path):
+    runner = CliRunner()
+    assert runner.invoke(main, ["run", "no_such_task"]).exit_code == 2
+    assert runner.invoke(main, ["run", "single_arm_pour_water", "--p", "1.5"]).exit_code == 2
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("task: t\nstart: v0\ngoal: v9\nnodes: [{id: v0, semantic: s}]\nedges: []\n")
+    result = runner.invoke(main, ["run", "single_arm_pour_water", "--graph", str(bad)])
+    assert result.exit_code == 2
+    assert f"{bad}: goal: unknown node 'v9'" in result.output
+
+
+def test_demo_writes_the_aggregates_of_each_strategy(tmp_path):
+    out = tmp_path / "demo.json"
+    result = CliRunner().invoke(main, ["demo", "--trials", "1", "--p", "0", "--workers", "1", "--json", str(out)])
+    assert result.exit_code == 0, result.output
+    data = json.loads(out.read_text())
+    assert data["p"] == 0 and data["trials"] == 1
+    for name in ("agentchord", "agentchord-bt"):
+        stats = data["strategies"][name]
+        assert stats["success_rate"] == 1.0
+        assert {"mean_steps", "mean_time_s", "drops_injected", "drops_recovered", "reaction_latency_ticks_max"} <= set(stats)
+
+
+def test_demo_refuses_an_unknown_strategy():
+    result = CliRunner().invoke(main, ["demo", "--strategies", "magic"])
+    assert result.exit_code == 2
+    assert "unknown strategy" in result.output
