@@ -41,6 +41,7 @@ test-all: install
 bench: install
 	$(BIN)/python benchmarks/bench_episode.py
 	$(BIN)/python benchmarks/bench_monitors.py
+	$(BIN)/python benchmarks/bench_recovery_cost.py
 
 clean:
 	rm -rf $(VENV) .pytest_cache .hypothesis

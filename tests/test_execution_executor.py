@@ -4,7 +4,7 @@ import pytest
 
 from agentchord.execution.episode import EpisodeSpec, run_episode
 from agentchord.execution.executor import ExecutorConfig
-from agentchord.worlds.sim.disturbances import ScriptedDrop
+from agentchord.worlds.sim.disturbances import ScriptedDrop, ScriptedPush
 
 TASK = "single_arm_pour_water"
 
@@ -76,3 +76,16 @@ def test_failure_budget_ends_the_episode_with_a_reason():
     result = run_episode(EpisodeSpec(TASK, seed=1, disturbance=drop, config=ExecutorConfig(failure_budget=0)))
     assert not result.success
     assert "failure budget exhausted" in result.reason
+
+
+@pytest.mark.parametrize("action,edge,entry", [
+    ("move_to_obj", "e2", "e2_r_cup_shifted"),
+    ("rotate_eef", "e3", "e3_r_cup_shifted"),
+])
+def test_cup_shifted_while_the_bottle_approaches_or_pours_is_followed(action, edge, entry):
+    push = ScriptedPush(action=action, obj="cup", force=(-3.0, 0.0, 0.0), after=20)
+    result = run_episode(EpisodeSpec(TASK, seed=1, disturbance=push))
+    assert result.success, result.reason
+    switch = result.trace.of("recovery_switch")[0]
+    assert (switch["failure"], switch["edge"], switch["to"]) == ("cup_shifted", edge, entry)
+    assert result.trace.of("disturbance")[0]["kind"] == "shift"

@@ -87,7 +87,7 @@ def run(task, strategy, p, seed, graph_path, trace_path, json_path, video_path, 
             elif event["event"] == "recovery_switch":
                 video.announce(f"RECOVERY -> {event['to']}")
             elif event["event"] == "disturbance":
-                video.announce(f"DISTURBANCE: {event['obj']} dropped", ticks=10)
+                video.announce(f"DISTURBANCE: {event['obj']} {'dropped' if event['kind'] == 'drop' else 'pushed'}", ticks=10)
         recorder["seen"] = len(executor.trace.events)
         program = executor.program
         caption = f"{task}  node {executor.node}  edge {program.edge_id if program else '-'} ({program.kind if program else ''})"
@@ -118,7 +118,8 @@ def _print_episode(console: Console, result) -> None:
             mark = "ok" if event["constraints_hold"] else f"constraints violated: {event.get('violated')}"
             console.print(f"{tick}  node [bold]{event['node']}[/bold]  {mark}")
         elif kind == "disturbance":
-            console.print(f"{tick}  [yellow]disturbance[/yellow]: {event['obj']} dropped by {event['arm']} during {event['action']}")
+            what = f"dropped by {event['arm']}" if event["kind"] == "drop" else "pushed"
+            console.print(f"{tick}  [yellow]disturbance[/yellow]: {event['obj']} {what} during {event['action']}")
         elif kind == "failure_detected":
             console.print(f"{tick}  [red]failure detected[/red]: {event['failure']} on {event['edge']} (violated since tick {event['onset_tick']})")
         elif kind == "recovery_switch":

@@ -28,10 +28,14 @@ class GraspArgs(_Args):
 
 
 class MoveToObjArgs(_Args):
-    """Move the held object (or the tool) to an offset from ``obj``'s top point."""
+    """Move the held object (or the tool) to an offset from ``obj``'s top point, upright."""
 
     obj: str
     offset: Vec3 = (0.0, 0.0, 0.1)
+    yaw: float | None = Field(
+        None, ge=-180.0, le=180.0,
+        description="Orientation hint: world yaw (deg) of the tool's horizontal approach axis; None keeps the current one.",
+    )
 
 
 class RotateEefArgs(_Args):

@@ -137,7 +137,13 @@ class MoveToObj(ArmAction):
 
     def script(self, robot: RobotController) -> Iterator[None]:
         arm = self.arm
-        rotation = grasp_frame(robot.rotation(arm)[:, 0])
+        # A pushed target may still be sliding: aim at where it stops.
+        yield from wait_for_rest(robot, self.args.obj)
+        if self.args.yaw is None:
+            rotation = grasp_frame(robot.rotation(arm)[:, 0])
+        else:
+            yaw = np.radians(self.args.yaw)
+            rotation = grasp_frame(np.array([np.cos(yaw), np.sin(yaw), 0.0]))
         target = robot.frame.objects[self.args.obj].top + np.asarray(self.args.offset)
         yield from move_to(robot, arm, pose_from_matrix(target, rotation))
         # Re-aim at the object's latest position (it may have been moved).

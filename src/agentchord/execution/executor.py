@@ -140,7 +140,8 @@ class Executor:
         self._latencies: list[int] = []
         self._drops_detected = 0
         self._drops_recovered = 0
-        self._recovery_drop: dict | None = None
+        # Drops detected whose recovery has not merged back yet (a second drop can interrupt the first's).
+        self._unmerged_drops = 0
 
     # ------------------------------------------------------------- queries
     @property
@@ -177,7 +178,7 @@ class Executor:
             path=self.path,
             failures_detected=len(self.trace.of("failure_detected")),
             recoveries=len(self.trace.of("recovery_switch")),
-            drops_injected=len(self.disturbance.events) if self.disturbance else 0,
+            drops_injected=sum(e.kind == "drop" for e in self.disturbance.events) if self.disturbance else 0,
             drops_detected=self._drops_detected,
             drops_recovered=self._drops_recovered,
             reaction_latency_ticks=self._latencies,
@@ -190,10 +191,11 @@ class Executor:
         frame = self.extractor.update()
         self.tracker.observe(frame)
         if self.disturbance is not None:
-            drop = self.disturbance.apply(self.world, frame)
-            if drop is not None:
-                self._open_drop = {"tick": drop.tick, "obj": drop.obj}
-                self.trace.add(drop.tick, "disturbance", kind="drop", arm=drop.arm, obj=drop.obj, action=drop.action)
+            event = self.disturbance.apply(self.world, frame)
+            if event is not None:
+                if event.kind == "drop":
+                    self._open_drop = {"tick": event.tick, "obj": event.obj}
+                self.trace.add(event.tick, "disturbance", kind=event.kind, arm=event.arm, obj=event.obj, action=event.action)
         if self.world.tick >= self.config.tick_limit:
             return False, f"tick limit {self.config.tick_limit} reached at {self._where()}"
         if self.armed is not None:
@@ -232,9 +234,8 @@ class Executor:
             if self.recovering_from is not None:
                 self.recovering_from = None
                 self.trace.add(self.world.tick, "recovery_merged", node=node_id)
-                if self._recovery_drop is not None:
-                    self._drops_recovered += 1
-                    self._recovery_drop = None
+                self._drops_recovered += self._unmerged_drops
+                self._unmerged_drops = 0
         if node_id == self.graph.goal:
             verdict = self.tracker.verdict(self.frame, self.world)
             return verdict.success, verdict.reason
@@ -283,7 +284,8 @@ class Executor:
         if self._open_drop is not None:
             self._drops_detected += 1
             self._latencies.append(detection.tick - self._open_drop["tick"])
-            self._recovery_drop, self._open_drop = self._open_drop, None
+            self._unmerged_drops += 1
+            self._open_drop = None
         if self.fire_counts[key] > self.config.failure_budget:
             return False, f"failure budget exhausted: {detection.failure.name} on {detection.edge_id} fired {self.fire_counts[key]} times"
         self.program.terminate(Status.INVALID)

@@ -17,19 +17,21 @@ from agentchord.worlds.sim.world import SimWorld
 
 @dataclass
 class DropEvent:
-    """One injected drop.
+    """One injected disturbance.
 
     Attributes:
-        tick: Tick the gripper was forced open.
-        arm: The arm that lost its object.
-        obj: The object that was dropped.
+        tick: Tick it happened (for a drop: the gripper was forced open).
+        arm: The arm that lost its object ("" when no arm is involved).
+        obj: The object that was dropped or pushed.
         action: The atomic action that was running.
+        kind: ``drop`` or ``shift``.
     """
 
     tick: int
     arm: str
     obj: str
     action: str
+    kind: str = "drop"
 
 
 @dataclass
@@ -131,5 +133,46 @@ class ScriptedDrop:
         return event
 
 
+@dataclass
+class ScriptedPush:
+    """Push an object (e.g. the cup) during the ``nth`` run of ``action``, ``after`` ticks in.
+
+    A horizontal force for a few ticks: the object slides, as when a person moves the target.
+    Recorded in the trace as a ``shift`` disturbance.
+    """
+
+    action: str
+    obj: str
+    force: tuple[float, float, float] = (0.0, 3.0, 0.0)
+    nth: int = 0
+    after: int = 20
+    ticks: int = 8
+    events: list[DropEvent] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        self._seen = 0
+        self._due: int | None = None
+
+    def action_started(self, arm: str, action: str, expected_ticks: int, tick: int) -> None:
+        """Arm the push when the chosen run of the chosen action starts."""
+        if action == self.action:
+            if self._seen == self.nth:
+                self._due = tick + self.after
+            self._seen += 1
+
+    def action_ended(self, arm: str) -> None:
+        """Pushes do not depend on the action still running."""
+
+    def apply(self, world: SimWorld, frame: FeatureFrame) -> DropEvent | None:
+        """Push when due."""
+        if self._due is None or world.tick < self._due:
+            return None
+        self._due = None
+        world.push(self.obj, np.asarray(self.force, dtype=float), self.ticks)
+        event = DropEvent(tick=world.tick, arm="", obj=self.obj, action=self.action, kind="shift")
+        self.events.append(event)
+        return event
+
+
 #: Anything with the schedule interface the executor drives.
-Disturbance = RandomDrop | ScriptedDrop
+Disturbance = RandomDrop | ScriptedDrop | ScriptedPush

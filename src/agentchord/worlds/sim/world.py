@@ -66,6 +66,7 @@ class SimWorld:
         self._object_geom = {o.name: m.geom(o.name).id for o in scene.objects}
         self._object_spec = {o.name: o for o in scene.objects}
         self._fault_until: dict[str, int] = {}
+        self._push_until: dict[int, int] = {}
         self.commands: dict[str, ArmCommand] = {}
         self._contacts: set[tuple[int, int]] = set()
         self.reset()
@@ -98,6 +99,18 @@ class SimWorld:
         """Force ``arm``'s gripper open for ``ticks`` control ticks (the drop disturbance)."""
         self._fault_until[arm] = self.tick + ticks
 
+    def push(self, obj: str, force: np.ndarray, ticks: int) -> None:
+        """Slide an object: a force (N, world frame) applied at its base for ``ticks`` ticks.
+
+        Applied at the base, not the centre, so a tall cup slides instead of tipping over.
+        """
+        spec = self.object_spec(obj)
+        body = self._object_body[obj]
+        base = np.array([0.0, 0.0, -0.5 * spec.height])
+        self.data.xfrc_applied[body, :3] = force
+        self.data.xfrc_applied[body, 3:] = np.cross(base, force)
+        self._push_until[body] = self.tick + ticks
+
     def gripper_faulted(self, arm: str) -> bool:
         """Whether a gripper fault is forcing ``arm`` open now."""
         return self._fault_until.get(arm, -1) > self.tick
@@ -119,6 +132,10 @@ class SimWorld:
         for _ in range(self.substeps):
             mujoco.mj_step(self.model, self.data)
         self.tick += 1
+        for body, until in list(self._push_until.items()):
+            if self.tick >= until:
+                self.data.xfrc_applied[body] = 0.0
+                del self._push_until[body]
         geoms = self.data.contact.geom[: self.data.ncon]
         self._contacts = {(int(a), int(b)) for a, b in geoms}
 
