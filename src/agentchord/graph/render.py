@@ -3,7 +3,7 @@
 Colours follow the paper's Fig. 3: nominal edges blue, recovery edges pink.
 Recovery nodes are outlined pink, the start node is bold and the goal doubly
 outlined. A recovery entry edge is dashed and labelled with the failure modes
-that fire it (``mode: monitor > margin``); a nominal edge lists its failure
+that fire it (``when mode on edge``); a nominal edge lists its failure
 modes with their entry edges (``! mode -> entry``).
 """
 
@@ -42,7 +42,8 @@ def _entry_failures(graph: TaskGraph) -> dict[str, list[tuple[Edge, FailureMode]
 
 
 def _trigger(failure: FailureMode, edge: Edge) -> str:
-    return f"{failure.name} on {edge.id}: {failure.monitor} > {failure.margin:g}"
+    # The monitor's expression stays in the file: a figure that prints it is unreadable.
+    return f"when {failure.name} on {edge.id}"
 
 
 def _edge_lines(edge: Edge, triggers: list[tuple[Edge, FailureMode]]) -> list[str]:

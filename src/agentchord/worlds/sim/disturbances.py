@@ -34,6 +34,18 @@ class DropEvent:
     kind: str = "drop"
 
 
+def drop_if_held(world: SimWorld, frame: FeatureFrame, arm: str, action: str, fault_ticks: int) -> DropEvent | None:
+    """Force ``arm``'s gripper open if it holds an object with a closed grip.
+
+    An opening gripper is releasing anyway, and an empty one has nothing to drop.
+    """
+    held = sorted(obj for a, obj in frame.holding if a == arm)
+    if not held or world.commands[arm].grip < 0.5:
+        return None
+    world.inject_gripper_fault(arm, fault_ticks)
+    return DropEvent(tick=world.tick, arm=arm, obj=held[0], action=action)
+
+
 @dataclass
 class RandomDrop:
     """With probability ``p`` per atomic action, the held object is dropped at a random moment.
@@ -78,11 +90,8 @@ class RandomDrop:
             if world.tick < due:
                 continue
             del self._pending[arm]
-            held = sorted(obj for a, obj in frame.holding if a == arm)
-            # Only a closed grip can lose its object: an opening gripper is releasing anyway.
-            if held and world.commands[arm].grip >= 0.5:
-                world.inject_gripper_fault(arm, self.fault_ticks)
-                event = DropEvent(tick=world.tick, arm=arm, obj=held[0], action=action)
+            event = drop_if_held(world, frame, arm, action, self.fault_ticks)
+            if event is not None:
                 self.events.append(event)
                 return event
         return None
@@ -124,12 +133,9 @@ class ScriptedDrop:
             return None
         arm = self._due[0]
         self._due = None
-        held = sorted(obj for a, obj in frame.holding if a == arm)
-        if not held:
-            return None
-        world.inject_gripper_fault(arm, self.fault_ticks)
-        event = DropEvent(tick=world.tick, arm=arm, obj=held[0], action=self.action)
-        self.events.append(event)
+        event = drop_if_held(world, frame, arm, self.action, self.fault_ticks)
+        if event is not None:
+            self.events.append(event)
         return event
 
 
