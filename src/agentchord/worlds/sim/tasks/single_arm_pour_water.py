@@ -1,10 +1,4 @@
-"""Simulated tasks: randomised trial scenes and success checks (paper Appendix B).
-
-A task knows how to sample one trial's scene from a seeded generator (object
-instances within a category, table poses) and how to judge success from the
-feature frames of the episode. The task *graph* lives in the task library
-(:mod:`agentchord.tasks`); this module is the world side only.
-"""
+"""Single-arm pour water (paper Appendix B): grasp bottle, move to cup, pour, place bottle."""
 
 from __future__ import annotations
 
@@ -14,19 +8,12 @@ import numpy as np
 
 from agentchord.features.frame import FeatureFrame
 from agentchord.worlds.sim.scene import ObjectSpec, SceneSpec
+from agentchord.worlds.sim.tasks.base import Verdict, resting_on_table, tilt_deg, uniform
 from agentchord.worlds.sim.world import SimWorld
 
 
 @dataclass
-class Verdict:
-    """Whether the task succeeded, and why not."""
-
-    success: bool
-    reason: str
-
-
-@dataclass
-class SuccessTracker:
+class PourTracker:
     """Success of single-arm pour water, judged from the episode's frames.
 
     The bottle must reach a pouring orientation with its mouth above the cup
@@ -51,7 +38,7 @@ class SuccessTracker:
         bottle, cup = frame.objects["bottle"], frame.objects["cup"]
         if not frame.is_holding("right", "bottle"):
             return
-        tilt = np.degrees(np.arccos(np.clip(bottle.axis[2], -1.0, 1.0)))
+        tilt = tilt_deg(bottle.axis)
         lateral = np.linalg.norm((bottle.top - cup.top)[:2])
         if tilt >= self.pour_tilt_deg and lateral <= 0.5 * cup.extent[0] + 0.01 and bottle.top[2] > cup.top[2]:
             self.poured = True
@@ -60,17 +47,13 @@ class SuccessTracker:
     def verdict(self, frame: FeatureFrame, world: SimWorld) -> Verdict:
         """Judge the end state."""
         bottle = frame.objects["bottle"]
-        tilt = np.degrees(np.arccos(np.clip(bottle.axis[2], -1.0, 1.0)))
+        tilt = tilt_deg(bottle.axis)
         if not self.poured:
             return Verdict(False, "the bottle never reached a pouring orientation above the cup")
-        if any(arm == "right" or arm == "left" for arm, obj in frame.holding if obj == "bottle"):
-            return Verdict(False, "the bottle is still held")
         if tilt > 10.0:
             return Verdict(False, f"the bottle is not upright (tilt {tilt:.0f} deg)")
-        if bottle.bottom[2] > 0.01 or not world.on_table("bottle"):
-            return Verdict(False, "the bottle is not standing on the table")
-        if world.object_velocity("bottle") > 0.02:
-            return Verdict(False, "the bottle is still moving")
+        if bottle.bottom[2] > 0.01 or not resting_on_table(world, "bottle", frame):
+            return Verdict(False, "the bottle is not standing on the table, released and at rest")
         return Verdict(True, "poured, then placed upright and released")
 
 
@@ -93,32 +76,26 @@ class SingleArmPourWater:
     def sample_scene(self, rng: np.random.Generator) -> SceneSpec:
         """One trial's scene: object instances and poses drawn from the stated ranges."""
 
-        def uniform(bounds: tuple[float, float]) -> float:
-            return float(rng.uniform(*bounds))
-
         bottle = ObjectSpec(
             name="bottle",
             shape="cylinder",
-            size=(uniform(self.BOTTLE_RADIUS), uniform(self.BOTTLE_HALF_HEIGHT)),
-            mass=uniform(self.BOTTLE_MASS),
-            pos=(uniform(self.BOTTLE_XY[0]), uniform(self.BOTTLE_XY[1])),
+            size=(uniform(rng, self.BOTTLE_RADIUS), uniform(rng, self.BOTTLE_HALF_HEIGHT)),
+            mass=uniform(rng, self.BOTTLE_MASS),
+            pos=(uniform(rng, self.BOTTLE_XY[0]), uniform(rng, self.BOTTLE_XY[1])),
             rgba=(*rng.uniform(0.1, 0.6, 2), rng.uniform(0.6, 1.0), 1.0),
-            friction=uniform((0.8, 1.2)),
+            friction=uniform(rng, (0.8, 1.2)),
         )
         cup = ObjectSpec(
             name="cup",
             shape="cylinder",
-            size=(uniform(self.CUP_RADIUS), uniform(self.CUP_HALF_HEIGHT)),
-            mass=uniform(self.CUP_MASS),
-            pos=(uniform(self.CUP_XY[0]), uniform(self.CUP_XY[1])),
+            size=(uniform(rng, self.CUP_RADIUS), uniform(rng, self.CUP_HALF_HEIGHT)),
+            mass=uniform(rng, self.CUP_MASS),
+            pos=(uniform(rng, self.CUP_XY[0]), uniform(rng, self.CUP_XY[1])),
             rgba=(rng.uniform(0.7, 1.0), *rng.uniform(0.1, 0.5, 2), 1.0),
-            friction=uniform((0.8, 1.2)),
+            friction=uniform(rng, (0.8, 1.2)),
         )
         return SceneSpec(objects=[bottle, cup])
 
-    def success_tracker(self) -> SuccessTracker:
+    def success_tracker(self) -> PourTracker:
         """A fresh success tracker for one episode."""
-        return SuccessTracker()
-
-
-SIM_TASKS = {task.name: task for task in (SingleArmPourWater(),)}
+        return PourTracker()

@@ -1,0 +1,65 @@
+"""What every simulated task provides: a seeded scene sampler and a success check.
+
+A task knows how to sample one trial's scene from a seeded generator (object
+instances within a category, table poses) and how to judge success from the
+feature frames of the episode. The task *graph* lives in the task library
+(:mod:`agentchord.tasks`); this package is the world side only.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+
+from agentchord.features.frame import FeatureFrame
+from agentchord.worlds.sim.scene import SceneSpec
+from agentchord.worlds.sim.world import SimWorld
+
+
+@dataclass
+class Verdict:
+    """Whether the task succeeded, and why not."""
+
+    success: bool
+    reason: str
+
+
+class SuccessTracker(Protocol):
+    """Watches an episode's frames and judges its end state."""
+
+    def observe(self, frame: FeatureFrame) -> None:
+        """Watch one tick (for events that must happen during the episode)."""
+
+    def verdict(self, frame: FeatureFrame, world: SimWorld) -> Verdict:
+        """Judge the end state."""
+
+
+class SimTask(Protocol):
+    """A simulated task."""
+
+    name: str
+    description: str
+
+    def sample_scene(self, rng: np.random.Generator) -> SceneSpec:
+        """One trial's scene, drawn from the task's stated ranges."""
+
+    def success_tracker(self) -> SuccessTracker:
+        """A fresh success tracker for one episode."""
+
+
+def uniform(rng: np.random.Generator, bounds: tuple[float, float]) -> float:
+    """A float drawn uniformly from ``bounds``."""
+    return float(rng.uniform(*bounds))
+
+
+def tilt_deg(axis: np.ndarray) -> float:
+    """Angle (deg) between an object's axis and world up."""
+    return float(np.degrees(np.arccos(np.clip(axis[2], -1.0, 1.0))))
+
+
+def resting_on_table(world: SimWorld, name: str, frame: FeatureFrame, max_speed: float = 0.02) -> bool:
+    """Whether an object stands on the table, released by both arms and at rest."""
+    held = any(obj == name for _, obj in frame.holding)
+    return not held and world.on_table(name) and world.object_velocity(name) <= max_speed
