@@ -8,6 +8,7 @@ The tick-level programs that realise these actions live beside it.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
@@ -19,19 +20,25 @@ class _Args(BaseModel):
 
 
 class GraspArgs(_Args):
-    """Approach ``obj`` from its side, close on it, lift it clear of the table."""
+    """Approach ``obj``, close on it, lift it clear of the table (a fallen object is set upright)."""
 
     obj: str
     pre_grasp_dis: float = Field(0.08, ge=0.0, le=0.3, description="Stand-off before the final approach (m).")
-    height: float = Field(0.5, ge=0.1, le=0.9, description="Grasp height as a fraction of the object's height.")
+    height: float = Field(0.5, ge=0.1, le=0.9, description="Side grasp: height as a fraction of the object's height.")
     lift: float = Field(0.06, ge=0.0, le=0.3, description="Lift after closing (m).")
+    mode: Literal["auto", "side", "top"] = Field(
+        "auto", description="side: horizontal approach; top: from above; auto: side for tall upright objects, else top."
+    )
+    offset: Vec3 = Field((0.0, 0.0, 0.0), description="Grasp offset from the grasp point, world frame (m).")
+    yaw: float | None = Field(None, ge=-180.0, le=180.0, description="Side grasp: world yaw of the approach (deg); None = from the arm's base.")
 
 
 class MoveToObjArgs(_Args):
-    """Move the held object (or the tool) to an offset from ``obj``'s top point, upright."""
+    """Move the held object (or the tool) to an offset from ``obj``'s top point."""
 
     obj: str
     offset: Vec3 = (0.0, 0.0, 0.1)
+    keep_orientation: bool = Field(False, description="Keep the tool's orientation (else: level side-grasp frame).")
     yaw: float | None = Field(
         None, ge=-180.0, le=180.0,
         description="Orientation hint: world yaw (deg) of the tool's horizontal approach axis; None keeps the current one.",
@@ -50,6 +57,21 @@ class PlaceArgs(_Args):
     obj: str
     target: tuple[float, float] | None = Field(None, description="Table position (m); None = straight down.")
     z_offset: float = Field(0.0, ge=-0.05, le=0.2)
+
+
+class MoveToTargetArgs(_Args):
+    """Move the tool to an absolute position (extrinsic frame)."""
+
+    pos: Vec3
+    yaw: float | None = Field(None, ge=-180.0, le=180.0, description="World yaw of a level tool's approach (deg); None keeps the orientation.")
+
+
+class MoveByOffsetArgs(_Args):
+    """Displace the tool by a translation and rotation, in the world or the tool frame."""
+
+    offset: Vec3 = (0.0, 0.0, 0.0)
+    angles: Vec3 = Field((0.0, 0.0, 0.0), description="Roll, pitch, yaw (deg) about the frame's x, y, z.")
+    frame: Literal["extrinsic", "intrinsic"] = "extrinsic"
 
 
 class NoArgs(_Args):
@@ -83,6 +105,8 @@ ACTIONS: dict[str, ActionSpec] = {
         ActionSpec("move_to_obj", MoveToObjArgs, 110, ("obj",), holds_object=True),
         ActionSpec("rotate_eef", RotateEefArgs, 80, holds_object=True),
         ActionSpec("place", PlaceArgs, 170, ("obj",), holds_object=True),
+        ActionSpec("move_to_target", MoveToTargetArgs, 110),
+        ActionSpec("move_by_offset", MoveByOffsetArgs, 60),
         ActionSpec("back", NoArgs, 100),
         ActionSpec("open_gripper", NoArgs, 25),
         ActionSpec("close_gripper", NoArgs, 25),

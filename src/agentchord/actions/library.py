@@ -27,13 +27,28 @@ def _tilt_deg(axis: np.ndarray) -> float:
     return float(np.degrees(np.arccos(np.clip(axis[2], -1.0, 1.0))))
 
 
+def _level(rotation: np.ndarray) -> np.ndarray:
+    """The tool's level side-grasp frame for its current approach; a top-down tool is kept."""
+    if abs(rotation[2, 0]) > 0.7:
+        return rotation
+    return grasp_frame(rotation[:, 0])
+
+
+def _matrix(quat: np.ndarray) -> np.ndarray:
+    w, x, y, z = quat
+    return Rotation.from_quat([x, y, z, w]).as_matrix()
+
+
 class Grasp(ArmAction):
     """Grasp an object wherever it is, then lift it; a fallen object is set upright in hand.
 
-    Upright object: side grasp at ``height`` of the object, approached from
-    the arm's base. Fallen object (lying on its side): top-down grasp across
-    its middle, lift, swing its top away from the robot and up, so the action
-    ends, like the upright case, with the object held upright in a side grasp.
+    Side grasp (tall upright objects: bottles, cups): horizontal approach from
+    the arm's base at ``height`` of the object. Top grasp (short or flat
+    objects: blocks, capsules, cutlery): from above, fingers across the
+    object's narrow horizontal side. A fallen tall object (lying on its side)
+    is grasped from above across its middle, lifted, swung so its top points
+    away from the robot and pitched up: the action ends, like the upright case,
+    with the object held upright in a side grasp.
     """
 
     name = "grasp"
@@ -41,12 +56,23 @@ class Grasp(ArmAction):
 
     #: Tilt (deg) beyond which the object is treated as lying on its side.
     FALLEN_DEG = 60.0
+    #: Objects shorter than this (m) are grasped from above in ``auto`` mode.
+    SIDE_MIN_HEIGHT = 0.08
+    #: The finger tips reach this far past the tool centre (m): keep them off the table.
+    FINGERTIP_REACH = 0.039
 
     def script(self, robot: RobotController) -> Iterator[None]:
         yield from self._let_go(robot)
         yield from wait_for_rest(robot, self.args.obj)
-        tilt = _tilt_deg(robot.frame.objects[self.args.obj].axis)
-        if tilt <= UPRIGHT_TOLERANCE_DEG:
+        feats = robot.frame.objects[self.args.obj]
+        tilt = _tilt_deg(feats.axis)
+        height = float(np.linalg.norm(feats.top - feats.bottom))
+        mode = self.args.mode
+        if mode == "auto":
+            mode = "side" if height >= self.SIDE_MIN_HEIGHT else "top"
+        if mode == "top":
+            yield from self._top_grasp(robot)
+        elif tilt <= UPRIGHT_TOLERANCE_DEG:
             yield from self._side_grasp(robot)
         elif tilt >= self.FALLEN_DEG:
             yield from self._fallen_grasp(robot)
@@ -59,15 +85,19 @@ class Grasp(ArmAction):
         arm = self.arm
         if robot.targets[arm].grip > 0.0 or robot.frame.arms[arm].width < 0.05:
             robot.set_grip(arm, 0.0)
-            rotation = grasp_frame(robot.rotation(arm)[:, 0])
-            back = -0.12 * rotation[:, 0] + np.array([0.0, 0.0, 0.04])
+            approach = robot.rotation(arm)[:, 0]
+            if abs(approach[2]) > 0.9:  # a top grasp: just rise
+                rotation, back = robot.rotation(arm), np.array([0.0, 0.0, 0.06])
+            else:
+                rotation = grasp_frame(approach)
+                back = -0.12 * rotation[:, 0] + np.array([0.0, 0.0, 0.04])
             yield from move_to(robot, arm, pose_from_matrix(robot.commanded_pose(arm).pos + back, rotation), speed=0.2)
         robot.set_grip(arm, 0.0)
 
     def _side_point(self, robot: RobotController) -> np.ndarray:
         feats = robot.frame.objects[self.args.obj]
         height = float(np.linalg.norm(feats.top - feats.bottom))
-        return feats.bottom + self.args.height * height * feats.axis
+        return feats.bottom + self.args.height * height * feats.axis + np.asarray(self.args.offset)
 
     def _clear_from_below(self, robot: RobotController, height: float) -> Iterator[None]:
         # Coming from low (a recovery after a drop): rise first so the fingers clear the object.
@@ -84,7 +114,11 @@ class Grasp(ArmAction):
     def _side_grasp(self, robot: RobotController) -> Iterator[None]:
         arm = self.arm
         point = self._side_point(robot)
-        rotation = grasp_frame(point - robot.world.arm_base(arm))
+        if self.args.yaw is None:
+            rotation = grasp_frame(point - robot.world.arm_base(arm))
+        else:
+            yaw = np.radians(self.args.yaw)
+            rotation = grasp_frame(np.array([np.cos(yaw), np.sin(yaw), 0.0]))
         pre = point - self.args.pre_grasp_dis * rotation[:, 0]
         if np.linalg.norm(robot.commanded_pose(arm).pos[:2] - pre[:2]) > 0.05:
             yield from self._clear_from_below(robot, pre[2] + 0.08)
@@ -94,6 +128,47 @@ class Grasp(ArmAction):
         yield from move_to(robot, arm, pose_from_matrix(point, rotation), speed=0.15)
         yield from self._close_and_check(robot)
         lift = robot.commanded_pose(arm).pos + np.array([0.0, 0.0, self.args.lift])
+        yield from move_to(robot, arm, pose_from_matrix(lift, rotation), speed=0.15)
+
+    def _top_frame(self, robot: RobotController) -> tuple[np.ndarray, np.ndarray]:
+        """Tool rotation (approach down, fingers across the narrow side) and grasp point."""
+        feats = robot.frame.objects[self.args.obj]
+        rot = _matrix(feats.quat)
+        # The object's horizontal principal direction: its axis if lying, else its longer side.
+        if _tilt_deg(feats.axis) >= self.FALLEN_DEG:
+            long_dir = feats.axis
+        else:
+            long_dir = rot[:, 0] if feats.extent[0] >= feats.extent[1] else rot[:, 1]
+        long_dir = np.array([long_dir[0], long_dir[1], 0.0])
+        if np.linalg.norm(long_dir) < 1e-6:
+            long_dir = np.array([1.0, 0.0, 0.0])
+        long_dir /= np.linalg.norm(long_dir)
+        # Of the two equivalent finger orientations, take the one facing away from the arm's base.
+        outward = feats.pos - robot.world.arm_base(self.arm)
+        if np.dot(long_dir[:2], outward[:2]) < 0:
+            long_dir = -long_dir
+        down = np.array([0.0, 0.0, -1.0])
+        rotation = np.column_stack([down, np.cross(long_dir, down), long_dir])
+        lying = _tilt_deg(feats.axis) >= self.FALLEN_DEG
+        top_z = feats.pos[2] + 0.5 * feats.extent[0] if lying else max(feats.top[2], feats.bottom[2])
+        height = top_z - min(feats.bottom[2], feats.top[2]) if not lying else float(feats.extent[0])
+        # Finger tips go 70% down the object (at most 3 cm), never closer than 4 mm to the table.
+        tips_z = max(top_z - min(0.7 * height, 0.03), 0.004)
+        point = np.r_[feats.pos[:2], tips_z + self.FINGERTIP_REACH]
+        return rotation, point + np.asarray(self.args.offset)
+
+    def _top_grasp(self, robot: RobotController) -> Iterator[None]:
+        arm = self.arm
+        rotation, point = self._top_frame(robot)
+        above = point + np.array([0.0, 0.0, self.args.pre_grasp_dis])
+        yield from self._clear_from_below(robot, above[2])
+        yield from move_to(robot, arm, pose_from_matrix(above, rotation))
+        # A top-down tool often flips the forearm roll: let the IK converge before descending.
+        yield from settle(robot, arm, tolerance=0.003, max_ticks=60, required=0.015)
+        rotation, point = self._top_frame(robot)
+        yield from move_to(robot, arm, pose_from_matrix(point, rotation), speed=0.08)
+        yield from self._close_and_check(robot)
+        lift = robot.commanded_pose(arm).pos + np.array([0.0, 0.0, max(self.args.lift, 0.04)])
         yield from move_to(robot, arm, pose_from_matrix(lift, rotation), speed=0.15)
 
     def _fallen_grasp(self, robot: RobotController) -> Iterator[None]:
@@ -106,7 +181,7 @@ class Grasp(ArmAction):
         rotation = np.column_stack([down, np.cross(top_dir, down), top_dir])
         radius = 0.5 * float(feats.extent[0])
         # The finger tips reach ~4 cm past the tool centre: stay high enough to miss the table.
-        point = np.r_[feats.pos[:2], max(feats.pos[2] + 0.35 * radius, 0.045)]
+        point = np.r_[feats.pos[:2], max(feats.pos[2] + 0.35 * radius, self.FINGERTIP_REACH + 0.006)]
         yield from self._clear_from_below(robot, point[2] + self.args.pre_grasp_dis + 0.05)
         yield from move_to(robot, arm, pose_from_matrix(point + np.array([0, 0, self.args.pre_grasp_dis]), rotation))
         # A top-down tool often flips the forearm roll: let the IK converge before descending.
@@ -139,8 +214,10 @@ class MoveToObj(ArmAction):
         arm = self.arm
         # A pushed target may still be sliding: aim at where it stops.
         yield from wait_for_rest(robot, self.args.obj)
-        if self.args.yaw is None:
-            rotation = grasp_frame(robot.rotation(arm)[:, 0])
+        if self.args.keep_orientation:
+            rotation = robot.rotation(arm)
+        elif self.args.yaw is None:
+            rotation = _level(robot.rotation(arm))
         else:
             yaw = np.radians(self.args.yaw)
             rotation = grasp_frame(np.array([np.cos(yaw), np.sin(yaw), 0.0]))
@@ -178,7 +255,7 @@ class Place(ArmAction):
             raise ActionFailed(f"{self.args.obj} is not held: nothing to place")
         obj = robot.frame.objects[self.args.obj]
         tool = robot.commanded_pose(arm)
-        rotation = grasp_frame(robot.rotation(arm)[:, 0])
+        rotation = _level(robot.rotation(arm))
         above = tool.pos.copy()
         if self.args.target is not None:
             # Put the object's centre, not the tool, over the target.
@@ -191,8 +268,44 @@ class Place(ArmAction):
         yield from move_to(robot, arm, pose_from_matrix(down, rotation), speed=0.12)
         yield from settle(robot, arm, max_ticks=10)
         yield from grip(robot, arm, 0.0, ticks=8)
-        retreat = down - 0.08 * rotation[:, 0] + np.array([0.0, 0.0, 0.04])
+        # Back off along the approach (straight up after a top grasp).
+        retreat = down - 0.08 * rotation[:, 0] + np.array([0.0, 0.0, 0.04 if rotation[2, 0] > -0.7 else 0.0])
         yield from move_to(robot, arm, pose_from_matrix(retreat, rotation))
+
+
+class MoveToTarget(ArmAction):
+    """Move the tool to an absolute position (extrinsic frame), clipped to the workspace."""
+
+    name = "move_to_target"
+    args: catalog.MoveToTargetArgs
+
+    def script(self, robot: RobotController) -> Iterator[None]:
+        if self.args.yaw is None:
+            rotation = robot.rotation(self.arm)
+        else:
+            yaw = np.radians(self.args.yaw)
+            rotation = grasp_frame(np.array([np.cos(yaw), np.sin(yaw), 0.0]))
+        yield from move_to(robot, self.arm, pose_from_matrix(np.asarray(self.args.pos, dtype=float), rotation))
+        yield from settle(robot, self.arm)
+
+
+class MoveByOffset(ArmAction):
+    """Displace the tool: a translation and roll/pitch/yaw in the world (extrinsic) or tool (intrinsic) frame."""
+
+    name = "move_by_offset"
+    args: catalog.MoveByOffsetArgs
+
+    def script(self, robot: RobotController) -> Iterator[None]:
+        pose = robot.commanded_pose(self.arm)
+        rotation = robot.rotation(self.arm)
+        turn = Rotation.from_euler("xyz", self.args.angles, degrees=True).as_matrix()
+        offset = np.asarray(self.args.offset, dtype=float)
+        if self.args.frame == "intrinsic":
+            goal_pos, goal_rot = pose.pos + rotation @ offset, rotation @ turn
+        else:
+            goal_pos, goal_rot = pose.pos + offset, turn @ rotation
+        yield from move_to(robot, self.arm, pose_from_matrix(goal_pos, goal_rot))
+        yield from settle(robot, self.arm, max_ticks=10)
 
 
 class Back(ArmAction):
@@ -224,7 +337,7 @@ class CloseGripper(ArmAction):
 
 
 PROGRAMS: dict[str, type[ArmAction]] = {
-    cls.name: cls for cls in (Grasp, MoveToObj, RotateEef, Place, Back, OpenGripper, CloseGripper)
+    cls.name: cls for cls in (Grasp, MoveToObj, MoveToTarget, MoveByOffset, RotateEef, Place, Back, OpenGripper, CloseGripper)
 }
 
 
