@@ -7,6 +7,8 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+
+from agentchord.actions.catalog import ACTIONS
 import yaml
 
 from agentchord.expr import ExprError, Vocabulary, compile_expr
@@ -131,8 +133,7 @@ def test_unknown_action() -> None:
     assert problems == [
         Problem(
             "edges[0].actions.right.fn",
-            "unknown action 'grab' (did you mean 'grasp'?); actions are back, close_gripper, grasp, move_to_obj, "
-            "open_gripper, place, rotate_eef",
+            f"unknown action 'grab' (did you mean 'grasp'?); actions are {', '.join(sorted(ACTIONS))}",
         )
     ]
 

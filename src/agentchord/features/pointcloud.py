@@ -1,0 +1,428 @@
+"""Point clouds from depth images, and shape fits to them (RGB-D perception).
+
+Numpy only, no renderer: back-projection of a depth image through a pinhole
+camera, voxel down-sampling, PCA, and least-squares fits of the two model
+families of the scene's objects (cylinders and boxes).
+
+The fits minimise the signed distance of every visible point to the surface of
+a solid cylinder / box, with the object's nominal size as a soft prior. Views
+see only the front surface of an object, so a centroid of the visible points is
+biased towards the cameras (2-4 cm for a bottle); a surface fit is not.
+
+Conventions: MuJoCo cameras look along their -z axis with y up and x right;
+``cam_rot`` has the camera axes as columns (``data.cam_xmat`` reshaped).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from agentchord.features.frame import UP
+
+#: Residual scale (m) beyond which a point's weight decays (Huber): guards against mask bleed.
+HUBER_M = 0.004
+#: Standard deviation (m) of the size prior (the nominal size of the object's category).
+SIZE_PRIOR_SIGMA = 0.005
+#: Standard deviation (m) assumed for one point's distance to the surface.
+POINT_SIGMA = 0.001
+#: Mean cost per point (in POINT_SIGMA units, 0.5 * (d / sigma)^2) under which a start is kept
+#: without trying the others: an RMS distance to the surface of about 1 mm.
+GOOD_START_COST = 0.5
+
+
+# --------------------------------------------------------------------------- camera geometry
+def focal_length(fovy_deg: float, height: int) -> float:
+    """Focal length in pixels of a camera with vertical field of view ``fovy_deg``."""
+    return 0.5 * height / np.tan(0.5 * np.radians(fovy_deg))
+
+
+def backproject(
+    depth: np.ndarray,
+    fovy_deg: float,
+    cam_pos: np.ndarray,
+    cam_rot: np.ndarray,
+    mask: np.ndarray | None = None,
+) -> np.ndarray:
+    """World points of the (masked) pixels of a depth image.
+
+    Args:
+        depth: (H, W) distance along the camera's viewing axis (m), row 0 at the top.
+        fovy_deg: Vertical field of view (``model.cam_fovy``), square pixels.
+        cam_pos: Camera position in the world (``data.cam_xpos``).
+        cam_rot: (3, 3) camera axes as columns (``data.cam_xmat``).
+        mask: Optional (H, W) bool mask of the pixels to keep.
+
+    Returns:
+        (N, 3) world points, one per kept pixel, in row-major pixel order.
+    """
+    height, width = depth.shape
+    f = focal_length(fovy_deg, height)
+    if mask is None:
+        rows, cols = np.indices(depth.shape).reshape(2, -1)
+        z = depth.reshape(-1).astype(float)
+    else:
+        rows, cols = np.nonzero(mask)
+        z = depth[rows, cols].astype(float)
+    # Pixel centres; image x to the right, image rows downwards = camera -y.
+    x = (cols + 0.5 - 0.5 * width) / f * z
+    y = -(rows + 0.5 - 0.5 * height) / f * z
+    local = np.stack([x, y, -z], axis=1)
+    return local @ np.asarray(cam_rot, dtype=float).reshape(3, 3).T + np.asarray(cam_pos, dtype=float)
+
+
+def voxel_downsample(points: np.ndarray, voxel: float) -> np.ndarray:
+    """One point (the mean) per occupied voxel of edge ``voxel`` (m)."""
+    if len(points) == 0 or voxel <= 0:
+        return points
+    keys = np.floor(points / voxel).astype(np.int64)
+    _, inverse, counts = np.unique(keys, axis=0, return_inverse=True, return_counts=True)
+    inverse = inverse.reshape(-1)
+    sums = np.zeros((len(counts), 3))
+    np.add.at(sums, inverse, points)
+    return sums / counts[:, None]
+
+
+def pca(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Centroid, eigenvalues (descending) and eigenvectors (columns) of a cloud."""
+    centroid = points.mean(axis=0)
+    cov = np.cov((points - centroid).T) if len(points) > 1 else np.zeros((3, 3))
+    values, vectors = np.linalg.eigh(cov)
+    order = np.argsort(values)[::-1]
+    return centroid, values[order], vectors[:, order]
+
+
+def orient(axis: np.ndarray, reference: np.ndarray | None) -> np.ndarray:
+    """Flip ``axis`` to point the same way as ``reference`` (the last estimate), else up."""
+    ref = UP if reference is None or not np.any(reference) else reference
+    return -axis if float(np.dot(axis, ref)) < 0.0 else axis
+
+
+def quat_from_axis(axis: np.ndarray) -> np.ndarray:
+    """Quaternion (w, x, y, z) of the smallest rotation taking world z to ``axis``.
+
+    A cylinder's spin about its own axis is not observable; this picks none.
+    """
+    axis = axis / np.linalg.norm(axis)
+    w = 1.0 + float(axis[2])
+    if w < 1e-9:  # upside down: half turn about x
+        return np.array([0.0, 1.0, 0.0, 0.0])
+    quat = np.array([w, -axis[1], axis[0], 0.0])  # cross(z, axis) = (-a_y, a_x, 0)
+    return quat / np.linalg.norm(quat)
+
+
+def quat_from_matrix(rot: np.ndarray) -> np.ndarray:
+    """Quaternion (w, x, y, z) of a rotation matrix."""
+    quat = np.empty(4)
+    mujoco.mju_mat2Quat(quat, np.ascontiguousarray(rot, dtype=float).reshape(-1))
+    return quat
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+
+
+def _perpendicular_basis(axis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    helper = np.array([1.0, 0.0, 0.0]) if abs(axis[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    e1 = _cross(axis, helper)
+    e1 /= np.linalg.norm(e1)
+    return e1, _cross(axis, e1)
+
+
+def fit_circle(xy: np.ndarray) -> tuple[np.ndarray, float]:
+    """Algebraic (Kasa) least-squares circle through 2-D points: centre, radius."""
+    a = np.column_stack([xy, np.ones(len(xy))])
+    b = (xy**2).sum(axis=1)
+    sol, *_ = np.linalg.lstsq(a, b, rcond=None)
+    centre = 0.5 * sol[:2]
+    radius = float(np.sqrt(max(sol[2] + centre @ centre, 0.0)))
+    return centre, radius
+
+
+# --------------------------------------------------------------------------- fits
+@dataclass
+class ShapeFit:
+    """A fitted object model.
+
+    Attributes:
+        pos: Centre (m).
+        rot: Orientation; column 2 is the principal axis.
+        size: Cylinder (radius, half-height) or box half-sizes (m).
+        rms: Root-mean-square distance of the points to the fitted surface (m).
+    """
+
+    pos: np.ndarray
+    rot: np.ndarray
+    size: np.ndarray
+    rms: float
+
+    @property
+    def axis(self) -> np.ndarray:
+        """The principal axis (unit)."""
+        return self.rot[:, 2]
+
+
+def _huber_weights(res: np.ndarray, scale: float = HUBER_M) -> np.ndarray:
+    a = np.abs(res)
+    return np.where(a <= scale, 1.0, scale / np.maximum(a, 1e-12))
+
+
+def _cylinder_residuals(points, centre, axis, radius, half, jac: bool):
+    d = points - centre
+    s = d @ axis
+    q = d - s[:, None] * axis
+    rho = np.linalg.norm(q, axis=1)
+    u = rho - radius
+    v = np.abs(s) - half
+    corner = (u > 0) & (v > 0)
+    sdf = np.where(corner, np.hypot(np.maximum(u, 0), np.maximum(v, 0)), np.maximum(u, v))
+    if not jac:
+        return sdf, None
+    e1, e2 = _perpendicular_basis(axis)
+    qhat = q / np.maximum(rho, 1e-9)[:, None]
+    sign = np.sign(s)
+    # Derivatives of u and v wrt (centre[3], tilt[2], radius, half).
+    du = np.zeros((len(points), 7))
+    du[:, :3] = -qhat
+    du[:, 3] = -s * (qhat @ e1)
+    du[:, 4] = -s * (qhat @ e2)
+    du[:, 5] = -1.0
+    dv = np.zeros((len(points), 7))
+    dv[:, :3] = -sign[:, None] * axis
+    dv[:, 3] = sign * (q @ e1)
+    dv[:, 4] = sign * (q @ e2)
+    dv[:, 6] = -1.0
+    use_u = (u >= v)[:, None]
+    j = np.where(use_u, du, dv)
+    if corner.any():
+        c = corner
+        norm = np.maximum(sdf[c], 1e-12)[:, None]
+        j[c] = (u[c, None] * du[c] + v[c, None] * dv[c]) / norm
+    return sdf, (j, e1, e2)
+
+
+def _robust_cost(sdf: np.ndarray, prior: np.ndarray) -> float:
+    a = np.abs(sdf)
+    huber = np.where(a <= HUBER_M, 0.5 * a**2, HUBER_M * (a - 0.5 * HUBER_M))
+    return float(huber.sum() / POINT_SIGMA**2 + 0.5 * (prior**2).sum())
+
+
+def fit_cylinder(
+    points: np.ndarray,
+    radius: float,
+    half_height: float,
+    axis_hint: np.ndarray | None = None,
+    iterations: int = 30,
+) -> ShapeFit:
+    """Least-squares solid cylinder through surface points.
+
+    The axis is started from the cloud's PCA directions, world up and
+    ``axis_hint`` (the last estimate); each start gets a circle fit of the
+    points projected on the plane normal to the axis for its centre; the
+    best start after a few iterations is refined by Levenberg-Marquardt on the
+    points' signed distances to the surface, with the nominal radius and
+    half-height as a soft prior.
+
+    Args:
+        points: (N, 3) visible surface points (N >= 10).
+        radius: Nominal radius (m).
+        half_height: Nominal half-height (m).
+        axis_hint: Previous axis estimate, if any.
+        iterations: Most Levenberg-Marquardt iterations of the refinement.
+    """
+    centroid, _, vectors = pca(points)
+    starts: list[np.ndarray] = []
+    for cand in ([axis_hint] if axis_hint is not None and np.any(axis_hint) else []) + [vectors[:, 0], UP, vectors[:, 1], vectors[:, 2]]:
+        cand = cand / np.linalg.norm(cand)
+        if all(abs(float(cand @ s)) < 0.97 for s in starts):
+            starts.append(cand)
+    best = None
+    for axis in starts:
+        state = _cylinder_start(points, centroid, axis, radius, half_height)
+        state, cost = _lm_cylinder(points, state, radius, half_height, iterations=4)
+        if best is None or cost < best[1]:
+            best = (state, cost)
+        if best[1] < GOOD_START_COST * len(points):
+            break  # this start already explains the cloud (usually the last estimate's axis)
+    state, _ = _lm_cylinder(points, best[0], radius, half_height, iterations=iterations)
+    centre, axis, r, h = state
+    sdf, _ = _cylinder_residuals(points, centre, axis, r, h, jac=False)
+    axis = orient(axis, axis_hint)
+    e1, e2 = _perpendicular_basis(axis)
+    return ShapeFit(pos=centre, rot=np.column_stack([e1, e2, axis]), size=np.array([r, h]), rms=float(np.sqrt(np.mean(sdf**2))))
+
+
+def _cylinder_start(points, centroid, axis, radius, half_height):
+    e1, e2 = _perpendicular_basis(axis)
+    d = points - centroid
+    xy = np.column_stack([d @ e1, d @ e2])
+    s = d @ axis
+    try:
+        c2, r_fit = fit_circle(xy)
+        if not np.isfinite(r_fit) or r_fit > 3 * radius or np.linalg.norm(c2) > 3 * radius:
+            raise np.linalg.LinAlgError
+    except np.linalg.LinAlgError:
+        c2 = np.zeros(2)
+    mid = 0.5 * (s.min() + s.max())
+    centre = centroid + c2[0] * e1 + c2[1] * e2 + mid * axis
+    return centre, axis, float(radius), float(half_height)
+
+
+def _lm_cylinder(points, state, radius0, half0, iterations):
+    centre, axis, r, h = state
+    lam = 1e-3
+    prior_w = 1.0 / SIZE_PRIOR_SIGMA
+    point_w = 1.0 / POINT_SIGMA
+
+    def prior(r_, h_):
+        return np.array([(r_ - radius0) * prior_w, (h_ - half0) * prior_w])
+
+    sdf, (j, e1, e2) = _cylinder_residuals(points, centre, axis, r, h, jac=True)
+    cost = _robust_cost(sdf, prior(r, h))
+    for _ in range(iterations):
+        w = _huber_weights(sdf) * point_w**2
+        jw = j * w[:, None]
+        a = j.T @ jw
+        g = jw.T @ sdf
+        pr = prior(r, h)
+        a[5, 5] += prior_w**2
+        a[6, 6] += prior_w**2
+        g[5] += prior_w * pr[0]
+        g[6] += prior_w * pr[1]
+        improved = False
+        for _ in range(6):
+            step = np.linalg.solve(a + lam * np.diag(np.diag(a) + 1e-9), -g)
+            new_axis = axis + step[3] * e1 + step[4] * e2
+            new_axis /= np.linalg.norm(new_axis)
+            cand = (centre + step[:3], new_axis, max(r + step[5], 1e-3), max(h + step[6], 1e-3))
+            sdf_new, _ = _cylinder_residuals(points, *cand, jac=False)
+            new_cost = _robust_cost(sdf_new, prior(cand[2], cand[3]))
+            if new_cost < cost:
+                lam = max(lam / 3, 1e-7)
+                improved = True
+                break
+            lam *= 4
+        if not improved:
+            break
+        converged = cost - new_cost < 1e-5 * cost
+        centre, axis, r, h = cand
+        cost = new_cost
+        sdf, (j, e1, e2) = _cylinder_residuals(points, centre, axis, r, h, jac=True)
+        if converged or np.linalg.norm(step[:5]) < 1e-6:
+            break
+    return (centre, axis, r, h), cost
+
+
+def _box_sdf(points, centre, rot, half):
+    local = (points - centre) @ rot
+    q = np.abs(local) - half
+    outside = np.linalg.norm(np.maximum(q, 0.0), axis=1)
+    inside = np.minimum(q.max(axis=1), 0.0)
+    return outside + inside
+
+
+def _rodrigues(w: np.ndarray) -> np.ndarray:
+    theta = float(np.linalg.norm(w))
+    if theta < 1e-12:
+        return np.eye(3)
+    k = w / theta
+    kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    return np.eye(3) + np.sin(theta) * kx + (1 - np.cos(theta)) * kx @ kx
+
+
+def fit_box(
+    points: np.ndarray,
+    half_sizes: np.ndarray,
+    rot_hint: np.ndarray | None = None,
+    iterations: int = 25,
+) -> ShapeFit:
+    """Least-squares box through surface points.
+
+    Started from the PCA axes (each assigned to the nominal half-size it best
+    matches, the centre in the middle of the extremal projections, not the
+    centroid), from the upright box turned to the PCA direction in the table
+    plane, and from ``rot_hint``; refined by Levenberg-Marquardt (numeric
+    Jacobian) on the points' distances to the surface, nominal size as a prior.
+    """
+    half_sizes = np.asarray(half_sizes, dtype=float)
+    centroid, _, vectors = pca(points)
+    starts = []
+    # PCA frame: the largest spread goes with the largest nominal size.
+    order = np.argsort(half_sizes)[::-1]
+    rot = np.zeros((3, 3))
+    for k, idx in enumerate(order):
+        rot[:, idx] = vectors[:, k]
+    starts.append(rot)
+    # Upright, yawed to the horizontal PCA direction of the cloud.
+    flat = (points - centroid)[:, :2]
+    _, vec2 = np.linalg.eigh(np.cov(flat.T))
+    x = np.array([vec2[0, -1], vec2[1, -1], 0.0])
+    starts.append(np.column_stack([x, _cross(UP, x), UP]))
+    if rot_hint is not None:
+        starts.append(np.asarray(rot_hint, dtype=float))
+    best = None
+    for rot in starts:
+        if np.linalg.det(rot) < 0:
+            rot = rot.copy()
+            rot[:, 0] *= -1
+        proj = (points - centroid) @ rot
+        centre = centroid + rot @ (0.5 * (proj.min(axis=0) + proj.max(axis=0)))
+        state, cost = _lm_box(points, centre, rot, half_sizes.copy(), half_sizes, iterations=4)
+        if best is None or cost < best[1]:
+            best = (state, cost)
+    (centre, rot, half), _ = _lm_box(points, *best[0], half_sizes, iterations=iterations)
+    # Sign of the principal (z) axis: consistent with the last estimate, else up.
+    if float(rot[:, 2] @ (rot_hint[:, 2] if rot_hint is not None else UP)) < 0:
+        rot = rot @ np.diag([-1.0, 1.0, -1.0])
+    sdf = _box_sdf(points, centre, rot, half)
+    return ShapeFit(pos=centre, rot=rot, size=half, rms=float(np.sqrt(np.mean(sdf**2))))
+
+
+def _lm_box(points, centre, rot, half, half0, iterations):
+    prior_w = 1.0 / SIZE_PRIOR_SIGMA
+    point_w = 1.0 / POINT_SIGMA
+
+    def residuals(params):
+        c = centre + params[:3]
+        r = rot @ _rodrigues(params[3:6])
+        h = np.maximum(half + params[6:9], 1e-3)
+        return _box_sdf(points, c, r, h), (h - half0) * prior_w
+
+    x = np.zeros(9)
+    sdf, pr = residuals(x)
+    cost = _robust_cost(sdf, pr)
+    lam = 1e-3
+    eps = 1e-5
+    for _ in range(iterations):
+        j = np.empty((len(points), 9))
+        for k in range(9):
+            dx = x.copy()
+            dx[k] += eps
+            j[:, k] = (residuals(dx)[0] - sdf) / eps
+        w = _huber_weights(sdf) * point_w**2
+        jw = j * w[:, None]
+        a = j.T @ jw
+        g = jw.T @ sdf
+        a[6:, 6:] += np.eye(3) * prior_w**2
+        g[6:] += prior_w * pr
+        improved = False
+        for _ in range(6):
+            step = np.linalg.solve(a + lam * np.diag(np.diag(a) + 1e-9), -g)
+            sdf_new, pr_new = residuals(x + step)
+            new_cost = _robust_cost(sdf_new, pr_new)
+            if new_cost < cost:
+                lam = max(lam / 3, 1e-7)
+                improved = True
+                break
+            lam *= 4
+        if not improved:
+            break
+        converged = cost - new_cost < 1e-5 * cost
+        x = x + step
+        sdf, pr, cost = sdf_new, pr_new, new_cost
+        if converged:
+            break
+    state = (centre + x[:3], rot @ _rodrigues(x[3:6]), np.maximum(half + x[6:9], 1e-3))
+    return state, cost

@@ -1,0 +1,335 @@
+"""RGB-D feature extraction: object features from rendered depth + segmentation.
+
+The alternative to :class:`~agentchord.features.oracle.OracleExtractor`
+(``--perception rgbd``): the scene cameras render depth and segmentation at the
+camera rate (10 Hz, every 5th control tick at 50 Hz), a :class:`Segmenter`
+gives one mask per object and camera, the masked depth pixels are
+back-projected into world points, the views are fused, and a cylinder or box is
+fitted to the fused cloud (:mod:`agentchord.features.pointcloud`). Between
+camera frames the last estimate is kept. The robot's own signals (end
+effectors, joints, gripper width, the grasp signal) and the contact-based
+``holding`` relation come from the robot every tick, as in oracle mode: they are
+proprioception and contact sensing, not vision.
+
+The object's category (``object_spec(name).shape`` and its nominal size) only
+chooses the model family and a soft size prior; its pose is never read.
+"""
+
+from __future__ import annotations
+
+import time
+from collections import deque
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from agentchord.features.frame import ARMS, ArmFeatures, FeatureFrame, ObjectFeatures
+from agentchord.features.pointcloud import ShapeFit, backproject, fit_box, fit_cylinder, quat_from_axis, quat_from_matrix, voxel_downsample
+from agentchord.features.segmentation import Segmenter, SimSegmenter
+from agentchord.worlds.sim.world import CONTROL_HZ, SimWorld
+
+#: Scene cameras used for perception (defined in :mod:`agentchord.worlds.sim.scene`).
+PERCEPTION_CAMERAS = ("front", "side")
+#: Camera frame rate (Hz) of the paper's RGB-D setting.
+CAMERA_RATE_HZ = 10
+#: Fewer fused points than this: the object counts as not seen, its last estimate is kept.
+MIN_POINTS = 30
+#: Voxel edge (m) of the down-sampling of the fused cloud before fitting (equalises view densities).
+VOXEL_M = 0.003
+
+
+@dataclass
+class CameraImage:
+    """One camera's depth and segmentation, with the camera geometry they were taken with.
+
+    Attributes:
+        camera: Camera name.
+        depth: (H, W) float32 distance along the viewing axis (m); row 0 at the top.
+        seg: (H, W, 2) int32 (object id, object type) per pixel; -1 for background.
+        fovy: Vertical field of view (deg).
+        pos: Camera position (world).
+        rot: (3, 3) camera axes as columns (world); the camera looks along -z.
+    """
+
+    camera: str
+    depth: np.ndarray
+    seg: np.ndarray
+    fovy: float
+    pos: np.ndarray
+    rot: np.ndarray
+
+    def points(self, mask: np.ndarray | None = None) -> np.ndarray:
+        """World points of the (masked) pixels."""
+        return backproject(self.depth, self.fovy, self.pos, self.rot, mask)
+
+
+class DepthCamera:
+    """A scene camera that renders depth and segmentation with its own ``mujoco.Renderer``.
+
+    Both images come from one render pass when the renderer's GL context is
+    reachable (segmentation colours and the depth buffer of the same pass),
+    else from two passes with the public ``enable_*_rendering`` switches.
+
+    Args:
+        model: The compiled model.
+        camera: Name of a camera of the model.
+        width: Image width (px).
+        height: Image height (px).
+    """
+
+    def __init__(self, model: mujoco.MjModel, camera: str, width: int = 320, height: int = 240) -> None:
+        self.model = model
+        self.camera = camera
+        self.camera_id = model.camera(camera).id
+        self.width, self.height = width, height
+        self.renderer = mujoco.Renderer(model, height, width)
+        self.option = mujoco.MjvOption()
+        self.option.sitegroup[:] = 0  # sites (the TCP markers) are not scene surfaces
+        extent = model.stat.extent
+        znear = np.float32(model.vis.map.znear * extent)
+        zfar = np.float32(model.vis.map.zfar * extent)
+        c_coef = -(zfar + znear) / (zfar - znear)
+        d_coef = -(np.float32(2) * zfar * znear) / (zfar - znear)
+        # Reversed-Z depth buffer (the renderer's readDepthMap = ZEROFAR).
+        self._c = float(np.float32(-0.5) * c_coef - np.float32(0.5))
+        self._d = float(np.float32(-0.5) * d_coef)
+        r = self.renderer
+        self.single_pass = all(hasattr(r, a) for a in ("_rect", "_mjr_context", "_gl_context"))
+        self._rgb = np.empty((height, width, 3), dtype=np.uint8)
+        self._zbuf = np.empty((height, width), dtype=np.float32)
+
+    def capture(self, data: mujoco.MjData) -> CameraImage:
+        """Render the current state."""
+        r = self.renderer
+        r.update_scene(data, camera=self.camera_id, scene_option=self.option)
+        if self.single_pass:
+            depth, seg = self._render_single_pass()
+        else:  # pragma: no cover - depends on the mujoco version's internals
+            r.enable_depth_rendering()
+            depth = r.render()
+            r.enable_segmentation_rendering()
+            seg = r.render()
+            r.disable_segmentation_rendering()
+        return CameraImage(
+            camera=self.camera,
+            depth=depth,
+            seg=seg,
+            fovy=float(self.model.cam_fovy[self.camera_id]),
+            pos=data.cam_xpos[self.camera_id].copy(),
+            rot=data.cam_xmat[self.camera_id].reshape(3, 3).copy(),
+        )
+
+    def _render_single_pass(self) -> tuple[np.ndarray, np.ndarray]:
+        r = self.renderer
+        scene = r.scene
+        flags = scene.flags.copy()
+        scene.flags[mujoco.mjtRndFlag.mjRND_SEGMENT] = True
+        scene.flags[mujoco.mjtRndFlag.mjRND_IDCOLOR] = True
+        if r._gl_context:
+            r._gl_context.make_current()
+        mujoco.mjr_render(r._rect, scene, r._mjr_context)
+        mujoco.mjr_readPixels(self._rgb, self._zbuf, r._rect, r._mjr_context)
+        np.copyto(scene.flags, flags)
+        depth = (self._d / (self._zbuf.astype(np.float64) + self._c)).astype(np.float32)
+        rgb = self._rgb.astype(np.int32)
+        segid = rgb[..., 0] + (rgb[..., 1] << 8) + (rgb[..., 2] << 16)
+        lut = np.full((scene.ngeom + 2, 2), -1, dtype=np.int32)
+        for geom in scene.geoms[: scene.ngeom]:
+            if geom.segid != -1:
+                lut[geom.segid + 1] = (geom.objid, geom.objtype)
+        seg = lut[np.minimum(segid, scene.ngeom + 1)]
+        if r._gl_context:  # EGL/OSMesa images are bottom-up
+            depth = np.flipud(depth)
+            seg = np.flipud(seg)
+        return np.ascontiguousarray(depth), np.ascontiguousarray(seg)
+
+    def close(self) -> None:
+        """Free the renderer's GL resources."""
+        if self.renderer is not None:
+            self.renderer.close()
+            self.renderer = None
+
+
+class RgbdExtractor:
+    """Builds a :class:`FeatureFrame` from rendered depth + segmentation of scene cameras.
+
+    Same interface as :class:`~agentchord.features.oracle.OracleExtractor`: the
+    frame is updated in place (``frame.refs`` survive), ``update()`` is called
+    every control tick. Objects are re-perceived every ``round(50 / rate_hz)``-th
+    tick; in between the last estimate is kept. An object with fewer than
+    ``min_points`` fused points keeps its last estimate, and its ``points`` is
+    the count seen (so a ``lost_view`` monitor fires).
+
+    Args:
+        world: The simulated world (rendered; its object poses are not read).
+        grasp_signal: Callable ``arm -> bool``: the controller's latched grasp signal.
+        cameras: Names of the scene cameras to fuse.
+        rate_hz: Camera rate (Hz).
+        width: Image width (px).
+        height: Image height (px).
+        segmenter: Object masks per image; default :class:`SimSegmenter`.
+        min_points: Fewest fused points for a new estimate.
+        voxel: Voxel edge (m) of the fused cloud's down-sampling (0: none).
+
+    Attributes:
+        last_perceived_tick: Tick of the last camera frame.
+        perceptions: Number of camera frames processed.
+        costs_ms: Wall-clock cost of the recent camera frames (all cameras, all objects).
+        estimated: Per object, whether it has been seen at least once.
+    """
+
+    def __init__(
+        self,
+        world: SimWorld,
+        grasp_signal=None,
+        cameras: tuple[str, ...] = PERCEPTION_CAMERAS,
+        rate_hz: float = CAMERA_RATE_HZ,
+        width: int = 320,
+        height: int = 240,
+        segmenter: Segmenter | None = None,
+        min_points: int = MIN_POINTS,
+        voxel: float = VOXEL_M,
+    ) -> None:
+        self.world = world
+        self.grasp_signal = grasp_signal or (lambda arm: False)
+        self.period = max(1, round(CONTROL_HZ / rate_hz))
+        self.min_points = min_points
+        self.voxel = voxel
+        self.segmenter = segmenter if segmenter is not None else SimSegmenter.for_world(world)
+        self.cameras: list[DepthCamera] = []
+        try:
+            for name in cameras:
+                self.cameras.append(DepthCamera(world.model, name, width, height))
+        except Exception:
+            self.close()
+            raise
+        self.frame = FeatureFrame(objects={}, arms={})
+        self._priors: dict[str, tuple[str, np.ndarray]] = {}
+        self._rot: dict[str, np.ndarray] = {}
+        self.estimated: dict[str, bool] = {}
+        for name in world.object_names:
+            spec = world.object_spec(name)
+            if spec.shape == "cylinder":
+                extent = np.array([2 * spec.size[0], 2 * spec.size[0], 2 * spec.size[1]])
+            else:
+                extent = 2 * np.asarray(spec.size, dtype=float)
+            self._priors[name] = (spec.shape, np.asarray(spec.size, dtype=float))
+            self.estimated[name] = False
+            half = np.array([0.0, 0.0, 0.5 * extent[2]])
+            self.frame.objects[name] = ObjectFeatures(
+                pos=np.zeros(3), quat=np.array([1.0, 0.0, 0.0, 0.0]), axis=np.array([0.0, 0.0, 1.0]),
+                extent=extent, top=half.copy(), bottom=-half, points=0.0,
+            )  # fmt: skip
+        for arm in ARMS:
+            self.frame.arms[arm] = ArmFeatures(ee=np.zeros(3), ee_quat=np.zeros(4), q=np.zeros(6), width=0.0, closed=0.0)
+        self.last_perceived_tick: int | None = None
+        self.perceptions = 0
+        self.costs_ms: deque[float] = deque(maxlen=1000)
+        self.update()
+        self.frame.capture_refs()
+
+    # ------------------------------------------------------------------ life cycle
+    def close(self) -> None:
+        """Free the cameras' renderers (call before the interpreter exits)."""
+        for camera in self.cameras:
+            camera.close()
+
+    def __enter__(self) -> RgbdExtractor:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    # ------------------------------------------------------------------ per tick
+    def due(self) -> bool:
+        """Whether this tick gets a camera frame."""
+        last = self.last_perceived_tick
+        tick = self.world.tick
+        return last is None or tick < last or tick - last >= self.period
+
+    def update(self) -> FeatureFrame:
+        """Refresh the frame: objects at the camera rate, the robot every tick."""
+        world, frame = self.world, self.frame
+        if self.due():
+            self.perceive()
+        holding = set()
+        for arm, feats in frame.arms.items():
+            ee, rot = world.tcp_pose(arm)
+            feats.ee = ee
+            feats.ee_quat = quat_from_matrix(rot)
+            feats.q = world.arm_q(arm)
+            feats.width = world.gripper_width(arm)
+            feats.closed = 1.0 if self.grasp_signal(arm) else 0.0
+            for name in frame.objects:
+                if world.holding(arm, name):
+                    holding.add((arm, name))
+        frame.holding = holding
+        frame.tick = world.tick
+        return frame
+
+    # ------------------------------------------------------------------ perception
+    def capture(self) -> list[CameraImage]:
+        """Render every perception camera at the current state."""
+        return [camera.capture(self.world.data) for camera in self.cameras]
+
+    def object_clouds(self, images: list[CameraImage]) -> dict[str, list[np.ndarray]]:
+        """Per object, the world points of its mask in each image (in camera order)."""
+        clouds: dict[str, list[np.ndarray]] = {name: [] for name in self.frame.objects}
+        for image in images:
+            masks = self.segmenter.masks(image.seg, image.camera)
+            for name in clouds:
+                mask = masks.get(name)
+                if mask is None or not mask.any():
+                    clouds[name].append(np.empty((0, 3)))
+                else:
+                    clouds[name].append(image.points(mask & (image.depth < 0.99 * self._far)))
+        return clouds
+
+    @property
+    def _far(self) -> float:
+        return float(self.world.model.vis.map.zfar * self.world.model.stat.extent)
+
+    def fit(self, name: str, points: np.ndarray, hint: bool = True) -> ShapeFit:
+        """Fit the object's model family to a cloud (``hint``: start from the last estimate)."""
+        shape, size = self._priors[name]
+        if self.voxel > 0:
+            points = voxel_downsample(points, self.voxel)
+        known = hint and self.estimated[name]
+        if shape == "cylinder":
+            return fit_cylinder(points, radius=size[0], half_height=size[1], axis_hint=self.frame.objects[name].axis if known else None)
+        return fit_box(points, size, rot_hint=self._rot.get(name) if known else None)
+
+    def perceive(self) -> None:
+        """Take one camera frame and re-estimate every object seen."""
+        t0 = time.perf_counter()
+        clouds = self.object_clouds(self.capture())
+        for name, views in clouds.items():
+            points = np.concatenate(views) if views else np.empty((0, 3))
+            feats = self.frame.objects[name]
+            feats.points = float(len(points))
+            if len(points) < self.min_points:
+                continue  # occluded or out of view: keep the last estimate
+            self._write(name, self.fit(name, points))
+        self.last_perceived_tick = self.world.tick
+        self.perceptions += 1
+        self.costs_ms.append((time.perf_counter() - t0) * 1e3)
+
+    def _write(self, name: str, fit: ShapeFit) -> None:
+        feats = self.frame.objects[name]
+        shape, _ = self._priors[name]
+        axis = fit.axis.copy()
+        if shape == "cylinder":
+            radius, half = fit.size
+            feats.extent = np.array([2 * radius, 2 * radius, 2 * half])
+            feats.quat = quat_from_axis(axis)
+        else:
+            half = fit.size[2]
+            feats.extent = 2 * fit.size.copy()
+            feats.quat = quat_from_matrix(fit.rot)
+        self._rot[name] = fit.rot.copy()
+        feats.pos = fit.pos.copy()
+        feats.axis = axis
+        feats.top = fit.pos + half * axis
+        feats.bottom = fit.pos - half * axis
+        self.estimated[name] = True
