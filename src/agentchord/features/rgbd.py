@@ -17,7 +17,9 @@ chooses the model family and a soft size prior; its pose is never read.
 
 from __future__ import annotations
 
+import atexit
 import time
+import weakref
 from collections import deque
 from dataclasses import dataclass
 
@@ -37,6 +39,26 @@ CAMERA_RATE_HZ = 10
 MIN_POINTS = 30
 #: Voxel edge (m) of the down-sampling of the fused cloud before fitting (equalises view densities).
 VOXEL_M = 0.003
+
+
+_OPEN_CAMERAS: weakref.WeakSet = weakref.WeakSet()
+_EXIT_HOOK = False
+
+
+def _close_open_cameras() -> None:
+    # Renderers still open at exit would be freed by their finalisers after EGL shut down.
+    for camera in list(_OPEN_CAMERAS):
+        camera.close()
+
+
+def _track(camera: DepthCamera) -> None:
+    global _EXIT_HOOK
+    if not _EXIT_HOOK:
+        # Registered after the renderer created its GL context (so after the EGL module set up
+        # its own exit handler): exit handlers run last-in first-out, so this one runs first.
+        atexit.register(_close_open_cameras)
+        _EXIT_HOOK = True
+    _OPEN_CAMERAS.add(camera)
 
 
 @dataclass
@@ -98,6 +120,7 @@ class DepthCamera:
         self.single_pass = all(hasattr(r, a) for a in ("_rect", "_mjr_context", "_gl_context"))
         self._rgb = np.empty((height, width, 3), dtype=np.uint8)
         self._zbuf = np.empty((height, width), dtype=np.float32)
+        _track(self)
 
     def capture(self, data: mujoco.MjData) -> CameraImage:
         """Render the current state."""
@@ -149,6 +172,7 @@ class DepthCamera:
         if self.renderer is not None:
             self.renderer.close()
             self.renderer = None
+        _OPEN_CAMERAS.discard(self)
 
 
 class RgbdExtractor:
@@ -171,6 +195,10 @@ class RgbdExtractor:
         segmenter: Object masks per image; default :class:`SimSegmenter`.
         min_points: Fewest fused points for a new estimate.
         voxel: Voxel edge (m) of the fused cloud's down-sampling (0: none).
+        depth_noise: Standard deviation (m) of Gaussian depth noise at 1 m, growing
+            with the square of the distance as for stereo / structured-light
+            sensors (0: the renderer's exact depth).
+        seed: Seed of the depth noise.
 
     Attributes:
         last_perceived_tick: Tick of the last camera frame.
@@ -190,12 +218,16 @@ class RgbdExtractor:
         segmenter: Segmenter | None = None,
         min_points: int = MIN_POINTS,
         voxel: float = VOXEL_M,
+        depth_noise: float = 0.0,
+        seed: int = 0,
     ) -> None:
         self.world = world
         self.grasp_signal = grasp_signal or (lambda arm: False)
         self.period = max(1, round(CONTROL_HZ / rate_hz))
         self.min_points = min_points
         self.voxel = voxel
+        self.depth_noise = depth_noise
+        self.rng = np.random.default_rng(seed)
         self.segmenter = segmenter if segmenter is not None else SimSegmenter.for_world(world)
         self.cameras: list[DepthCamera] = []
         try:
@@ -271,7 +303,12 @@ class RgbdExtractor:
     # ------------------------------------------------------------------ perception
     def capture(self) -> list[CameraImage]:
         """Render every perception camera at the current state."""
-        return [camera.capture(self.world.data) for camera in self.cameras]
+        images = [camera.capture(self.world.data) for camera in self.cameras]
+        if self.depth_noise > 0:
+            for image in images:
+                noise = self.rng.standard_normal(image.depth.shape, dtype=np.float32)
+                image.depth = image.depth + noise * np.float32(self.depth_noise) * image.depth**2
+        return images
 
     def object_clouds(self, images: list[CameraImage]) -> dict[str, list[np.ndarray]]:
         """Per object, the world points of its mask in each image (in camera order)."""
@@ -290,27 +327,53 @@ class RgbdExtractor:
     def _far(self) -> float:
         return float(self.world.model.vis.map.zfar * self.world.model.stat.extent)
 
-    def fit(self, name: str, points: np.ndarray, hint: bool = True) -> ShapeFit:
-        """Fit the object's model family to a cloud (``hint``: start from the last estimate)."""
+    def fuse(self, views: list[np.ndarray], origins: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+        """Fuse per-camera clouds: each voxel-downsampled, then concatenated.
+
+        Returns:
+            The points and, per point, the position of the camera that saw it.
+        """
+        points, viewpoints = [], []
+        for cloud, origin in zip(views, origins):
+            if len(cloud) == 0:
+                continue
+            if self.voxel > 0:
+                cloud = voxel_downsample(cloud, self.voxel)
+            points.append(cloud)
+            viewpoints.append(np.broadcast_to(np.asarray(origin, dtype=float), cloud.shape))
+        if not points:
+            return np.empty((0, 3)), np.empty((0, 3))
+        return np.concatenate(points), np.concatenate(viewpoints)
+
+    def fit(self, name: str, views: list[np.ndarray], origins: list[np.ndarray], hint: bool = True) -> ShapeFit:
+        """Fit the object's model family to its fused views.
+
+        Args:
+            name: The object.
+            views: Its points as seen by each camera.
+            origins: The position of each of those cameras.
+            hint: Start from the last estimate (if any).
+        """
         shape, size = self._priors[name]
-        if self.voxel > 0:
-            points = voxel_downsample(points, self.voxel)
+        points, viewpoints = self.fuse(views, origins)
         known = hint and self.estimated[name]
         if shape == "cylinder":
-            return fit_cylinder(points, radius=size[0], half_height=size[1], axis_hint=self.frame.objects[name].axis if known else None)
-        return fit_box(points, size, rot_hint=self._rot.get(name) if known else None)
+            axis = self.frame.objects[name].axis if known else None
+            return fit_cylinder(points, radius=size[0], half_height=size[1], axis_hint=axis, viewpoints=viewpoints)
+        return fit_box(points, size, rot_hint=self._rot.get(name) if known else None, viewpoints=viewpoints)
 
     def perceive(self) -> None:
         """Take one camera frame and re-estimate every object seen."""
         t0 = time.perf_counter()
-        clouds = self.object_clouds(self.capture())
-        for name, views in clouds.items():
-            points = np.concatenate(views) if views else np.empty((0, 3))
+        images = self.capture()
+        origins = [image.pos for image in images]
+        for name, views in self.object_clouds(images).items():
+            count = sum(len(v) for v in views)
             feats = self.frame.objects[name]
-            feats.points = float(len(points))
-            if len(points) < self.min_points:
+            feats.points = float(count)
+            if count < self.min_points:
                 continue  # occluded or out of view: keep the last estimate
-            self._write(name, self.fit(name, points))
+            self._write(name, self.fit(name, views, origins))
         self.last_perceived_tick = self.world.tick
         self.perceptions += 1
         self.costs_ms.append((time.perf_counter() - t0) * 1e3)

@@ -3,6 +3,9 @@
 The solver works on a robot-only copy of the model (no free-floating objects),
 warm-started from the last commanded configuration: each control tick moves
 the tool-centre targets a little, so one or two QP iterations converge.
+The arms never collide: when their tools come within ``ARM_PROXIMITY`` of
+each other, mink's collision-avoidance limit between the two arms' geoms joins
+the QP, on capsule proxies of the distal links (cheap analytic distances).
 """
 
 from __future__ import annotations
@@ -13,7 +16,7 @@ import mink
 import mujoco
 import numpy as np
 
-from agentchord.worlds.sim.scene import ARM_JOINTS, ARM_PREFIX, HOME_Q, build_robot_model
+from agentchord.worlds.sim.scene import ARM_JOINTS, ARM_PREFIX, COLLISION_PROXIES, HOME_Q, build_robot_model
 
 
 @dataclass
@@ -24,15 +27,22 @@ class PoseTarget:
     quat: np.ndarray
 
 
+#: Tool-to-tool distance (m) under which arm-arm collision avoidance is active.
+ARM_PROXIMITY = 0.35
+#: Clearance (m) the collision-avoidance limit keeps between the arms.
+ARM_CLEARANCE = 0.02
+
+
 class BimanualIK:
     """Solve joint targets of both arms for tool-centre pose targets.
 
     Args:
-        iterations: QP iterations per call (each ~0.2 ms).
+        iterations: QP iterations per call (each ~0.1 ms, ~0.8 ms with collision avoidance).
         dt: Integration step of the differential IK.
+        avoid_arm_collisions: Keep the two arms apart.
     """
 
-    def __init__(self, iterations: int = 2, dt: float = 0.05) -> None:
+    def __init__(self, iterations: int = 2, dt: float = 0.05, avoid_arm_collisions: bool = True) -> None:
         self.model = build_robot_model()
         self.configuration = mink.Configuration(self.model)
         self.iterations = iterations
@@ -43,6 +53,18 @@ class BimanualIK:
         }
         self.posture = mink.PostureTask(self.model, cost=1e-3)
         self.limits = [mink.ConfigurationLimit(self.model)]
+        self.arm_collision_limit = None
+        if avoid_arm_collisions:
+            # Capsule proxies around forearm, wrist and gripper (scene.COLLISION_PROXIES).
+            geoms = {arm: [f"{arm}_proxy_{k}" for k in range(len(COLLISION_PROXIES))] for arm in ARM_PREFIX}
+            self._proxy_pairs = [
+                (self.model.geom(a).id, self.model.geom(b).id) for a in geoms["left"] for b in geoms["right"]
+            ]
+            self._fromto = np.zeros(6)
+            self.arm_collision_limit = mink.CollisionAvoidanceLimit(
+                self.model, [(geoms["left"], geoms["right"])],
+                minimum_distance_from_collisions=ARM_CLEARANCE, collision_detection_distance=0.2, gain=0.5,
+            )
         self._arm_qadr = {
             arm: np.array([self.model.joint(f"{prefix}/{name}").qposadr[0] for name in ARM_JOINTS])
             for arm, prefix in ARM_PREFIX.items()
@@ -88,10 +110,30 @@ class BimanualIK:
                 task.set_target(mink.SE3.from_rotation_and_translation(mink.SO3(np.asarray(target.quat)), np.asarray(target.pos)))
             tasks.append(task)
         self.posture.set_target(self.configuration.q)
+        limits = self.limits
+        guarded = self.arm_collision_limit is not None and self.arms_close()
+        if guarded:
+            limits = [*self.limits, self.arm_collision_limit]
+            previous = self.configuration.q.copy()
         for _ in range(self.iterations):
-            velocity = mink.solve_ik(self.configuration, tasks, self.dt, solver="daqp", damping=1e-4, limits=self.limits)
+            velocity = mink.solve_ik(self.configuration, tasks, self.dt, solver="daqp", damping=1e-4, limits=limits)
             self.configuration.integrate_inplace(velocity, self.dt)
+        if guarded and self.arm_clearance() < 0.0:
+            # The linearised limit can still be stepped through when targets cross: then both
+            # arms hold their last configuration rather than collide.
+            self.configuration.update(previous)
         return {arm: self.arm_q(arm) for arm in ARM_PREFIX}
+
+    def arm_clearance(self) -> float:
+        """Smallest distance (m) between the two arms' collision proxies (negative: overlap)."""
+        data = self.configuration.data
+        return min(
+            mujoco.mj_geomDistance(self.model, data, a, b, 0.5, self._fromto) for a, b in self._proxy_pairs
+        )
+
+    def arms_close(self) -> bool:
+        """Whether the two tools are near enough for the arms to touch."""
+        return float(np.linalg.norm(self.tcp_pose("left").pos - self.tcp_pose("right").pos)) < ARM_PROXIMITY
 
     def residual(self, arm: str, target: PoseTarget) -> float:
         """Position error (m) of the current solution to a target."""
