@@ -1,9 +1,30 @@
-"""Simulated tasks (paper Appendix B): seeded scenes and success checks, one module per task."""
+"""Simulated tasks (paper Appendix B): seeded scenes and success checks, one module per task.
+
+Every module of this package that defines ``TASK`` (a :class:`SimTask`) is registered under
+``TASK.name``: adding a task is adding a module.
+"""
+
+from __future__ import annotations
+
+import importlib
+import pkgutil
 
 from agentchord.worlds.sim.tasks.base import SimTask, SuccessTracker, Verdict
-from agentchord.worlds.sim.tasks.single_arm_pour_water import SingleArmPourWater
+
+
+def _discover() -> dict[str, SimTask]:
+    tasks: dict[str, SimTask] = {}
+    for module_info in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
+        if module_info.name == "base":
+            continue
+        module = importlib.import_module(f"{__name__}.{module_info.name}")
+        task = getattr(module, "TASK", None)
+        if task is not None:
+            tasks[task.name] = task
+    return tasks
+
 
 #: Every simulated task by name.
-SIM_TASKS: dict[str, SimTask] = {task.name: task for task in (SingleArmPourWater(),)}
+SIM_TASKS: dict[str, SimTask] = _discover()
 
 __all__ = ["SIM_TASKS", "SimTask", "SuccessTracker", "Verdict"]

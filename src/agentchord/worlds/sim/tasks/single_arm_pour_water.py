@@ -99,3 +99,6 @@ class SingleArmPourWater:
     def success_tracker(self) -> PourTracker:
         """A fresh success tracker for one episode."""
         return PourTracker()
+
+
+TASK = SingleArmPourWater()
