@@ -4,7 +4,7 @@ import pytest
 
 from agentchord.execution.episode import EpisodeSpec, run_episode
 from agentchord.execution.executor import ExecutorConfig
-from agentchord.worlds.sim.disturbances import ScriptedDrop, ScriptedPush
+from agentchord.worlds.sim.disturbances import ScriptedDisturbance, ScriptedDrop
 
 TASK = "single_arm_pour_water"
 
@@ -83,7 +83,7 @@ def test_failure_budget_ends_the_episode_with_a_reason():
     ("rotate_eef", "e3", "e3_r_cup_shifted"),
 ])
 def test_cup_shifted_while_the_bottle_approaches_or_pours_is_followed(action, edge, entry):
-    push = ScriptedPush(action=action, obj="cup", force=(-3.0, 0.0, 0.0), after=20)
+    push = ScriptedDisturbance(action=action, kind="shift", after=20, direction=(-1.0, 0.0, 0.0))
     result = run_episode(EpisodeSpec(TASK, seed=1, disturbance=push))
     assert result.success, result.reason
     switch = result.trace.of("recovery_switch")[0]

@@ -11,6 +11,7 @@ from agentchord.features.pointcloud import (
     fit_circle,
     fit_cylinder,
     focal_length,
+    orient,
     quat_from_axis,
     voxel_downsample,
 )
@@ -133,3 +134,12 @@ def test_circle_voxels_and_quaternions():
     np.testing.assert_allclose(quat_from_axis(np.array([0.0, 0.0, 1.0])), [1, 0, 0, 0])
     q = quat_from_axis(np.array([1.0, 0.0, 0.0]))  # a quarter turn about y
     np.testing.assert_allclose(q, [np.cos(np.pi / 4), 0, np.sin(np.pi / 4), 0], atol=1e-12)
+
+
+def test_axis_sign_follows_the_last_estimate_only_while_it_is_informative():
+    down_tilted = np.array([0.9, 0.0, -0.2]) / np.linalg.norm([0.9, 0.0, -0.2])
+    previous = np.array([0.8, 0.0, 0.1]) / np.linalg.norm([0.8, 0.0, 0.1])
+    np.testing.assert_allclose(orient(down_tilted, previous), down_tilted)  # past horizontal in a pour
+    np.testing.assert_allclose(orient(down_tilted, None), -down_tilted)  # first sight: the top points up
+    # After a big jump (a fallen bottle set upright again) the up-pointing end is the top.
+    np.testing.assert_allclose(orient(np.array([0.0, 0.0, -1.0]), np.array([0.0, 1.0, 0.0])), [0.0, 0.0, 1.0])

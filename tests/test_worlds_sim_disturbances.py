@@ -1,33 +1,69 @@
-"""Seeded disturbance schedules: drawn from the seed, identical across strategies."""
+"""Seeded disturbances: every kind happens, and schedules are the same for two strategies."""
 
 import pytest
 
+from agentchord.actions.library import make_action
 from agentchord.execution.episode import EpisodeSpec, run_episode
-from agentchord.worlds.sim.disturbances import RandomDrop
+from agentchord.worlds.sim.disturbances import KINDS, ProtocolDisturbances, RandomDisturbances, ScriptedDisturbance, parse_kinds
+
+TASK = "single_arm_pour_water"
 
 
 def _draws(schedule, n=50):
+    action = make_action("move_to_obj", "right", {"obj": "cup"})
     due = []
     for k in range(n):
-        schedule.action_started("right", "move_to_obj", 100, tick=1000 * k)
-        due.append(schedule._pending.get("right"))
+        schedule.action_started("right", action, 100, tick=1000 * k)
+        pending = schedule._pending.get("right")
+        due.append(None if pending is None else pending[:2])
     return due
 
 
 def test_same_seed_same_schedule_other_seed_other_schedule():
-    assert _draws(RandomDrop(0.3, seed=4)) == _draws(RandomDrop(0.3, seed=4))
-    assert _draws(RandomDrop(0.3, seed=4)) != _draws(RandomDrop(0.3, seed=5))
+    assert _draws(RandomDisturbances(0.3, seed=4)) == _draws(RandomDisturbances(0.3, seed=4))
+    assert _draws(RandomDisturbances(0.3, seed=4)) != _draws(RandomDisturbances(0.3, seed=5))
 
 
-def test_probability_zero_never_drops_and_bad_probability_is_refused():
-    assert all(d is None for d in _draws(RandomDrop(0.0, seed=1)))
+def test_probability_zero_never_disturbs_and_bad_input_is_refused():
+    assert all(d is None for d in _draws(RandomDisturbances(0.0, seed=1)))
     with pytest.raises(ValueError, match=r"\[0, 1\]"):
-        RandomDrop(1.5, seed=1)
+        RandomDisturbances(1.5, seed=1)
+    with pytest.raises(ValueError, match="unknown disturbance kind"):
+        parse_kinds("drop,earthquake")
 
 
-def test_both_strategies_see_the_same_first_disturbance_for_a_seed():
+@pytest.mark.parametrize("kind,action,after,moved", [
+    ("drop", "move_to_obj", 30, "bottle"),
+    ("pull", "move_to_obj", 30, "bottle"),
+    ("perturb", "grasp", 40, "bottle"),
+    ("shift", "move_to_obj", 20, "cup"),
+    ("knock", "move_to_obj", 20, "cup"),
+])
+def test_every_kind_happens_and_is_the_same_for_both_strategies(kind, action, after, moved):
     firsts = []
     for strategy in ("agentchord", "agentchord-bt"):
-        result = run_episode(EpisodeSpec("single_arm_pour_water", strategy=strategy, p=0.3, seed=5))
-        firsts.append(result.trace.of("disturbance")[0])
+        disturbance = ScriptedDisturbance(action, kind, after=after, seed=3)
+        result = run_episode(EpisodeSpec(TASK, strategy=strategy, seed=2, disturbance=disturbance,
+                                         config=None))
+        events = result.trace.of("disturbance")
+        assert events and events[0]["kind"] == kind and events[0]["obj"] == moved
+        firsts.append(events[0])
     assert firsts[0] == firsts[1]
+
+
+def test_knock_tips_the_object_over():
+    result = run_episode(EpisodeSpec(TASK, seed=2, disturbance=ScriptedDisturbance("move_to_obj", "knock", after=5)))
+    knocked = result.trace.of("disturbance")[0]["obj"]
+    assert knocked == "cup"
+
+
+def test_protocol_injects_one_or_two_disturbances_identically_for_both_strategies():
+    counts = []
+    for seed in range(4):
+        schedule = ProtocolDisturbances(seed)
+        assert 1 <= len(schedule._due) <= 2
+        counts.append(len(schedule._due))
+    assert ProtocolDisturbances(7)._due == ProtocolDisturbances(7)._due
+    firsts = [run_episode(EpisodeSpec(TASK, strategy=s, seed=1, protocol=True, disturb=KINDS)).trace.of("disturbance")[:1]
+              for s in ("agentchord", "agentchord-bt")]
+    assert firsts[0] == firsts[1] and firsts[0]

@@ -18,6 +18,24 @@ from agentchord import __version__
 from agentchord.graph.cli import graph_group, schema_command
 
 STRATEGY_NAMES = ("agentchord", "agentchord-bt")
+PERCEPTION_NAMES = ("oracle", "rgbd")
+DISTURB_HELP = "Disturbance kinds, comma-separated: drop, pull, perturb, shift, knock."
+
+
+def _kinds(ctx, param, value: str) -> tuple[str, ...]:
+    from agentchord.worlds.sim.disturbances import parse_kinds  # noqa: PLC0415
+
+    try:
+        return parse_kinds(value)
+    except ValueError as exc:
+        raise click.BadParameter(str(exc)) from exc
+
+
+def _task_name(task: str, param_hint: str) -> None:
+    from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: PLC0415
+
+    if task not in SIM_TASKS:
+        raise click.BadParameter(f"unknown task {task!r} (tasks: {', '.join(SIM_TASKS)})", param_hint=param_hint)
 
 
 @click.group()
@@ -28,6 +46,19 @@ def main() -> None:
 
 main.add_command(schema_command)
 main.add_command(graph_group)
+
+
+@main.command()
+def tasks() -> None:
+    """List the simulated tasks, with a one-line description each."""
+    from agentchord.tasks import library_tasks  # noqa: PLC0415
+    from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: PLC0415
+
+    graphs = set(library_tasks())
+    width = max(len(name) for name in SIM_TASKS)
+    for name, task in sorted(SIM_TASKS.items()):
+        mark = "" if name in graphs else "  (no library graph yet)"
+        click.echo(f"{name:<{width}}  {task.description}{mark}")
 
 
 def _load_graph_option(graph_path: str | None):
@@ -51,23 +82,24 @@ def _load_graph_option(graph_path: str | None):
 @main.command()
 @click.argument("task")
 @click.option("--strategy", type=click.Choice(STRATEGY_NAMES), default="agentchord", show_default=True)
-@click.option("--p", "p", type=click.FloatRange(0.0, 1.0), default=0.0, show_default=True, help="Drop probability per atomic action.")
+@click.option("--p", "p", type=click.FloatRange(0.0, 1.0), default=0.0, show_default=True, help="Disturbance probability per atomic action.")
+@click.option("--disturb", default="drop", show_default=True, callback=_kinds, help=DISTURB_HELP)
+@click.option("--protocol", is_flag=True, help="The paper's real-world protocol: 1-2 disturbances at random moments (ignores --p).")
+@click.option("--perception", type=click.Choice(PERCEPTION_NAMES), default="oracle", show_default=True)
 @click.option("--seed", type=int, default=0, show_default=True)
 @click.option("--graph", "graph_path", type=click.Path(exists=True, dir_okay=False), help="Graph file (default: the task library's).")
 @click.option("--trace", "trace_path", type=click.Path(dir_okay=False), help="Write the trace as JSON lines.")
 @click.option("--json", "json_path", type=click.Path(dir_okay=False), help="Write the episode summary as JSON.")
 @click.option("--video", "video_path", type=click.Path(dir_okay=False), help="Write an MP4 of the episode.")
 @click.option("--camera", default="front", show_default=True, help="Scene camera for --video.")
-def run(task, strategy, p, seed, graph_path, trace_path, json_path, video_path, camera) -> None:
+def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, trace_path, json_path, video_path, camera) -> None:
     """Run one episode of TASK and print its path through the graph.
 
     Exit status 0 when the task succeeded, 1 when it failed, 2 on bad input.
     """
     from agentchord.execution.episode import EpisodeSpec, run_episode  # noqa: PLC0415
-    from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: PLC0415
 
-    if task not in SIM_TASKS:
-        raise click.BadParameter(f"unknown task {task!r} (tasks: {', '.join(SIM_TASKS)})", param_hint="TASK")
+    _task_name(task, "TASK")
     graph = _load_graph_option(graph_path)
     console = Console()
     recorder = {}
@@ -87,13 +119,14 @@ def run(task, strategy, p, seed, graph_path, trace_path, json_path, video_path, 
             elif event["event"] == "recovery_switch":
                 video.announce(f"RECOVERY -> {event['to']}")
             elif event["event"] == "disturbance":
-                video.announce(f"DISTURBANCE: {event['obj']} {'dropped' if event['kind'] == 'drop' else 'pushed'}", ticks=10)
+                video.announce(f"DISTURBANCE: {event['kind']} {event['obj']}", ticks=25)
         recorder["seen"] = len(executor.trace.events)
         program = executor.program
         caption = f"{task}  node {executor.node}  edge {program.edge_id if program else '-'} ({program.kind if program else ''})"
         video.capture(caption)
 
-    result = run_episode(EpisodeSpec(task=task, strategy=strategy, p=p, seed=seed, graph=graph), on_tick=on_tick)
+    spec = EpisodeSpec(task=task, strategy=strategy, p=p, seed=seed, graph=graph, disturb=disturb, protocol=protocol, perception=perception)
+    result = run_episode(spec, on_tick=on_tick)
     _print_episode(console, result)
     if trace_path:
         result.trace.write(trace_path)
@@ -118,8 +151,9 @@ def _print_episode(console: Console, result) -> None:
             mark = "ok" if event["constraints_hold"] else f"constraints violated: {event.get('violated')}"
             console.print(f"{tick}  node [bold]{event['node']}[/bold]  {mark}")
         elif kind == "disturbance":
-            what = f"dropped by {event['arm']}" if event["kind"] == "drop" else "pushed"
-            console.print(f"{tick}  [yellow]disturbance[/yellow]: {event['obj']} {what} during {event['action']}")
+            by = f" from the {event['arm']} gripper" if event["kind"] in ("drop", "pull") else ""
+            during = f" during {event['action']}" if event["action"] else ""
+            console.print(f"{tick}  [yellow]disturbance[/yellow]: {event['kind']} {event['obj']}{by}{during}")
         elif kind == "failure_detected":
             console.print(f"{tick}  [red]failure detected[/red]: {event['failure']} on {event['edge']} (violated since tick {event['onset_tick']})")
         elif kind == "recovery_switch":
@@ -137,25 +171,28 @@ def _print_episode(console: Console, result) -> None:
 @click.option("--task", default="single_arm_pour_water", show_default=True)
 @click.option("--trials", type=click.IntRange(1, 10000), default=20, show_default=True)
 @click.option("--p", "p", type=click.FloatRange(0.0, 1.0), default=0.1, show_default=True)
+@click.option("--disturb", default="drop", show_default=True, callback=_kinds, help=DISTURB_HELP)
+@click.option("--protocol", is_flag=True, help="The paper's real-world protocol: 1-2 disturbances at random moments (ignores --p).")
+@click.option("--perception", type=click.Choice(PERCEPTION_NAMES), default="oracle", show_default=True)
 @click.option("--strategies", default=",".join(STRATEGY_NAMES), show_default=True, help="Comma-separated strategies to compare.")
 @click.option("--workers", type=click.IntRange(1, 64), default=None, help="Worker processes (default: one per core).")
 @click.option("--json", "json_path", type=click.Path(dir_okay=False), help="Write the aggregates as JSON.")
-def demo(task, trials, p, strategies, workers, json_path) -> None:
+def demo(task, trials, p, disturb, protocol, perception, strategies, workers, json_path) -> None:
     """Seeded episodes of each strategy under random drops, then a table per strategy."""
     from agentchord.bench.report import aggregate, paired_steps, print_tables  # noqa: PLC0415
     from agentchord.bench.runner import run_many  # noqa: PLC0415
     from agentchord.execution.episode import EpisodeSpec  # noqa: PLC0415
-    from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: PLC0415
-
     names = [s.strip() for s in strategies.split(",") if s.strip()]
     unknown = [s for s in names if s not in STRATEGY_NAMES]
     if unknown or not names:
         raise click.BadParameter(f"unknown strategy {unknown} (choose from {', '.join(STRATEGY_NAMES)})", param_hint="--strategies")
-    if task not in SIM_TASKS:
-        raise click.BadParameter(f"unknown task {task!r} (tasks: {', '.join(SIM_TASKS)})", param_hint="--task")
+    _task_name(task, "--task")
     console = Console()
-    console.print(f"[bold]{task}[/bold]: {trials} seeded episodes per strategy, drop probability p = {p}")
-    specs = [EpisodeSpec(task=task, strategy=name, p=p, seed=seed) for name in names for seed in range(trials)]
+    schedule = "1-2 disturbances per trial (real-world protocol)" if protocol else f"probability p = {p} per atomic action"
+    console.print(f"[bold]{task}[/bold]: {trials} seeded episodes per strategy; disturbances {', '.join(disturb)}, "
+                  f"{schedule}; perception {perception}")
+    specs = [EpisodeSpec(task=task, strategy=name, p=p, seed=seed, disturb=disturb, protocol=protocol, perception=perception)
+             for name in names for seed in range(trials)]
     summaries: dict[str, list[dict]] = {name: [] for name in names}
     with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(), console=console) as bar:
         job = bar.add_task("episodes", total=len(specs))
@@ -168,7 +205,8 @@ def demo(task, trials, p, strategies, workers, json_path) -> None:
     paired = paired_steps(summaries)
     print_tables(results, console, paired)
     if json_path:
-        payload = {"task": task, "p": p, "trials": trials, "strategies": results, "paired_steps": paired}
+        payload = {"task": task, "p": p, "trials": trials, "disturb": list(disturb), "protocol": protocol,
+                   "perception": perception, "strategies": results, "paired_steps": paired}
         Path(json_path).parent.mkdir(parents=True, exist_ok=True)
         Path(json_path).write_text(json.dumps(payload, indent=2) + "\n")
         console.print(f"aggregates: {json_path}")

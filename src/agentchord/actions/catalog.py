@@ -31,6 +31,9 @@ class GraspArgs(_Args):
     )
     offset: Vec3 = Field((0.0, 0.0, 0.0), description="Grasp offset from the grasp point, world frame (m).")
     yaw: float | None = Field(None, ge=-180.0, le=180.0, description="Side grasp: world yaw of the approach (deg); None = from the arm's base.")
+    skip_if_held: bool = Field(
+        False, description="If the arm already holds obj with a closed grip, do nothing (finish an interrupted synchronous grasp)."
+    )
 
 
 class MoveToObjArgs(_Args):
@@ -56,7 +59,16 @@ class PlaceArgs(_Args):
 
     obj: str
     target: tuple[float, float] | None = Field(None, description="Table position (m); None = straight down.")
+    relative_to: str | None = Field(None, description="Take target as an (x, y) offset from this object's centre; None = absolute.")
     z_offset: float = Field(0.0, ge=-0.05, le=0.2)
+    yaw: float | None = Field(
+        None, ge=-180.0, le=180.0,
+        description="World yaw (deg) of the object's long horizontal axis once placed (either direction); None keeps the current orientation.",
+    )
+    skip_if_placed: bool = Field(
+        False,
+        description="If obj is not held but already stands upright on the table, only open and retreat (finish an interrupted synchronous place).",
+    )
 
 
 class MoveToTargetArgs(_Args):
@@ -104,7 +116,7 @@ ACTIONS: dict[str, ActionSpec] = {
         ActionSpec("grasp", GraspArgs, 190, ("obj",)),
         ActionSpec("move_to_obj", MoveToObjArgs, 110, ("obj",), holds_object=True),
         ActionSpec("rotate_eef", RotateEefArgs, 80, holds_object=True),
-        ActionSpec("place", PlaceArgs, 170, ("obj",), holds_object=True),
+        ActionSpec("place", PlaceArgs, 170, ("obj", "relative_to"), holds_object=True),
         ActionSpec("move_to_target", MoveToTargetArgs, 110),
         ActionSpec("move_by_offset", MoveByOffsetArgs, 60),
         ActionSpec("back", NoArgs, 100),

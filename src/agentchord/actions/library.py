@@ -17,10 +17,14 @@ from agentchord.actions import catalog
 from agentchord.actions.base import ActionFailed, ArmAction
 from agentchord.actions.controller import RobotController
 from agentchord.actions.motion import grasp_frame, grip, move_joints, move_to, pose_from_matrix, settle, wait_for_rest
-from agentchord.worlds.sim.scene import HOME_Q
+from agentchord.worlds.sim.scene import ARM_JOINTS, ARM_PREFIX, HOME_Q
 
 #: Tilt (deg) beyond which an object counts as fallen for a side grasp.
 UPRIGHT_TOLERANCE_DEG = 25.0
+
+
+class GraspMissed(ActionFailed):
+    """The fingers closed but the object is not between them."""
 
 
 def _tilt_deg(axis: np.ndarray) -> float:
@@ -37,6 +41,42 @@ def _level(rotation: np.ndarray) -> np.ndarray:
 def _matrix(quat: np.ndarray) -> np.ndarray:
     w, x, y, z = quat
     return Rotation.from_quat([x, y, z, w]).as_matrix()
+
+
+def _long_axis(feats) -> np.ndarray:
+    """An object's long horizontal direction: its axis if lying, else its longer horizontal side."""
+    if _tilt_deg(feats.axis) >= Grasp.FALLEN_DEG:
+        return feats.axis
+    rot = _matrix(feats.quat)
+    return rot[:, 0] if feats.extent[0] >= feats.extent[1] else rot[:, 1]
+
+
+def _yaw_turn(robot: RobotController, arm: str, direction: np.ndarray, yaw_deg: float, goal: np.ndarray) -> np.ndarray:
+    """Rotation about world z that brings ``direction``'s yaw to ``yaw_deg``, either way round (mod 180).
+
+    Of the two turns, the smaller one unless it would drive the wrist-rotate joint (whose axis
+    is the tool's approach) past its range: a top grasp often leaves that joint near a limit.
+    The waist's own turn toward ``goal`` (x, y) is accounted for.
+    """
+    current = np.degrees(np.arctan2(direction[1], direction[0]))
+    delta = (yaw_deg - current + 90.0) % 180.0 - 90.0
+    candidates = [delta] if abs(delta) < 1e-6 else [delta, delta - np.copysign(180.0, delta)]
+    joint = robot.ik.model.joint(f"{ARM_PREFIX[arm]}/wrist_rotate")
+    lo, hi = joint.range
+    q = robot.ik.arm_q(arm)[ARM_JOINTS.index("wrist_rotate")]
+    base = robot.world.arm_base(arm)[:2]
+    here, there = robot.commanded_pose(arm).pos[:2] - base, np.asarray(goal) - base
+    waist = np.degrees(np.arctan2(there[1], there[0]) - np.arctan2(here[1], here[0]))
+    waist = (waist + 180.0) % 360.0 - 180.0
+    # A turn about world z is a turn about the approach axis scaled by its vertical component.
+    approach_z = robot.rotation(arm)[2, 0]
+
+    def margin(turn: float) -> float:
+        after = q + np.radians(turn - waist) * approach_z
+        return min(after - lo, hi - after)
+
+    best = candidates[0] if margin(candidates[0]) >= 0.3 else max(candidates, key=margin)
+    return Rotation.from_euler("z", best, degrees=True).as_matrix()
 
 
 class Grasp(ArmAction):
@@ -56,15 +96,31 @@ class Grasp(ArmAction):
 
     #: Tilt (deg) beyond which the object is treated as lying on its side.
     FALLEN_DEG = 60.0
+    #: Tries before a grasp that closes on nothing fails.
+    ATTEMPTS = 2
     #: Objects shorter than this (m) are grasped from above in ``auto`` mode.
     SIDE_MIN_HEIGHT = 0.08
     #: The finger tips reach this far past the tool centre (m): keep them off the table.
     FINGERTIP_REACH = 0.039
 
     def script(self, robot: RobotController) -> Iterator[None]:
-        yield from self._let_go(robot)
-        yield from wait_for_rest(robot, self.args.obj)
+        if self.args.skip_if_held and robot.targets[self.arm].grip_closed_settled and robot.frame.is_holding(self.arm, self.args.obj):
+            return
+        for attempt in range(self.ATTEMPTS):
+            try:
+                yield from self._let_go(robot)
+                yield from wait_for_rest(robot, self.args.obj)
+                yield from self._attempt(robot)
+                return
+            except GraspMissed:
+                # The object moved as the fingers closed (a nudge, a roll): look again and retry.
+                if attempt == self.ATTEMPTS - 1:
+                    raise
+
+    def _attempt(self, robot: RobotController) -> Iterator[None]:
         feats = robot.frame.objects[self.args.obj]
+        if feats.pos[2] < -0.02:
+            raise ActionFailed(f"{self.args.obj} fell off the table")
         tilt = _tilt_deg(feats.axis)
         height = float(np.linalg.norm(feats.top - feats.bottom))
         mode = self.args.mode
@@ -109,7 +165,7 @@ class Grasp(ArmAction):
         yield from settle(robot, self.arm, max_ticks=30, required=0.015)
         yield from grip(robot, self.arm, 1.0)
         if not robot.frame.is_holding(self.arm, self.args.obj):
-            raise ActionFailed(f"fingers closed but {self.args.obj} is not held")
+            raise GraspMissed(f"fingers closed but {self.args.obj} is not held")
 
     def _side_grasp(self, robot: RobotController) -> Iterator[None]:
         arm = self.arm
@@ -252,14 +308,31 @@ class Place(ArmAction):
     def script(self, robot: RobotController) -> Iterator[None]:
         arm = self.arm
         if not robot.frame.is_holding(arm, self.args.obj):
+            if self.args.skip_if_placed and self._standing(robot):
+                yield from self._release_and_retreat(robot)
+                return
             raise ActionFailed(f"{self.args.obj} is not held: nothing to place")
+        if self.args.relative_to is not None:
+            # A pushed reference may still be sliding: aim at where it stops.
+            yield from wait_for_rest(robot, self.args.relative_to)
         obj = robot.frame.objects[self.args.obj]
         tool = robot.commanded_pose(arm)
         rotation = _level(robot.rotation(arm))
         above = tool.pos.copy()
-        if self.args.target is not None:
+        target = None if self.args.target is None else np.asarray(self.args.target, dtype=float)
+        if target is not None and self.args.relative_to is not None:
+            target = target + robot.frame.objects[self.args.relative_to].pos[:2]
+        if self.args.yaw is not None:
+            # Turn the tool about the vertical so the object's long axis ends at the asked yaw
+            # (either direction), keeping the object's centre where it goes.
+            goal = target if target is not None else obj.pos[:2]
+            turn = _yaw_turn(robot, arm, _long_axis(obj), self.args.yaw, goal)
+            held = obj.pos[:2] - tool.pos[:2]
+            rotation = turn @ rotation
+            above[:2] = goal - turn[:2, :2] @ held
+        elif target is not None:
             # Put the object's centre, not the tool, over the target.
-            above[:2] += np.asarray(self.args.target) - obj.pos[:2]
+            above[:2] += target - obj.pos[:2]
         above[2] = max(above[2], tool.pos[2])
         yield from move_to(robot, arm, pose_from_matrix(above, rotation))
         obj = robot.frame.objects[self.args.obj]
@@ -270,6 +343,21 @@ class Place(ArmAction):
         yield from grip(robot, arm, 0.0, ticks=8)
         # Back off along the approach (straight up after a top grasp).
         retreat = down - 0.08 * rotation[:, 0] + np.array([0.0, 0.0, 0.04 if rotation[2, 0] > -0.7 else 0.0])
+        yield from move_to(robot, arm, pose_from_matrix(retreat, rotation))
+
+    def _standing(self, robot: RobotController) -> bool:
+        """Whether the object already stands upright on the table (an earlier place released it)."""
+        feats = robot.frame.objects[self.args.obj]
+        return _tilt_deg(feats.axis) <= UPRIGHT_TOLERANCE_DEG and min(feats.bottom[2], feats.top[2]) < 0.01
+
+    def _release_and_retreat(self, robot: RobotController) -> Iterator[None]:
+        """Open (if still closed) and back off from where the tool is: the rest of an interrupted place."""
+        arm = self.arm
+        if robot.targets[arm].grip > 0.0:
+            yield from grip(robot, arm, 0.0, ticks=8)
+        rotation = _level(robot.rotation(arm))
+        tool = robot.commanded_pose(arm).pos
+        retreat = tool - 0.08 * rotation[:, 0] + np.array([0.0, 0.0, 0.04 if rotation[2, 0] > -0.7 else 0.0])
         yield from move_to(robot, arm, pose_from_matrix(retreat, rotation))
 
 

@@ -11,7 +11,7 @@ from agentchord.execution.executor import EpisodeResult, Executor, ExecutorConfi
 from agentchord.execution.strategies import make_strategy
 from agentchord.graph.models import TaskGraph
 from agentchord.tasks import load_task_graph
-from agentchord.worlds.sim.disturbances import Disturbance, RandomDrop
+from agentchord.worlds.sim.disturbances import Disturbance, ProtocolDisturbances, RandomDisturbances
 from agentchord.worlds.sim.tasks import SIM_TASKS
 from agentchord.worlds.sim.world import SimWorld
 
@@ -27,7 +27,11 @@ class EpisodeSpec:
         seed: Seeds the scene (object instances, poses) and the disturbance schedule.
         graph: The graph to run; None = the task library's graph.
         config: Budgets.
-        disturbance: A disturbance to use instead of the random drop of ``p``.
+        disturb: Disturbance kinds drawn (``drop`` is the paper's simulated one).
+        protocol: The paper's real-world protocol: one or two disturbances of the
+            ``disturb`` kinds at random moments, whatever ``p``.
+        disturbance: A disturbance schedule to use instead (tests, scripted demos).
+        perception: ``oracle`` or ``rgbd`` features.
     """
 
     task: str
@@ -36,7 +40,18 @@ class EpisodeSpec:
     seed: int = 0
     graph: TaskGraph | None = None
     config: ExecutorConfig | None = None
+    disturb: tuple[str, ...] = ("drop",)
+    protocol: bool = False
+    perception: str = "oracle"
     disturbance: Disturbance | None = None
+
+    def make_disturbance(self) -> Disturbance | None:
+        """The seeded disturbance schedule this spec asks for."""
+        if self.disturbance is not None:
+            return self.disturbance
+        if self.protocol:
+            return ProtocolDisturbances(self.seed, self.disturb)
+        return RandomDisturbances(self.p, self.seed, self.disturb) if self.p > 0 else None
 
 
 def run_episode(spec: EpisodeSpec, on_tick: Callable[[Executor], None] | None = None) -> EpisodeResult:
@@ -57,9 +72,10 @@ def run_episode(spec: EpisodeSpec, on_tick: Callable[[Executor], None] | None = 
         world=world,
         strategy=make_strategy(spec.strategy),
         tracker=task.success_tracker(),
-        disturbance=spec.disturbance or (RandomDrop(spec.p, spec.seed) if spec.p > 0 else None),
+        disturbance=spec.make_disturbance(),
         config=spec.config,
         on_tick=on_tick,
+        perception=spec.perception,
     )
     result = executor.run()
     result.trace.events[0].update({"seed": spec.seed, "p": spec.p})

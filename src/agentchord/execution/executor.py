@@ -24,11 +24,11 @@ from agentchord.execution.strategies import RecoveryStrategy
 from agentchord.execution.trace import Trace
 from agentchord.expr import Vocabulary, compile_expr
 from agentchord.features.frame import FeatureFrame
-from agentchord.features.oracle import OracleExtractor
+from agentchord.features.extractors import make_extractor
 from agentchord.graph.models import TaskGraph
 from agentchord.graph.progress import forward_filter, nominal_path
 from agentchord.monitor import Detection, EdgeMonitors, RecoveryMap
-from agentchord.worlds.sim.disturbances import Disturbance
+from agentchord.worlds.sim.disturbances import Disturbance, DisturbanceEvent
 from agentchord.worlds.sim.tasks import SuccessTracker
 from agentchord.worlds.sim.world import CONTROL_HZ, SimWorld
 
@@ -48,7 +48,12 @@ class ExecutorConfig:
 
 @dataclass
 class EpisodeResult:
-    """What an episode did: the metrics of DESIGN section 7."""
+    """What an episode did: the metrics of DESIGN section 7.
+
+    ``drops_*`` count the paper's drop disturbance; ``disturbances`` maps every injected
+    kind to [injected, detected, recovered]. Reaction latencies are ticks from a
+    disturbance to the first detection after it.
+    """
 
     success: bool
     reason: str
@@ -62,6 +67,7 @@ class EpisodeResult:
     drops_detected: int
     drops_recovered: int
     reaction_latency_ticks: list[int]
+    disturbances: dict[str, list[int]]
     trace: Trace = field(repr=False)
 
     def summary(self) -> dict:
@@ -78,6 +84,7 @@ class EpisodeResult:
             "drops_detected": self.drops_detected,
             "drops_recovered": self.drops_recovered,
             "reaction_latency_ticks": self.reaction_latency_ticks,
+            "disturbances": self.disturbances,
             "path": self.path,
         }
 
@@ -93,6 +100,8 @@ class Executor:
         disturbance: Seeded disturbance schedule (None: undisturbed).
         config: Budgets.
         on_tick: Called after every tick (video recording).
+        perception: ``oracle`` (simulator state) or ``rgbd`` (rendered depth and
+            segmentation of two cameras at 10 Hz, fused and shape-fitted).
     """
 
     def __init__(
@@ -104,6 +113,7 @@ class Executor:
         disturbance: Disturbance | None = None,
         config: ExecutorConfig | None = None,
         on_tick: Callable[[Executor], None] | None = None,
+        perception: str = "oracle",
     ) -> None:
         filtered = forward_filter(graph)
         self.graph = filtered.graph
@@ -117,7 +127,7 @@ class Executor:
         for removed in filtered.removed:
             self.trace.add(0, "branch_removed", failure=removed.failure, edge=removed.edge, reason=removed.reason)
         self.robot = RobotController(world)
-        self.extractor = OracleExtractor(world, grasp_signal=lambda arm: self.robot.targets[arm].grip_closed_settled)
+        self.extractor = make_extractor(perception, world, lambda arm: self.robot.targets[arm].grip_closed_settled)
         self.robot.frame = self.extractor.frame
         vocabulary = Vocabulary(frozenset(self.graph.objects))
         # Compile once, before execution: the tick loop only evaluates closures.
@@ -136,12 +146,12 @@ class Executor:
         self.recovering_from: str | None = None
         self.fire_counts: dict[tuple[str, str], int] = {}
         self.node = self.graph.start
-        self._open_drop: dict | None = None
+        self._open_disturbance: DisturbanceEvent | None = None
         self._latencies: list[int] = []
-        self._drops_detected = 0
-        self._drops_recovered = 0
-        # Drops detected whose recovery has not merged back yet (a second drop can interrupt the first's).
-        self._unmerged_drops = 0
+        self._detected: list[DisturbanceEvent] = []
+        self._recovered: list[DisturbanceEvent] = []
+        # Detected disturbances whose recovery has not merged back yet (a second one can interrupt the first's).
+        self._unmerged: list[DisturbanceEvent] = []
 
     # ------------------------------------------------------------- queries
     @property
@@ -169,6 +179,7 @@ class Executor:
             if outcome is not None:
                 success, reason = outcome
                 break
+        injected = self.disturbance.events if self.disturbance is not None else []
         result = EpisodeResult(
             success=success,
             reason=reason,
@@ -178,13 +189,18 @@ class Executor:
             path=self.path,
             failures_detected=len(self.trace.of("failure_detected")),
             recoveries=len(self.trace.of("recovery_switch")),
-            drops_injected=sum(e.kind == "drop" for e in self.disturbance.events) if self.disturbance else 0,
-            drops_detected=self._drops_detected,
-            drops_recovered=self._drops_recovered,
+            drops_injected=sum(e.kind == "drop" for e in injected),
+            drops_detected=sum(e.kind == "drop" for e in self._detected),
+            drops_recovered=sum(e.kind == "drop" for e in self._recovered),
+            disturbances={kind: [sum(e.kind == kind for e in group) for group in (injected, self._detected, self._recovered)]
+                          for kind in sorted({e.kind for e in injected})},
             reaction_latency_ticks=self._latencies,
             trace=self.trace,
         )
         self.trace.add(self.world.tick, "episode_end", success=success, reason=reason, steps=result.steps)
+        close = getattr(self.extractor, "close", None)
+        if close is not None:
+            close()
         return result
 
     def _tick(self) -> tuple[bool, str] | None:
@@ -193,8 +209,7 @@ class Executor:
         if self.disturbance is not None:
             event = self.disturbance.apply(self.world, frame)
             if event is not None:
-                if event.kind == "drop":
-                    self._open_drop = {"tick": event.tick, "obj": event.obj}
+                self._open_disturbance = event
                 self.trace.add(event.tick, "disturbance", kind=event.kind, arm=event.arm, obj=event.obj, action=event.action)
         if self.world.tick >= self.config.tick_limit:
             return False, f"tick limit {self.config.tick_limit} reached at {self._where()}"
@@ -234,8 +249,8 @@ class Executor:
             if self.recovering_from is not None:
                 self.recovering_from = None
                 self.trace.add(self.world.tick, "recovery_merged", node=node_id)
-                self._drops_recovered += self._unmerged_drops
-                self._unmerged_drops = 0
+                self._recovered.extend(self._unmerged)
+                self._unmerged = []
         if node_id == self.graph.goal:
             verdict = self.tracker.verdict(self.frame, self.world)
             return verdict.success, verdict.reason
@@ -281,11 +296,12 @@ class Executor:
         self.fire_counts[key] = self.fire_counts.get(key, 0) + 1
         self.trace.add(detection.tick, "failure_detected", edge=detection.edge_id, failure=detection.failure.name,
                        onset_tick=detection.onset_tick, value=detection.value, count=self.fire_counts[key])
-        if self._open_drop is not None:
-            self._drops_detected += 1
-            self._latencies.append(detection.tick - self._open_drop["tick"])
-            self._unmerged_drops += 1
-            self._open_drop = None
+        if self._open_disturbance is not None:
+            # The first detection after a disturbance is its detection.
+            self._detected.append(self._open_disturbance)
+            self._latencies.append(detection.tick - self._open_disturbance.tick)
+            self._unmerged.append(self._open_disturbance)
+            self._open_disturbance = None
         if self.fire_counts[key] > self.config.failure_budget:
             return False, f"failure budget exhausted: {detection.failure.name} on {detection.edge_id} fired {self.fire_counts[key]} times"
         self.program.terminate(Status.INVALID)
@@ -304,7 +320,7 @@ class Executor:
         self.trace.add(self.world.tick, "action_start", arm=arm, action=action.describe())
         if self.disturbance is not None:
             spec = ACTIONS.get(action.name)
-            self.disturbance.action_started(arm, action.name, spec.expected_ticks if spec else 100, self.world.tick)
+            self.disturbance.action_started(arm, action, spec.expected_ticks if spec else 100, self.world.tick)
 
     def _action_ended(self, arm: str, action: ArmAction) -> None:
         if self.disturbance is not None:

@@ -95,9 +95,20 @@ def pca(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return centroid, values[order], vectors[:, order]
 
 
+#: Smallest |cos| between a new axis and the last estimate for the last estimate to set its sign.
+CONTINUITY_COS = 0.5
+
+
 def orient(axis: np.ndarray, reference: np.ndarray | None) -> np.ndarray:
-    """Flip ``axis`` to point the same way as ``reference`` (the last estimate), else up."""
-    ref = UP if reference is None or not np.any(reference) else reference
+    """Flip ``axis`` to point the same way as ``reference`` (the last estimate), else up.
+
+    A cylinder's two ends look alike, so the sign of its axis ("top") follows
+    the last estimate while that is informative (within 60 degrees, e.g. a
+    bottle tilted past horizontal in a pour); otherwise (first sight, or the
+    object turned a lot between frames) the up-pointing end is the top.
+    """
+    use_ref = reference is not None and np.any(reference) and abs(float(np.dot(axis, reference))) >= CONTINUITY_COS
+    ref = reference if use_ref else UP
     return -axis if float(np.dot(axis, ref)) < 0.0 else axis
 
 
@@ -427,9 +438,11 @@ def fit_box(
         hinted = False
     (centre, rot, half), _ = _lm_box(points, best[0], half_sizes, iterations=iterations, toward=toward)
     rot, half = _match_axes(rot, half, half_sizes)
-    # Sign of the principal (z) axis: consistent with the last estimate, else up.
-    if float(rot[:, 2] @ (rot_hint[:, 2] if rot_hint is not None else UP)) < 0:
+    # Sign of the principal (z) axis: consistent with the last estimate, else up (see orient).
+    if float(rot[:, 2] @ orient(rot[:, 2], None if rot_hint is None else rot_hint[:, 2])) < 0:
         rot = rot @ np.diag([-1.0, 1.0, -1.0])
+    if rot_hint is not None and float(rot[:, 0] @ rot_hint[:, 0]) < 0:
+        rot = rot @ np.diag([-1.0, -1.0, 1.0])  # the same box, turned like the last estimate
     sdf, _ = _box_residuals(points, centre, rot, half, jac=False, toward=toward)
     return ShapeFit(pos=centre, rot=rot, size=half, rms=float(np.sqrt(np.mean(sdf**2))))
 

@@ -125,6 +125,8 @@ class DepthCamera:
     def capture(self, data: mujoco.MjData) -> CameraImage:
         """Render the current state."""
         r = self.renderer
+        if r is None:
+            raise RuntimeError(f"camera {self.camera!r} was closed")
         r.update_scene(data, camera=self.camera_id, scene_option=self.option)
         if self.single_pass:
             depth, seg = self._render_single_pass()
@@ -373,7 +375,12 @@ class RgbdExtractor:
             feats.points = float(count)
             if count < self.min_points:
                 continue  # occluded or out of view: keep the last estimate
-            self._write(name, self.fit(name, views, origins))
+            try:
+                fit = self.fit(name, views, origins)
+            except np.linalg.LinAlgError:
+                continue  # a degenerate cloud (a sliver): keep the last estimate
+            if np.all(np.isfinite(fit.pos)) and np.all(np.isfinite(fit.rot)):
+                self._write(name, fit)
         self.last_perceived_tick = self.world.tick
         self.perceptions += 1
         self.costs_ms.append((time.perf_counter() - t0) * 1e3)

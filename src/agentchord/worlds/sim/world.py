@@ -111,6 +111,19 @@ class SimWorld:
         self.data.xfrc_applied[body, 3:] = np.cross(base, force)
         self._push_until[body] = self.tick + ticks
 
+    def knock(self, obj: str, direction: np.ndarray, ticks: int = 6) -> None:
+        """Knock an object over: a horizontal push high on it, scaled to tip it."""
+        spec = self.object_spec(obj)
+        body = self._object_body[obj]
+        direction = np.asarray(direction, dtype=float)
+        direction = direction / max(np.linalg.norm(direction), 1e-9)
+        # Tipping needs F * h > m g * (half width): push with twice that.
+        force = 2.0 * spec.mass * 9.81 * (0.5 * spec.width) / max(spec.height, 1e-3) * direction
+        top = np.array([0.0, 0.0, 0.5 * spec.height])
+        self.data.xfrc_applied[body, :3] = force
+        self.data.xfrc_applied[body, 3:] = np.cross(top, force)
+        self._push_until[body] = self.tick + ticks
+
     def gripper_faulted(self, arm: str) -> bool:
         """Whether a gripper fault is forcing ``arm`` open now."""
         return self._fault_until.get(arm, -1) > self.tick

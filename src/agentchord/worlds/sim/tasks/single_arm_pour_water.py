@@ -68,7 +68,8 @@ class SingleArmPourWater:
     BOTTLE_HALF_HEIGHT = (0.08, 0.10)
     BOTTLE_MASS = (0.15, 0.35)
     BOTTLE_XY = ((0.04, 0.12), (0.48, 0.60))
-    CUP_RADIUS = (0.035, 0.045)
+    # Narrow enough for the other gripper (6.9 cm) to set a knocked-over cup upright.
+    CUP_RADIUS = (0.026, 0.030)
     CUP_HALF_HEIGHT = (0.04, 0.055)
     CUP_MASS = (0.15, 0.30)
     CUP_XY = ((-0.14, -0.06), (0.52, 0.64))

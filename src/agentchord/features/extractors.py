@@ -1,0 +1,27 @@
+"""Choose a feature extractor by name: ``oracle`` or ``rgbd``."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from agentchord.worlds.sim.world import SimWorld
+
+#: Names accepted by ``--perception``.
+PERCEPTION_MODES = ("oracle", "rgbd")
+
+
+def make_extractor(mode: str, world: SimWorld, grasp_signal: Callable[[str], bool]):
+    """The feature extractor for a perception mode.
+
+    Raises:
+        ValueError: Unknown mode.
+    """
+    if mode == "oracle":
+        from agentchord.features.oracle import OracleExtractor  # noqa: PLC0415
+
+        return OracleExtractor(world, grasp_signal=grasp_signal)
+    if mode == "rgbd":
+        from agentchord.features.rgbd import RgbdExtractor  # noqa: PLC0415  (imports the renderer)
+
+        return RgbdExtractor(world, grasp_signal=grasp_signal)
+    raise ValueError(f"unknown perception mode {mode!r} (choose from: {', '.join(PERCEPTION_MODES)})")
