@@ -1,0 +1,80 @@
+"""Exceptions of the agents package.
+
+Every error a reasoner raises is a :class:`ReasonerError`; its message says what
+was expected and what came, and, when the call got that far, the
+:class:`~agentchord.agents.reasoner.ReasonerCall` record of the failed call is
+attached (it is also in the reasoner's ``calls`` list).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from agentchord.agents.reasoner import ReasonerCall
+
+
+class ReasonerError(Exception):
+    """A reasoner could not produce a valid result.
+
+    Attributes:
+        agent: The agent whose call failed (``composer``, ``arranger``, ``conductor``), if known.
+        headline: The message without the list of problems.
+        problems: One line per problem, the last ones seen.
+        call: The record of the failed call, if one was made.
+    """
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        agent: str | None = None,
+        problems: Sequence[str] = (),
+        call: ReasonerCall | None = None,
+    ) -> None:
+        self.agent = agent
+        self.headline = message
+        self.problems = list(problems)
+        self.call = call
+        lines = [message, *(f"  - {problem}" for problem in self.problems)]
+        super().__init__("\n".join(lines))
+
+
+class ReasonerConfigError(ReasonerError):
+    """A reasoner is missing a setting (endpoint, model, key) or has an invalid one.
+
+    Attributes:
+        missing: Names of the environment variables that were needed and unset.
+    """
+
+    def __init__(self, message: str, *, missing: Sequence[str] = (), problems: Sequence[str] = ()) -> None:
+        self.missing = list(missing)
+        super().__init__(message, problems=problems)
+
+
+class ReasonerTransportError(ReasonerError):
+    """The endpoint could not be reached, or refused the request, after every retry.
+
+    Attributes:
+        status: HTTP status of the last response, ``None`` for a connection error or timeout.
+    """
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        agent: str | None = None,
+        status: int | None = None,
+        problems: Sequence[str] = (),
+        call: ReasonerCall | None = None,
+    ) -> None:
+        self.status = status
+        super().__init__(message, agent=agent, problems=problems, call=call)
+
+
+class InvalidReplyError(ReasonerError):
+    """Every reply, repairs included, failed the schema or the semantic checks.
+
+    ``problems`` lists the problems of the last reply.
+    """
