@@ -15,7 +15,7 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
 from agentchord import __version__
-from agentchord.graph.cli import graph_group, schema_command
+from agentchord.graph.cli import graph_group, import_release_command, schema_command
 
 STRATEGY_NAMES = ("agentchord", "agentchord-bt")
 PERCEPTION_NAMES = ("oracle", "rgbd")
@@ -46,6 +46,7 @@ def main() -> None:
 
 main.add_command(schema_command)
 main.add_command(graph_group)
+main.add_command(import_release_command)
 
 
 @main.command()

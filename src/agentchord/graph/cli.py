@@ -111,3 +111,90 @@ def filter_command(file: Path, output: Path | None) -> None:
         except GraphFileError as error:
             raise click.ClickException(str(error)) from None
         click.echo(f"wrote {output}")
+
+
+@click.command("import-release")
+@click.argument("task_graph", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.argument("recovery_spec", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.option(
+    "-o",
+    "--output",
+    "output",
+    required=True,
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="Write the augmented graph here (.yaml/.yml/.json).",
+)
+@click.option("--task", "task", default=None, help="Our task name (default: the sim task matching the release's).")
+@click.option(
+    "--objects",
+    default=None,
+    help="The graph's objects, comma-separated; NAME or RELEASE_NAME=NAME to rename (default: the release's names).",
+)
+@click.option(
+    "--frame",
+    default="aloha",
+    show_default=True,
+    help="Release frame -> ours: aloha ((x, y, z) -> (-y, x, z)), identity, or yaw=DEG,dx=M,dy=M,dz=M.",
+)
+@click.option("--quiet", is_flag=True, help="Do not list what was dropped or approximated.")
+def import_release_command(
+    task_graph: Path, recovery_spec: Path, output: Path, task: str | None, objects: str | None, frame: str, quiet: bool
+) -> None:
+    """Import the AgentChord reference release's TASK_GRAPH.json and RECOVERY_SPEC.json as one augmented graph.
+
+    Every drop or approximation is listed as ``note: FILE: json.path: what``; anything that
+    cannot be mapped is an error naming the file, the JSON path and the problem (exit 2).
+    The mapping is documented in ``agentchord.graph.interop``.
+    """
+    from agentchord.graph.interop import FrameMap, ReleaseImportError, import_release  # noqa: PLC0415
+
+    try:
+        frame_map = FrameMap.parse(frame)
+    except ValueError as error:
+        raise click.BadParameter(str(error), param_hint="--frame") from None
+    names = None if objects is None else [o.strip() for o in objects.split(",") if o.strip()]
+    try:
+        result = import_release(task_graph, recovery_spec, task=task, objects=names, frame=frame_map)
+    except ReleaseImportError as error:
+        for line in error.problems:
+            click.echo(line, err=True)
+        sys.exit(2)
+    if not quiet:
+        for line in result.notes:
+            click.echo(f"note: {line}")
+    try:
+        dump_graph(result.graph, output)
+    except GraphFileError as error:
+        raise click.ClickException(str(error)) from None
+    if output.suffix.lower() in (".yaml", ".yml"):
+        header = [
+            f"# Imported by `agentchord import-release` from {task_graph} and {recovery_spec}",
+            f"# (frame {frame}); dropped or approximated:",
+            *(f"#   {line}" for line in result.notes),
+        ]
+        output.write_text("\n".join(header) + "\n" + output.read_text(encoding="utf-8"), encoding="utf-8")
+    graph = result.graph
+    _warn_sim_objects(graph)
+    click.echo(
+        f"wrote {output}: task {graph.task}, {len(graph.nodes)} nodes, {len(graph.edges)} edges, "
+        f"{len(graph.failures())} failure modes"
+    )
+
+
+def _warn_sim_objects(graph: TaskGraph) -> None:
+    """Say so when the graph names objects that its simulated task's scene lacks."""
+    import numpy as np  # noqa: PLC0415
+
+    from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: PLC0415
+
+    task = SIM_TASKS.get(graph.task)
+    if task is None:
+        click.echo(f"note: no simulated task {graph.task!r}: the graph can be checked, not run")
+        return
+    scene = {obj.name for obj in task.sample_scene(np.random.default_rng(0)).objects}
+    missing = [obj for obj in graph.objects if obj not in scene]
+    if missing:
+        click.echo(
+            f"warning: the {graph.task} scene has no {', '.join(missing)} (it has {', '.join(sorted(scene))}): "
+            "rename with --objects RELEASE_NAME=NAME"
+        )
