@@ -25,7 +25,10 @@ class GraspArgs(_Args):
     obj: str
     pre_grasp_dis: float = Field(0.08, ge=0.0, le=0.3, description="Stand-off before the final approach (m).")
     height: float = Field(0.5, ge=0.1, le=0.9, description="Side grasp: height as a fraction of the object's height.")
-    lift: float = Field(0.06, ge=0.0, le=0.3, description="Lift after closing (m).")
+    lift: float = Field(
+        0.06, ge=0.0, le=0.3,
+        description="Lift after closing (m); a top grasp lifts at least 4 cm, unless 0 (stay on the table: a two-arm grasp lifts afterwards).",
+    )
     mode: Literal["auto", "side", "top"] = Field(
         "auto", description="side: horizontal approach; top: from above; auto: side for tall upright objects, else top."
     )

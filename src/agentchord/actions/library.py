@@ -55,28 +55,30 @@ def _yaw_turn(robot: RobotController, arm: str, direction: np.ndarray, yaw_deg: 
     """Rotation about world z that brings ``direction``'s yaw to ``yaw_deg``, either way round (mod 180).
 
     Of the two turns, the smaller one unless it would drive the wrist-rotate joint (whose axis
-    is the tool's approach) past its range: a top grasp often leaves that joint near a limit.
+    is the tool's approach) past its range: a top grasp often leaves that joint at a limit.
     The waist's own turn toward ``goal`` (x, y) is accounted for.
     """
     current = np.degrees(np.arctan2(direction[1], direction[0]))
     delta = (yaw_deg - current + 90.0) % 180.0 - 90.0
     candidates = [delta] if abs(delta) < 1e-6 else [delta, delta - np.copysign(180.0, delta)]
-    joint = robot.ik.model.joint(f"{ARM_PREFIX[arm]}/wrist_rotate")
-    lo, hi = joint.range
+    best = candidates[0]
+    if _wrist_margin(robot, arm, best, goal) < 0.0:
+        best = max(candidates, key=lambda turn: _wrist_margin(robot, arm, turn, goal))
+    return Rotation.from_euler("z", best, degrees=True).as_matrix()
+
+
+def _wrist_margin(robot: RobotController, arm: str, turn_deg: float, goal: np.ndarray) -> float:
+    """Predicted distance (rad) of the wrist-rotate joint to its range after turning the tool
+    ``turn_deg`` about world z while moving to ``goal`` (x, y); the waist's own turn is accounted for."""
+    lo, hi = robot.ik.model.joint(f"{ARM_PREFIX[arm]}/wrist_rotate").range
     q = robot.ik.arm_q(arm)[ARM_JOINTS.index("wrist_rotate")]
     base = robot.world.arm_base(arm)[:2]
-    here, there = robot.commanded_pose(arm).pos[:2] - base, np.asarray(goal) - base
+    here, there = robot.commanded_pose(arm).pos[:2] - base, np.asarray(goal)[:2] - base
     waist = np.degrees(np.arctan2(there[1], there[0]) - np.arctan2(here[1], here[0]))
     waist = (waist + 180.0) % 360.0 - 180.0
     # A turn about world z is a turn about the approach axis scaled by its vertical component.
-    approach_z = robot.rotation(arm)[2, 0]
-
-    def margin(turn: float) -> float:
-        after = q + np.radians(turn - waist) * approach_z
-        return min(after - lo, hi - after)
-
-    best = candidates[0] if margin(candidates[0]) >= 0.3 else max(candidates, key=margin)
-    return Rotation.from_euler("z", best, degrees=True).as_matrix()
+    after = q + np.radians(turn_deg - waist) * robot.rotation(arm)[2, 0]
+    return float(min(after - lo, hi - after))
 
 
 class Grasp(ArmAction):
@@ -203,6 +205,17 @@ class Grasp(ArmAction):
         outward = feats.pos - robot.world.arm_base(self.arm)
         if np.dot(long_dir[:2], outward[:2]) < 0:
             long_dir = -long_dir
+        current = robot.rotation(self.arm)
+        if current[2, 0] < -0.7:
+            # Already top-down (a regrasp): the orientation nearer the tool's current one, unless
+            # that would drive the wrist-rotate joint past its range.
+            def turn(direction: np.ndarray) -> float:
+                diff = np.arctan2(direction[1], direction[0]) - np.arctan2(current[1, 2], current[0, 2])
+                return float((np.degrees(diff) + 180.0) % 360.0 - 180.0)
+
+            near, far = sorted((long_dir, -long_dir), key=lambda d: abs(turn(d)))
+            keep = _wrist_margin(robot, self.arm, turn(near), feats.pos)
+            long_dir = far if keep < 0.0 and _wrist_margin(robot, self.arm, turn(far), feats.pos) > keep else near
         down = np.array([0.0, 0.0, -1.0])
         rotation = np.column_stack([down, np.cross(long_dir, down), long_dir])
         lying = _tilt_deg(feats.axis) >= self.FALLEN_DEG
@@ -224,7 +237,9 @@ class Grasp(ArmAction):
         rotation, point = self._top_frame(robot)
         yield from move_to(robot, arm, pose_from_matrix(point, rotation), speed=0.08)
         yield from self._close_and_check(robot)
-        lift = robot.commanded_pose(arm).pos + np.array([0.0, 0.0, max(self.args.lift, 0.04)])
+        # lift 0 leaves the object on the table (two arms grasping one tray lift it together afterwards).
+        lift_by = 0.0 if self.args.lift == 0.0 else max(self.args.lift, 0.04)
+        lift = robot.commanded_pose(arm).pos + np.array([0.0, 0.0, lift_by])
         yield from move_to(robot, arm, pose_from_matrix(lift, rotation), speed=0.15)
 
     def _fallen_grasp(self, robot: RobotController) -> Iterator[None]:
@@ -305,12 +320,18 @@ class Place(ArmAction):
     name = "place"
     args: catalog.PlaceArgs
 
+    #: Ticks to wait before failing on an object that is not held: one dropped as the previous
+    #: action ended is then reported by the edge's drop monitor (its persistence window) instead.
+    DROP_GRACE_TICKS = 8
+
     def script(self, robot: RobotController) -> Iterator[None]:
         arm = self.arm
         if not robot.frame.is_holding(arm, self.args.obj):
             if self.args.skip_if_placed and self._standing(robot):
                 yield from self._release_and_retreat(robot)
                 return
+            for _ in range(self.DROP_GRACE_TICKS):
+                yield
             raise ActionFailed(f"{self.args.obj} is not held: nothing to place")
         if self.args.relative_to is not None:
             # A pushed reference may still be sliding: aim at where it stops.

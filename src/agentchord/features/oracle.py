@@ -40,6 +40,16 @@ class OracleExtractor:
             self.frame.objects[name] = ObjectFeatures(
                 pos=np.zeros(3), quat=np.zeros(4), axis=np.zeros(3), extent=extent, top=np.zeros(3), bottom=np.zeros(3)
             )
+        # A cloth's named points (its corners) are point-like objects: ``pos`` is the vertex, ``top`` and
+        # ``bottom`` are half a cloth thickness above and below it, ``axis`` is up, and the local x axis of
+        # ``quat`` is the corner's horizontal outward diagonal (a top grasp closes across it).
+        self._cloth_radius = world.scene.cloth.radius if getattr(world.scene, "cloth", None) is not None else 0.0
+        self._cloth_points = list(getattr(world, "cloth_point_names", []))
+        for name in self._cloth_points:
+            self.frame.objects[name] = ObjectFeatures(
+                pos=np.zeros(3), quat=np.zeros(4), axis=np.zeros(3), extent=np.full(3, 2 * self._cloth_radius),
+                top=np.zeros(3), bottom=np.zeros(3),
+            )
         for arm in ARMS:
             self.frame.arms[arm] = ArmFeatures(ee=np.zeros(3), ee_quat=np.zeros(4), q=np.zeros(6), width=0.0, closed=0.0)
         self.update()
@@ -48,7 +58,20 @@ class OracleExtractor:
     def update(self) -> FeatureFrame:
         """Refresh the frame from the current simulator state."""
         world, frame = self.world, self.frame
+        for name in self._cloth_points:
+            feats = frame.objects[name]
+            pos, out = world.cloth_point(name)
+            if not out.any():
+                out = np.array([1.0, 0.0, 0.0])
+            up = np.array([0.0, 0.0, 1.0])
+            feats.pos = pos
+            feats.quat = _quat_from_matrix(np.column_stack([out, np.cross(up, out), up]))
+            feats.axis = up
+            feats.top = pos + self._cloth_radius * up
+            feats.bottom = pos - self._cloth_radius * up
         for name, feats in frame.objects.items():
+            if name in self._cloth_points:
+                continue
             pos, rot = world.object_pose(name)
             axis = rot[:, 2]
             half = self._half_heights[name] * axis

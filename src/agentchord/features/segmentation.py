@@ -39,8 +39,8 @@ class Segmenter(Protocol):
 class SimSegmenter:
     """The simulator's ground-truth segmentation: geom id -> object name.
 
-    Every geom attached to an object's body counts as that object (the scene's
-    objects have one geom each, named like the object).
+    Every geom attached to an object's body counts as that object (most objects
+    have one geom, named like the object; a compound one, such as a tray, has several).
 
     Args:
         model: The compiled MuJoCo model.

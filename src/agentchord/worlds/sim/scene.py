@@ -61,6 +61,12 @@ class ObjectSpec:
         yaw: Initial rotation about z (rad).
         rgba: Colour.
         friction: Sliding friction coefficient.
+        parts: A compound object (a tray with a rim): box geoms, each (half-sizes,
+            centre in the body frame), that together make the object; then ``shape``
+            must be ``box`` and ``size`` gives the half-sizes of their overall bounding
+            box, centred on the body origin (what features such as ``extent``, ``top``
+            and ``bottom`` describe). The mass is spread over the parts by volume.
+            Empty (the default): one geom of ``shape`` and ``size``.
     """
 
     name: str
@@ -71,6 +77,7 @@ class ObjectSpec:
     yaw: float = 0.0
     rgba: tuple[float, float, float, float] = (0.2, 0.5, 0.9, 1.0)
     friction: float = 1.0
+    parts: tuple[tuple[tuple[float, float, float], tuple[float, float, float]], ...] = ()
 
     @property
     def height(self) -> float:
@@ -84,11 +91,70 @@ class ObjectSpec:
 
 
 @dataclass
+class ClothSpec:
+    """A cloth lying flat on the table: a MuJoCo flex grid (``flexcomp``, dim 2), no rigid body.
+
+    Vertex ``k`` of the grid is ``ix * count[1] + iy`` (``iy`` runs fastest); in the cloth's own
+    frame the corners are ``bl`` (x-min, y-min), ``br`` (x-max, y-min), ``tl`` (x-min, y-max) and
+    ``tr`` (x-max, y-max). The world exposes them as points ``{name}_bl`` ... (see
+    ``SimWorld.cloth_point``). MuJoCo 3.8 caps one flex/geom pair at 50 contacts, so the table
+    supports a coarse grid only (7x7: 72 elements, most in contact); a finer cloth sags into it.
+
+    Attributes:
+        name: Flex name; its vertex bodies are ``{name}_{k}``.
+        size: Full size (x, y) of the flat cloth (m).
+        count: Vertices along x and y.
+        mass: Total mass (kg), spread evenly over the vertices.
+        pos: Centre (x, y) on the table.
+        yaw: Rotation about z (rad).
+        radius: Half thickness (m): the collision radius of the flex elements.
+        friction: Sliding friction of every cloth contact (the cloth's contacts take priority
+            over the other geom's parameters: the fingers' condim-4 contact made the solver
+            return NaN on flex elements).
+        rgba: Colour.
+    """
+
+    name: str = "cloth"
+    size: tuple[float, float] = (0.30, 0.24)
+    count: tuple[int, int] = (7, 7)
+    mass: float = 0.06
+    pos: tuple[float, float] = (0.0, 0.55)
+    yaw: float = 0.0
+    radius: float = 0.004
+    friction: float = 1.5
+    rgba: tuple[float, float, float, float] = (0.85, 0.3, 0.3, 1.0)
+
+    def corner_vertices(self) -> dict[str, tuple[int, int]]:
+        """Corner label -> (corner vertex, its diagonal neighbour inside the cloth)."""
+        nx, ny = self.count
+        k = lambda ix, iy: ix * ny + iy  # noqa: E731
+        return {
+            "bl": (k(0, 0), k(1, 1)),
+            "br": (k(nx - 1, 0), k(nx - 2, 1)),
+            "tl": (k(0, ny - 1), k(1, ny - 2)),
+            "tr": (k(nx - 1, ny - 1), k(nx - 2, ny - 2)),
+        }
+
+
+def _cloth_xml(cloth: ClothSpec) -> str:
+    """The ``flexcomp`` element of a cloth (MjSpec has no flexcomp builder: it goes in the XML)."""
+    (nx, ny), (sx, sy) = cloth.count, cloth.size
+    return f"""<flexcomp name="{cloth.name}" type="grid" dim="2" count="{nx} {ny} 1"
+      spacing="{sx / (nx - 1)} {sy / (ny - 1)} {4 * cloth.radius + 0.01}" pos="{cloth.pos[0]} {cloth.pos[1]} {cloth.radius + 0.001}"
+      euler="0 0 {cloth.yaw}" radius="{cloth.radius}" mass="{cloth.mass}" rgba="{' '.join(map(str, cloth.rgba))}">
+      <contact condim="3" priority="1" friction="{cloth.friction} 0.005 0.0001" solref="0.01 1"
+        solimp="0.95 0.99 0.0001" selfcollide="none"/>
+      <edge equality="true" damping="0.01"/>
+    </flexcomp>"""
+
+
+@dataclass
 class SceneSpec:
-    """Everything needed to build one trial's scene."""
+    """Everything needed to build one trial's scene (``cloth``: an optional flex cloth, None = none)."""
 
     objects: list[ObjectSpec] = field(default_factory=list)
     timestep: float = 0.002
+    cloth: ClothSpec | None = None
 
 
 def _edit_robot(spec: mujoco.MjSpec) -> None:
@@ -171,10 +237,7 @@ def _add_object(spec: mujoco.MjSpec, obj: ObjectSpec) -> None:
     body = spec.worldbody.add_body(name=obj.name, pos=[obj.pos[0], obj.pos[1], z], quat=quat)
     body.add_freejoint(name=f"{obj.name}_free")
     geom_type = mujoco.mjtGeom.mjGEOM_CYLINDER if obj.shape == "cylinder" else mujoco.mjtGeom.mjGEOM_BOX
-    body.add_geom(
-        name=obj.name,
-        type=geom_type,
-        size=list(obj.size) + [0.0] * (3 - len(obj.size)),
+    contact = dict(
         rgba=list(obj.rgba),
         # Rolling friction (condim 6): a fallen bottle comes to rest instead of rolling away.
         friction=[obj.friction, 0.005, 0.003],
@@ -184,6 +247,21 @@ def _add_object(spec: mujoco.MjSpec, obj: ObjectSpec) -> None:
         # Group-0 geoms get no mass from inertiagrouprange="4 5": inertia is explicit.
         mass=0.0,
     )
+    if obj.parts:
+        if obj.shape != "box":
+            raise SceneError(f"{obj.name}: a compound object (parts) needs shape 'box' (its bounding box)")
+        # The first part carries the object's name (the lookup name); every part counts as the object.
+        for k, (half, centre) in enumerate(obj.parts):
+            body.add_geom(name=obj.name if k == 0 else f"{obj.name}/{k}", type=mujoco.mjtGeom.mjGEOM_BOX,
+                          size=list(half), pos=list(centre), **contact)
+        com, inertia, iquat = _compound_inertia(obj.mass, obj.parts)
+        body.mass = obj.mass
+        body.ipos = list(com)
+        body.iquat = list(iquat)
+        body.inertia = list(inertia)
+        body.explicitinertial = True
+        return
+    body.add_geom(name=obj.name, type=geom_type, size=list(obj.size) + [0.0] * (3 - len(obj.size)), **contact)
     if obj.shape == "cylinder":
         r, h = obj.size[0], obj.size[1]
         inertia = [obj.mass * (3 * r * r + 4 * h * h) / 12] * 2 + [0.5 * obj.mass * r * r]
@@ -195,6 +273,27 @@ def _add_object(spec: mujoco.MjSpec, obj: ObjectSpec) -> None:
     body.iquat = [1.0, 0.0, 0.0, 0.0]
     body.inertia = inertia
     body.explicitinertial = True
+
+
+def _compound_inertia(mass: float, parts) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Centre of mass, principal inertia and its frame (quat w, x, y, z) of boxes sharing ``mass`` by volume."""
+    halves = np.array([p[0] for p in parts], dtype=float)
+    centres = np.array([p[1] for p in parts], dtype=float)
+    volumes = np.prod(2.0 * halves, axis=1)
+    masses = mass * volumes / volumes.sum()
+    com = masses @ centres / mass
+    tensor = np.zeros((3, 3))
+    for m, half, centre in zip(masses, halves, centres):
+        a, b, c = 2.0 * half
+        tensor += np.diag([m * (b * b + c * c) / 12, m * (a * a + c * c) / 12, m * (a * a + b * b) / 12])
+        d = centre - com
+        tensor += m * (np.dot(d, d) * np.eye(3) - np.outer(d, d))  # parallel axis
+    principal, axes = np.linalg.eigh(tensor)
+    if np.linalg.det(axes) < 0:
+        axes[:, 0] = -axes[:, 0]
+    quat = np.empty(4)
+    mujoco.mju_mat2Quat(quat, axes.reshape(-1))
+    return com, principal, quat
 
 
 #: Capsules (body, from, to, radius) that wrap each arm's distal links for the IK's
@@ -238,6 +337,7 @@ def build_model(scene: SceneSpec, collision_proxies: bool = False) -> mujoco.MjM
   <worldbody>
     <include file="{assets}/vx300s_left.xml"/>
     <include file="{assets}/vx300s_right.xml"/>
+    {_cloth_xml(scene.cloth) if scene.cloth is not None else ""}
   </worldbody>
 </mujoco>"""
     try:

@@ -24,6 +24,8 @@ from agentchord.worlds.sim.scene import (
 
 #: Control rate of the robot (Hz); physics runs at 1 / timestep.
 CONTROL_HZ = 50
+#: A finger touches a cloth point (a corner) when it touches the cloth within this distance of it (m).
+CLOTH_HOLD_RADIUS = 0.04
 
 
 @dataclass
@@ -63,12 +65,24 @@ class SimWorld:
         }
         self._tcp_site = {a: m.site(f"{a}_tcp").id for a in ARM_PREFIX}
         self._object_body = {o.name: m.body(o.name).id for o in scene.objects}
-        self._object_geom = {o.name: m.geom(o.name).id for o in scene.objects}
+        # Every geom of an object's body counts as the object (a compound tray has several).
+        self._object_geoms = {
+            o.name: frozenset(int(g) for g in np.nonzero(m.geom_bodyid == m.body(o.name).id)[0]) for o in scene.objects
+        }
         self._object_spec = {o.name: o for o in scene.objects}
         self._fault_until: dict[str, int] = {}
         self._push_until: dict[int, int] = {}
         self.commands: dict[str, ArmCommand] = {}
         self._contacts: set[tuple[int, int]] = set()
+        # A cloth (flex): named points (its corners) -> (vertex, diagonal neighbour inside), and
+        # per finger geom the positions of its contacts with the cloth at the last tick.
+        self._cloth_points: dict[str, tuple[int, int]] = {}
+        self._cloth_vert0 = 0
+        self._finger_cloth_contacts: dict[int, np.ndarray] = {}
+        if scene.cloth is not None:
+            self._cloth_vert0 = int(m.flex_vertadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_FLEX, scene.cloth.name)])
+            for label, (corner, inner) in scene.cloth.corner_vertices().items():
+                self._cloth_points[f"{scene.cloth.name}_{label}"] = (corner, inner)
         self.reset()
 
     # ------------------------------------------------------------------ set-up
@@ -151,6 +165,20 @@ class SimWorld:
                 del self._push_until[body]
         geoms = self.data.contact.geom[: self.data.ncon]
         self._contacts = {(int(a), int(b)) for a, b in geoms}
+        if self._cloth_points:
+            self._record_cloth_contacts()
+
+    def _record_cloth_contacts(self) -> None:
+        ncon = self.data.ncon
+        flex = self.data.contact.flex[:ncon]
+        geoms = self.data.contact.geom[:ncon]
+        pos = self.data.contact.pos[:ncon]
+        with_cloth = (flex >= 0).any(axis=1)
+        self._finger_cloth_contacts = {}
+        for geom in (g for pair in self._finger_geoms.values() for g in pair):
+            rows = with_cloth & (geoms == geom).any(axis=1)
+            if rows.any():
+                self._finger_cloth_contacts[geom] = pos[rows].copy()
 
     # ------------------------------------------------------------------ state
     @property
@@ -205,19 +233,76 @@ class SimWorld:
         return (geom_a, geom_b) in self._contacts or (geom_b, geom_a) in self._contacts
 
     def holding(self, arm: str, obj: str) -> bool:
-        """Contact-based grasp: both finger pads touch the object."""
-        geom = self._object_geom[obj]
+        """Contact-based grasp: both finger pads touch the object (a cloth point: the cloth near it)."""
+        if obj in self._cloth_points:
+            return self._holding_cloth_point(arm, obj)
+        geoms = self._object_geoms[obj]
         left, right = self._finger_geoms[arm]
-        return self.in_contact(left, geom) and self.in_contact(right, geom)
+        return self._touches(left, geoms) and self._touches(right, geoms)
+
+    def _touches(self, geom: int, geoms: frozenset[int]) -> bool:
+        """Whether ``geom`` touches any of ``geoms`` at the last tick."""
+        return any(self.in_contact(geom, g) for g in geoms)
 
     def touching(self, obj_a: str, obj_b: str) -> bool:
         """Whether two objects touch."""
-        return self.in_contact(self._object_geom[obj_a], self._object_geom[obj_b])
+        return any(self._touches(g, self._object_geoms[obj_b]) for g in self._object_geoms[obj_a])
 
     def on_table(self, obj: str) -> bool:
         """Whether the object rests on the table."""
-        return self.in_contact(self._object_geom[obj], self.model.geom("table").id)
+        return self._touches(self.model.geom("table").id, self._object_geoms[obj])
 
     def arm_base(self, arm: str) -> np.ndarray:
         """Position of the arm's shoulder (its waist axis) in the world."""
         return self.data.xpos[self.model.body(f"{ARM_PREFIX[arm]}/shoulder_link").id].copy()
+
+    # ------------------------------------------------------------------ cloth
+    @property
+    def cloth_point_names(self) -> list[str]:
+        """Named points of the scene's cloth (its corners ``{cloth}_bl`` ...); empty without a cloth."""
+        return list(self._cloth_points)
+
+    def cloth_point(self, name: str) -> tuple[np.ndarray, np.ndarray]:
+        """A cloth point's position and its horizontal outward direction (from the diagonal
+        neighbour inside the cloth to the corner; unit, or zero when they are above each other)."""
+        try:
+            corner, inner = self._cloth_points[name]
+        except KeyError:
+            raise UnknownObjectError(f"no cloth point {name!r} in the scene (points: {', '.join(self._cloth_points)})") from None
+        verts = self.data.flexvert_xpos
+        pos = verts[self._cloth_vert0 + corner].copy()
+        out = pos - verts[self._cloth_vert0 + inner]
+        out[2] = 0.0
+        norm = float(np.linalg.norm(out))
+        return pos, out / norm if norm > 1e-6 else np.zeros(3)
+
+    def cloth_vertices(self) -> np.ndarray:
+        """Positions of the cloth's vertices (n x 3)."""
+        cloth = self.scene.cloth
+        if cloth is None:
+            return np.zeros((0, 3))
+        n = cloth.count[0] * cloth.count[1]
+        return self.data.flexvert_xpos[self._cloth_vert0 : self._cloth_vert0 + n].copy()
+
+    def cloth_speed(self) -> float:
+        """Largest speed of a cloth vertex (m/s); 0 without a cloth."""
+        cloth = self.scene.cloth
+        if cloth is None:
+            return 0.0
+        n = cloth.count[0] * cloth.count[1]
+        bodies = self.model.flex_vertbodyid[self._cloth_vert0 : self._cloth_vert0 + n]
+        dofs = self.model.body_dofadr[bodies]
+        vel = np.stack([self.data.qvel[d : d + 3] for d in dofs if d >= 0]) if len(dofs) else np.zeros((1, 3))
+        return float(np.linalg.norm(vel, axis=1).max())
+
+    def touching_cloth(self, arm: str) -> bool:
+        """Whether either finger pad of ``arm`` touches the cloth."""
+        return any(g in self._finger_cloth_contacts for g in self._finger_geoms[arm])
+
+    def _holding_cloth_point(self, arm: str, name: str) -> bool:
+        pos, _ = self.cloth_point(name)
+        for geom in self._finger_geoms[arm]:
+            contacts = self._finger_cloth_contacts.get(geom)
+            if contacts is None or np.linalg.norm(contacts - pos, axis=1).min() > CLOTH_HOLD_RADIUS:
+                return False
+        return True

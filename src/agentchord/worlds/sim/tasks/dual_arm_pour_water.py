@@ -81,11 +81,13 @@ class DualArmPourWater:
     BOTTLE_RADIUS = (0.024, 0.030)
     BOTTLE_HALF_HEIGHT = (0.08, 0.10)
     BOTTLE_MASS = (0.15, 0.35)
-    BOTTLE_XY = ((0.04, 0.12), (0.48, 0.60))
+    BOTTLE_XY = ((0.05, 0.13), (0.42, 0.52))
     CUP_RADIUS = (0.024, 0.028)
     CUP_HALF_HEIGHT = (0.042, 0.055)
     CUP_MASS = (0.10, 0.25)
-    CUP_XY = ((-0.15, -0.05), (0.50, 0.62))
+    #: Cup x stays >= -0.11: a cup dropped closer to the left arm's base is regrasped after a
+    #: back-off that folds the arm against itself (elbow at its limit), and the grasp fails.
+    CUP_XY = ((-0.11, -0.05), (0.50, 0.62))
     FRICTION = (0.8, 1.2)
 
     def sample_scene(self, rng: np.random.Generator) -> SceneSpec:

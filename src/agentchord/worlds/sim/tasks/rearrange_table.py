@@ -95,9 +95,10 @@ class RearrangeTable:
     UTENSIL_HALF_WIDTH = (0.0075, 0.0125)
     UTENSIL_HALF_THICKNESS = (0.004, 0.006)
     UTENSIL_MASS = (0.03, 0.07)
-    #: Fork on the left half, spoon on the right half (mirrored in x).
-    FORK_XY = ((-0.36, -0.26), (0.46, 0.74))
-    SPOON_XY = ((0.26, 0.36), (0.46, 0.74))
+    #: Fork on the left half, spoon on the right half (mirrored in x). Nearer than ~15 cm to an
+    #: arm's base (x = -/+0.469) a top-down tool cannot reach the table.
+    FORK_XY = ((-0.32, -0.22), (0.46, 0.74))
+    SPOON_XY = ((0.22, 0.32), (0.46, 0.74))
     #: Yaw of the long axis from the x axis (the arms' reach direction).
     UTENSIL_YAW = (np.radians(-60.0), np.radians(60.0))
     FRICTION = (0.8, 1.2)

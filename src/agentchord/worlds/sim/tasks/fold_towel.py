@@ -1,0 +1,101 @@
+"""Fold towel (paper Appendix B): fold a towel lying flat on the table in half.
+
+Grasp towel bottom corners (LR) -> lift towel bottom (LR) -> move to towel top corners (LR) ->
+place towel (LR). Success: the two bottom corners of the towel lie within a tolerance of the
+corresponding top corners (a half-folded towel), released by both grippers, the cloth at rest.
+
+The towel is a MuJoCo flex cloth (:class:`~agentchord.worlds.sim.scene.ClothSpec`), grasped only
+by friction between the finger pads: a top grasp pinches the corner vertex against nothing but the
+other finger. Convention: in the towel's own frame, the *bottom* edge is the y-min edge (nearer the
+front camera, ``towel_bl`` / ``towel_br``) and the *top* edge the y-max one (``towel_tl`` /
+``towel_tr``); ``l`` is x-min (the left arm's side), ``r`` is x-max (the right arm's side). The
+left arm folds ``towel_bl`` onto ``towel_tl``, the right arm ``towel_br`` onto ``towel_tr``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from agentchord.features.frame import FeatureFrame
+from agentchord.worlds.sim.scene import ClothSpec, SceneSpec
+from agentchord.worlds.sim.tasks.base import Verdict, uniform
+from agentchord.worlds.sim.world import SimWorld
+
+#: Bottom corner -> the top corner it is folded onto, and the arm that folds it.
+FOLD_PAIRS = {"towel_bl": ("towel_tl", "left"), "towel_br": ("towel_tr", "right")}
+
+
+@dataclass
+class FoldTracker:
+    """Success of fold towel, judged from the end state.
+
+    Each bottom corner must lie within ``tol`` of its top corner (3-D distance between the corner
+    vertices), on top of the towel's other half (not below it), the towel released by both arms and
+    at rest.
+
+    Attributes:
+        tol: Largest bottom-to-top corner distance (m).
+        max_speed: Largest cloth vertex speed of a towel at rest (m/s).
+    """
+
+    tol: float = 0.045
+    max_speed: float = 0.02
+
+    def observe(self, frame: FeatureFrame) -> None:
+        """Nothing to watch during the episode: success is a property of the end state."""
+
+    def verdict(self, frame: FeatureFrame, world: SimWorld) -> Verdict:
+        """Judge the end state."""
+        for bottom, (top, _) in FOLD_PAIRS.items():
+            gap = float(np.linalg.norm(frame.objects[bottom].pos - frame.objects[top].pos))
+            if gap > self.tol:
+                return Verdict(False, f"{bottom} is {100 * gap:.1f} cm from {top} (tolerance {100 * self.tol:.1f} cm)")
+        for arm in ("left", "right"):
+            if world.touching_cloth(arm):
+                return Verdict(False, f"the {arm} gripper still touches the towel")
+        speed = world.cloth_speed()
+        if speed > self.max_speed:
+            return Verdict(False, f"the towel is still moving ({100 * speed:.1f} cm/s)")
+        return Verdict(True, "bottom corners folded onto the top corners, towel released and at rest")
+
+
+class FoldTowel:
+    """Both arms fold a towel in half, bottom edge onto top edge."""
+
+    name = "fold_towel"
+    description = "Left and right arms pinch the towel's bottom corners and fold them onto its top corners."
+
+    #: Sampling ranges (m, kg, rad). A 7 x 7 vertex flex grid: see the module docstring and
+    #: ClothSpec (mujoco 3.8 caps a flex/geom pair at 50 contacts).
+    SIZE_X = (0.28, 0.32)
+    SIZE_Y = (0.22, 0.26)
+    MASS = (0.04, 0.08)
+    FRICTION = (1.3, 1.7)
+    CENTRE_XY = ((-0.03, 0.03), (0.53, 0.57))
+    YAW = (-0.10, 0.10)
+    COUNT = (7, 7)
+    RADIUS = 0.004
+
+    def sample_scene(self, rng: np.random.Generator) -> SceneSpec:
+        """One trial's scene: a towel instance and its pose drawn from the stated ranges."""
+        towel = ClothSpec(
+            name="towel",
+            size=(uniform(rng, self.SIZE_X), uniform(rng, self.SIZE_Y)),
+            count=self.COUNT,
+            mass=uniform(rng, self.MASS),
+            pos=(uniform(rng, self.CENTRE_XY[0]), uniform(rng, self.CENTRE_XY[1])),
+            yaw=uniform(rng, self.YAW),
+            radius=self.RADIUS,
+            friction=uniform(rng, self.FRICTION),
+            rgba=(*rng.uniform(0.3, 0.95, 3), 1.0),
+        )
+        return SceneSpec(objects=[], cloth=towel)
+
+    def success_tracker(self) -> FoldTracker:
+        """A fresh success tracker for one episode."""
+        return FoldTracker()
+
+
+TASK = FoldTowel()
