@@ -159,3 +159,23 @@ def test_skip_if_held_keeps_a_finished_grasp_and_skip_if_placed_only_retreats():
     status, _ = _run(robot, extractor, make_action("place", "right", {"obj": "bottle", "skip_if_placed": True}))
     assert status == Status.SUCCESS
     assert robot.commanded_pose("right").pos[2] > before[2]
+
+
+def test_reseat_turns_a_fallen_bottle_into_a_nominal_side_grasp():
+    scene = _scene(0)
+    world, robot, extractor = _robot(scene)
+    bottle = scene.objects[0]
+    adr = world.model.joint("bottle_free").qposadr[0]
+    x, y, z, w = (Rotation.from_euler("z", 0.3) * Rotation.from_euler("y", 90, degrees=True)).as_quat()
+    world.data.qpos[adr : adr + 7] = [0.05, 0.5, bottle.size[0] + 0.001, w, x, y, z]
+    for _ in range(40):
+        world.step()
+    assert extractor.update().objects["bottle"].axis[2] < 0.2  # lying down
+    status, _ = _run(robot, extractor, make_action("grasp", "right", {"obj": "bottle", "reseat": True}), max_ticks=2500)
+    assert status == Status.SUCCESS
+    frame = extractor.frame
+    feats, tool = frame.objects["bottle"], frame.arms["right"].ee
+    assert frame.is_holding("right", "bottle") and feats.axis[2] > np.cos(np.radians(5))
+    # Held at mid-height on its axis, as a side grasp of a standing bottle is (not off-centre).
+    offset = feats.pos - tool
+    assert np.linalg.norm(offset - np.dot(offset, feats.axis) * feats.axis) < 0.01

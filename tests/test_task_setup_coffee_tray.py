@@ -3,6 +3,7 @@
 import numpy as np
 
 from agentchord.execution.episode import EpisodeSpec, run_episode
+from agentchord.expr import Vocabulary, compile_expr
 from agentchord.features.oracle import OracleExtractor
 from agentchord.graph.progress import forward_filter, nominal_path
 from agentchord.graph.validation import check_graph
@@ -98,6 +99,24 @@ def test_success_check_passes_only_with_the_capsule_in_the_tray_at_the_forward_t
     _settle(world, 30)
     verdict = tracker.verdict(extractor.update(), world)
     assert not verdict.success
+
+
+def test_the_graphs_capsule_in_tray_expression_agrees_with_the_success_check_on_a_turned_tray():
+    graph = load_task_graph(TASK)
+    in_tray = compile_expr(graph.node("v2").constraints[1], Vocabulary(frozenset(graph.objects)))
+    world = SimWorld(_scene(2))
+    extractor = OracleExtractor(world)
+    z = world.object_spec("tray").size[2] + 0.001
+    yaw = 0.5  # ~29 degrees: a tray turned by a drop
+    _set_pose(world, "tray", (0.0, 0.6, z), yaw=yaw)
+    rot = np.array([[np.cos(yaw), -np.sin(yaw)], [np.sin(yaw), np.cos(yaw)]])
+    # Inside near a corner, outside beyond a long side, outside beyond a short side (tray frame).
+    for local, inside in (((0.08, 0.035), True), ((0.0, 0.10), False), ((0.20, 0.0), False), ((-0.07, -0.03), True)):
+        _set_pose(world, "capsule", (*(np.array([0.0, 0.6]) + rot @ np.array(local)), 0.04))
+        _settle(world)
+        frame = extractor.update()
+        assert capsule_in_tray(world)[0] == inside, local
+        assert (in_tray.scalar(frame) <= 0.0) == inside, local
 
 
 def test_library_graph_checks_clean_and_watches_every_edge_that_holds_an_object():

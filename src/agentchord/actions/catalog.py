@@ -32,10 +32,18 @@ class GraspArgs(_Args):
     mode: Literal["auto", "side", "top"] = Field(
         "auto", description="side: horizontal approach; top: from above; auto: side for tall upright objects, else top."
     )
-    offset: Vec3 = Field((0.0, 0.0, 0.0), description="Grasp offset from the grasp point, world frame (m).")
+    offset: Vec3 = Field((0.0, 0.0, 0.0), description="Grasp offset from the grasp point, in offset_frame (m).")
+    offset_frame: Literal["world", "object"] = Field(
+        "world", description="Frame of offset: world axes, or the object's own axes (a handle of a tray that may have turned)."
+    )
     yaw: float | None = Field(None, ge=-180.0, le=180.0, description="Side grasp: world yaw of the approach (deg); None = from the arm's base.")
     skip_if_held: bool = Field(
         False, description="If the arm already holds obj with a closed grip, do nothing (finish an interrupted synchronous grasp)."
+    )
+    reseat: bool = Field(
+        False,
+        description="A fallen object, once set upright in hand, is put down upright, the arm goes home and grasps it again "
+        "from the side: the nominal grasp geometry (a pour needs it) instead of the off-centre fallen-grasp hold.",
     )
 
 

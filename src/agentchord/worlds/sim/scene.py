@@ -137,11 +137,29 @@ class ClothSpec:
 
 
 def _cloth_xml(cloth: ClothSpec) -> str:
-    """The ``flexcomp`` element of a cloth (MjSpec has no flexcomp builder: it goes in the XML)."""
+    """The ``flexcomp`` element of a cloth (MjSpec has no flexcomp builder: it goes in the XML).
+
+    A ``direct`` flexcomp on the grid, not ``type="grid"``: the grid splits every quad along the same
+    diagonal, so two opposite corners belong to a single triangle that a pinch squeezes out of the
+    fingers. Here each quadrant's quads are split along the diagonal through its own cloth corner:
+    every corner vertex has two triangles, the same for all four (a symmetric "diamond" mesh).
+    """
     (nx, ny), (sx, sy) = cloth.count, cloth.size
-    return f"""<flexcomp name="{cloth.name}" type="grid" dim="2" count="{nx} {ny} 1"
-      spacing="{sx / (nx - 1)} {sy / (ny - 1)} {4 * cloth.radius + 0.01}" pos="{cloth.pos[0]} {cloth.pos[1]} {cloth.radius + 0.001}"
-      euler="0 0 {cloth.yaw}" radius="{cloth.radius}" mass="{cloth.mass}" rgba="{' '.join(map(str, cloth.rgba))}">
+    points = [(sx * (ix / (nx - 1) - 0.5), sy * (iy / (ny - 1) - 0.5)) for ix in range(nx) for iy in range(ny)]
+    k = lambda ix, iy: ix * ny + iy  # noqa: E731
+    elements = []
+    for ix in range(nx - 1):
+        for iy in range(ny - 1):
+            a, b, c, d = k(ix, iy), k(ix + 1, iy), k(ix + 1, iy + 1), k(ix, iy + 1)
+            if (2 * ix + 1 < nx - 1) == (2 * iy + 1 < ny - 1):
+                elements += [(a, b, c), (a, c, d)]
+            else:
+                elements += [(a, b, d), (b, c, d)]
+    point = " ".join(f"{x:.6f} {y:.6f} 0" for x, y in points)
+    element = " ".join(f"{a} {b} {c}" for a, b, c in elements)
+    return f"""<flexcomp name="{cloth.name}" type="direct" dim="2" point="{point}" element="{element}"
+      pos="{cloth.pos[0]} {cloth.pos[1]} {cloth.radius + 0.001}" euler="0 0 {cloth.yaw}" radius="{cloth.radius}"
+      mass="{cloth.mass}" rgba="{' '.join(map(str, cloth.rgba))}">
       <contact condim="3" priority="1" friction="{cloth.friction} 0.005 0.0001" solref="0.01 1"
         solimp="0.95 0.99 0.0001" selfcollide="none"/>
       <edge equality="true" damping="0.01"/>

@@ -3,11 +3,17 @@
 Grasp cup and bottle (LR, synchronous) -> move the cup to a receiving pose (L) -> move the
 bottle to the cup (R) -> pour (R) -> return cup and bottle (LR). The left arm holds the cup
 steady in the air while the right arm pours into it.
+
+Scene (ranges are the class constants below): a bottle on the right half of the table and a
+cup on the left half, both cylinders; the cup is narrow enough for a side grasp (diameter
+<= 5.6 cm in a 6.9 cm finger gap). The library graph (``tasks/library/dual_arm_pour_water.yaml``)
+holds the cup at a receiving pose (tool at x 0.0, y 0.62, z 0.15) and pours from 9 cm beside it,
+8 cm above its rim, rolling the bottle 95 degrees, as single-arm pour water does.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -39,7 +45,6 @@ class DualPourTracker:
     lateral_margin: float = 0.01
     poured: bool = False
     poured_tick: int | None = None
-    events: list[str] = field(default_factory=list)
 
     def observe(self, frame: FeatureFrame) -> None:
         """Watch one tick for the pouring event."""

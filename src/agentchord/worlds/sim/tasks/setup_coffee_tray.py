@@ -23,10 +23,11 @@ from agentchord.worlds.sim.world import SimWorld
 #: Where the tray must end (x, y, m): the designated forward position, 10-16 cm ahead of its start.
 TRAY_TARGET = (0.0, 0.67)
 #: Tray construction (m): base and wall thickness, handle tab length (along x) and thickness.
+#: A 2 cm tab gives the finger pads a tall face: with a 1.2 cm one, pad contacts flickered more.
 BASE_THICKNESS = 0.005
 WALL_THICKNESS = 0.006
 HANDLE_LENGTH = 0.05
-HANDLE_THICKNESS = 0.012
+HANDLE_THICKNESS = 0.02
 
 
 def tray_parts(half_length: float, half_width: float, height: float, handle_width: float):
