@@ -61,9 +61,10 @@ def _held_by(frame: FeatureFrame, arm: str) -> list[str]:
     return sorted(obj for a, obj in frame.holding if a == arm)
 
 
-def _free_objects(frame: FeatureFrame) -> list[str]:
+def _free_objects(frame: FeatureFrame, world: SimWorld) -> list[str]:
+    # Rigid bodies only: a frame may also carry feature points (a cloth's corners).
     held = {obj for _, obj in frame.holding}
-    return sorted(name for name in frame.objects if name not in held)
+    return sorted(name for name in world.object_names if name not in held)
 
 
 def _slide(world: SimWorld, obj: str, direction: np.ndarray, ticks: int = 6) -> None:
@@ -110,19 +111,19 @@ def inject(kind: str, world: SimWorld, frame: FeatureFrame, rng: np.random.Gener
         if not held or world.commands[arm].grip < 0.5:
             return None
         world.inject_gripper_fault(arm, FAULT_TICKS)
-        if kind == "pull":
+        if kind == "pull" and held[0] in world.object_names:
             # Taken out of the hand: shoved away from the gripper, outward and down.
             away = world.tcp_pose(arm)[1][:, 0]
             away = np.array([away[0], away[1], 0.0]) / max(np.linalg.norm(away[:2]), 1e-6)
             _slide(world, held[0], away)
         return DisturbanceEvent(world.tick, kind, held[0], arm, name)
     if kind == "perturb":
-        if name != "grasp" or target is None or frame.is_holding(arm, target):
+        if name != "grasp" or target not in world.object_names or frame.is_holding(arm, target):
             return None
         _slide(world, target, push_dir)
         return DisturbanceEvent(world.tick, kind, target, arm, name)
     if kind == "shift":
-        free = _free_objects(frame)
+        free = _free_objects(frame, world)
         if target is None and arm and free:
             # An action without an object (a pour): move what the tool works over.
             tool = frame.arms[arm].ee
@@ -132,7 +133,7 @@ def inject(kind: str, world: SimWorld, frame: FeatureFrame, rng: np.random.Gener
         _slide(world, target, push_dir)
         return DisturbanceEvent(world.tick, kind, target, arm, name)
     if kind == "knock":
-        upright = [n for n in _free_objects(frame) if frame.objects[n].axis[2] > 0.9]
+        upright = [n for n in _free_objects(frame, world) if frame.objects[n].axis[2] > 0.9]
         if not upright:
             return None
         victim = target if target in upright else upright[int(rng.integers(len(upright)))]

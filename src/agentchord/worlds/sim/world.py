@@ -26,6 +26,8 @@ from agentchord.worlds.sim.scene import (
 CONTROL_HZ = 50
 #: A finger touches a cloth point (a corner) when it touches the cloth within this distance of it (m).
 CLOTH_HOLD_RADIUS = 0.04
+#: ... and only with at least this gap between its finger pads (m): cloth pinched between them.
+CLOTH_MIN_PINCH = 0.002
 
 
 @dataclass
@@ -300,6 +302,9 @@ class SimWorld:
         return any(g in self._finger_cloth_contacts for g in self._finger_geoms[arm])
 
     def _holding_cloth_point(self, arm: str, name: str) -> bool:
+        # Cloth between the pads: fingers closed on nothing but resting on the cloth do not count.
+        if self.gripper_width(arm) < CLOTH_MIN_PINCH:
+            return False
         pos, _ = self.cloth_point(name)
         for geom in self._finger_geoms[arm]:
             contacts = self._finger_cloth_contacts.get(geom)
