@@ -42,6 +42,7 @@ bench: install
 	$(BIN)/python benchmarks/bench_episode.py
 	$(BIN)/python benchmarks/bench_monitors.py
 	$(BIN)/python benchmarks/bench_recovery_cost.py
+	$(BIN)/python benchmarks/bench_perception.py
 
 clean:
 	rm -rf $(VENV) .pytest_cache .hypothesis
