@@ -112,6 +112,11 @@ class ClothSpec:
             over the other geom's parameters: the fingers' condim-4 contact made the solver
             return NaN on flex elements).
         rgba: Colour.
+        bending: Young's modulus (Pa) of the cloth's bending stiffness (MuJoCo's ``elastic2d="bend"``,
+            shell thickness = ``radius``); 0 = none (the cloth crumples like a sheet of links).
+        bending_damping: Damping of the bending model (without it a stiff cloth keeps vibrating).
+        self_collide: Whether the cloth collides with itself (a folded layer lies on the other one
+            instead of passing through it).
     """
 
     name: str = "cloth"
@@ -123,6 +128,9 @@ class ClothSpec:
     radius: float = 0.004
     friction: float = 1.5
     rgba: tuple[float, float, float, float] = (0.85, 0.3, 0.3, 1.0)
+    bending: float = 0.0
+    bending_damping: float = 0.01
+    self_collide: bool = False
 
     def corner_vertices(self) -> dict[str, tuple[int, int]]:
         """Corner label -> (corner vertex, its diagonal neighbour inside the cloth)."""
@@ -157,12 +165,18 @@ def _cloth_xml(cloth: ClothSpec) -> str:
                 elements += [(a, b, d), (b, c, d)]
     point = " ".join(f"{x:.6f} {y:.6f} 0" for x, y in points)
     element = " ".join(f"{a} {b} {c}" for a, b, c in elements)
+    bending = (
+        f'<elasticity young="{cloth.bending}" poisson="0.3" thickness="{cloth.radius}" elastic2d="bend" damping="{cloth.bending_damping}"/>'
+        if cloth.bending > 0 else ""
+    )
+    self_collide = 'selfcollide="auto" internal="false"' if cloth.self_collide else 'selfcollide="none"'
     return f"""<flexcomp name="{cloth.name}" type="direct" dim="2" point="{point}" element="{element}"
       pos="{cloth.pos[0]} {cloth.pos[1]} {cloth.radius + 0.001}" euler="0 0 {cloth.yaw}" radius="{cloth.radius}"
       mass="{cloth.mass}" rgba="{' '.join(map(str, cloth.rgba))}">
       <contact condim="3" priority="1" friction="{cloth.friction} 0.005 0.0001" solref="0.01 1"
-        solimp="0.95 0.99 0.0001" selfcollide="none"/>
+        solimp="0.95 0.99 0.0001" {self_collide}/>
       <edge equality="true" damping="0.01"/>
+      {bending}
     </flexcomp>"""
 
 

@@ -77,6 +77,8 @@ class FoldTowel:
     YAW = (-0.10, 0.10)
     COUNT = (7, 7)
     RADIUS = 0.004
+    #: A towel has some bending stiffness (it lies flat once folded) and collides with itself.
+    BENDING = 1e5
 
     def sample_scene(self, rng: np.random.Generator) -> SceneSpec:
         """One trial's scene: a towel instance and its pose drawn from the stated ranges."""
@@ -89,7 +91,9 @@ class FoldTowel:
             yaw=uniform(rng, self.YAW),
             radius=self.RADIUS,
             friction=uniform(rng, self.FRICTION),
-            rgba=(*rng.uniform(0.3, 0.95, 3), 1.0),
+            rgba=(*(float(c) for c in rng.uniform(0.3, 0.95, 3)), 1.0),
+            bending=self.BENDING,
+            self_collide=True,
         )
         return SceneSpec(objects=[], cloth=towel)
 
