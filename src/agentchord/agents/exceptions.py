@@ -78,3 +78,28 @@ class InvalidReplyError(ReasonerError):
 
     ``problems`` lists the problems of the last reply.
     """
+
+
+class InstructionNotGroundedError(ReasonerError):
+    """The offline composer cannot read an instruction, or its words name no scene object.
+
+    Attributes:
+        instruction: The instruction as given.
+        reason: Which words failed and why.
+    """
+
+    def __init__(self, instruction: str, reason: str) -> None:
+        self.instruction = instruction
+        self.reason = reason
+        super().__init__(
+            f"cannot ground the instruction {instruction!r}: {reason}. Give the goal as a goal spec "
+            "(`--goal goal.yaml`, see `agentchord schema goal`) or use an LLM (`--reasoner llm`).",
+            agent="composer",
+        )
+
+
+class PlanningError(ReasonerError):
+    """No sequence of skills reaches the goal from the scene."""
+
+    def __init__(self, message: str) -> None:
+        super().__init__(message, agent="composer")

@@ -88,17 +88,35 @@ class ArmState(_Model):
     holding: str | None = None
 
 
+class Region(_Model):
+    """A named region of the table (a target area), a disc.
+
+    Attributes:
+        name: How instructions name it (``target``, ``forward``).
+        description: More words that name it.
+        center: Centre (x, y), metres.
+        radius: Radius, metres.
+    """
+
+    name: str
+    description: str = ""
+    center: tuple[float, float]
+    radius: float = Field(0.04, gt=0.0)
+
+
 class Scene(_Model):
     """The first observation given to the agents: objects with poses and sizes, and the arms.
 
     Attributes:
         objects: Scene objects.
         arms: Arm states (may be empty when unknown).
+        regions: Named regions of the table.
         notes: Anything else worth saying (table height, workspace bounds, in words).
     """
 
     objects: list[SceneObject]
     arms: list[ArmState] = Field(default_factory=list)
+    regions: list[Region] = Field(default_factory=list)
     notes: str = ""
 
     @property
@@ -113,6 +131,7 @@ class Scene(_Model):
         descriptions: Mapping[str, str] | None = None,
         notes: str = "",
         decimals: int = 4,
+        regions: Iterable[Region] = (),
     ) -> Scene:
         """The scene seen in a feature frame (oracle or RGB-D), rounded for a prompt.
 
@@ -120,6 +139,7 @@ class Scene(_Model):
             frame: The first frame of the episode.
             descriptions: Optional words per object name.
             notes: Free text passed on to the agents.
+            regions: Named regions of the table.
             decimals: Rounding of every coordinate (4: 0.1 mm).
         """
 
@@ -150,7 +170,7 @@ class Scene(_Model):
                     holding=held[0] if held else None,
                 )
             )
-        return cls(objects=objects, arms=arms, notes=notes)
+        return cls(objects=objects, arms=arms, regions=list(regions), notes=notes)
 
 
 # --- requests ----------------------------------------------------------------------------

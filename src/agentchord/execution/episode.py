@@ -7,7 +7,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from agentchord.agents.observe import observe, task_regions
+from agentchord.agents.pipeline import ReasonerRepairer, make_reasoner, plan_task
+from agentchord.agents.rules.goals import GoalSpec
 from agentchord.execution.executor import EpisodeResult, Executor, ExecutorConfig
+from agentchord.execution.repair import Repairer
 from agentchord.execution.strategies import make_strategy
 from agentchord.graph.models import TaskGraph
 from agentchord.tasks import load_task_graph
@@ -32,6 +36,12 @@ class EpisodeSpec:
             ``disturb`` kinds at random moments, whatever ``p``.
         disturbance: A disturbance schedule to use instead (tests, scripted demos).
         perception: ``oracle`` or ``rgbd`` features.
+        repairer: Online repair of unanticipated failures (None: none, unless planned).
+        instruction: Plan the graph from this instruction with ``reasoner`` on the
+            episode's first observation (instead of a library or given graph).
+        goal: Plan from this goal spec instead of reading ``instruction``.
+        reasoner: ``rules`` (offline) or ``llm``.
+        repair: Online repair through the reasoner; None = on when the graph is planned.
     """
 
     task: str
@@ -44,6 +54,16 @@ class EpisodeSpec:
     protocol: bool = False
     perception: str = "oracle"
     disturbance: Disturbance | None = None
+    repairer: Repairer | None = None
+    instruction: str | None = None
+    goal: GoalSpec | None = None
+    reasoner: str = "rules"
+    repair: bool | None = None
+
+    @property
+    def planned(self) -> bool:
+        """Whether the graph is planned by the agents at the start of the episode."""
+        return self.graph is None and (self.instruction is not None or self.goal is not None)
 
     def make_disturbance(self) -> Disturbance | None:
         """The seeded disturbance schedule this spec asks for."""
@@ -66,7 +86,19 @@ def run_episode(spec: EpisodeSpec, on_tick: Callable[[Executor], None] | None = 
     task = SIM_TASKS[spec.task]
     scene = task.sample_scene(np.random.default_rng([spec.seed, 0x5CE7E]))
     world = SimWorld(scene)
-    graph = spec.graph or load_task_graph(spec.task)
+    repairer = spec.repairer
+    calls = []
+    if spec.planned:
+        regions = task_regions(task)
+        reasoner = make_reasoner(spec.reasoner, goal=spec.goal, watch_visibility=spec.perception == "rgbd")
+        planned = plan_task(spec.instruction or "", observe(world, regions, spec.perception), reasoner, task=spec.task)
+        graph, calls = planned.graph, planned.calls
+        if repairer is None and spec.repair is not False:
+            repairer = ReasonerRepairer(reasoner, regions)
+    else:
+        graph = spec.graph or load_task_graph(spec.task)
+        if repairer is None and spec.repair:
+            repairer = ReasonerRepairer(make_reasoner("rules"), task_regions(task))
     executor = Executor(
         graph=graph,
         world=world,
@@ -76,7 +108,11 @@ def run_episode(spec: EpisodeSpec, on_tick: Callable[[Executor], None] | None = 
         config=spec.config,
         on_tick=on_tick,
         perception=spec.perception,
+        repairer=repairer,
     )
     result = executor.run()
-    result.trace.events[0].update({"seed": spec.seed, "p": spec.p})
+    start = next(e for e in result.trace.events if e["event"] == "episode_start")
+    start.update({"seed": spec.seed, "p": spec.p})
+    # The agents' calls came before the first tick: they open the trace.
+    result.trace.events[:0] = [{"tick": 0, "event": "reasoner_call", **call.to_trace_event()} for call in calls]
     return result

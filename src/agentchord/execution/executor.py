@@ -5,7 +5,10 @@ the active edge's compiled monitors, and on a persistent violation switch at
 once to what the recovery strategy says -- for AgentChord a pre-compiled
 forward-moving recovery edge that starts from the robot's current state, for
 the backtracking ablation a return to an earlier node's keyframe. Budgets end
-an episode as a failure with a reason, never as a hang.
+an episode as a failure with a reason, never as a hang. With a repairer, an edge
+that ends short of its target's constraints with no monitor fired (a failure
+nobody anticipated) is repaired online: the graph gains one branch, the compiled
+artefacts are rebuilt and the new recovery edge starts at once.
 """
 
 from __future__ import annotations
@@ -19,7 +22,10 @@ import numpy as np
 from agentchord.actions.base import ArmAction, Status
 from agentchord.actions.catalog import ACTIONS
 from agentchord.actions.controller import RobotController
+from agentchord.agents.exceptions import ReasonerError
+from agentchord.agents.reasoner import UnanticipatedFailure
 from agentchord.execution.edge_program import EdgeProgram
+from agentchord.execution.repair import RepairRejectedError, Repairer, validate_repair
 from agentchord.execution.strategies import RecoveryStrategy
 from agentchord.execution.trace import Trace
 from agentchord.expr import Vocabulary, compile_expr
@@ -40,10 +46,13 @@ class ExecutorConfig:
     Attributes:
         tick_limit: Ticks before the episode ends as a failure (50 Hz).
         failure_budget: Times one failure mode may fire per episode.
+        max_repairs: Online repairs attempted per episode (at most one per
+            (edge, target) pair); past it, unanticipated failures go unrepaired.
     """
 
     tick_limit: int = 4000
     failure_budget: int = 3
+    max_repairs: int = 2
 
 
 @dataclass
@@ -52,7 +61,7 @@ class EpisodeResult:
 
     ``drops_*`` count the paper's drop disturbance; ``disturbances`` maps every injected
     kind to [injected, detected, recovered]. Reaction latencies are ticks from a
-    disturbance to the first detection after it.
+    disturbance to the first detection after it. ``repairs`` counts accepted online repairs.
     """
 
     success: bool
@@ -63,6 +72,7 @@ class EpisodeResult:
     path: list[str]
     failures_detected: int
     recoveries: int
+    repairs: int
     drops_injected: int
     drops_detected: int
     drops_recovered: int
@@ -80,6 +90,7 @@ class EpisodeResult:
             "wall_s": round(self.wall_s, 3),
             "failures_detected": self.failures_detected,
             "recoveries": self.recoveries,
+            "repairs": self.repairs,
             "drops_injected": self.drops_injected,
             "drops_detected": self.drops_detected,
             "drops_recovered": self.drops_recovered,
@@ -102,6 +113,8 @@ class Executor:
         on_tick: Called after every tick (video recording).
         perception: ``oracle`` (simulator state) or ``rgbd`` (rendered depth and
             segmentation of two cameras at 10 Hz, fused and shape-fitted).
+        repairer: Proposes a branch for an unanticipated failure (None: no online
+            repair; the episode goes on from the unmet sub-goal as before).
     """
 
     def __init__(
@@ -114,29 +127,23 @@ class Executor:
         config: ExecutorConfig | None = None,
         on_tick: Callable[[Executor], None] | None = None,
         perception: str = "oracle",
+        repairer: Repairer | None = None,
     ) -> None:
         filtered = forward_filter(graph)
-        self.graph = filtered.graph
         self.world = world
         self.strategy = strategy
         self.tracker = tracker
         self.disturbance = disturbance
         self.config = config or ExecutorConfig()
         self.on_tick = on_tick
+        self.repairer = repairer
         self.trace = Trace()
         for removed in filtered.removed:
             self.trace.add(0, "branch_removed", failure=removed.failure, edge=removed.edge, reason=removed.reason)
         self.robot = RobotController(world)
         self.extractor = make_extractor(perception, world, lambda arm: self.robot.targets[arm].grip_closed_settled)
         self.robot.frame = self.extractor.frame
-        vocabulary = Vocabulary(frozenset(self.graph.objects))
-        # Compile once, before execution: the tick loop only evaluates closures.
-        self.monitors = {edge.id: EdgeMonitors.compile(edge, vocabulary) for edge in self.graph.edges}
-        self.constraints = {
-            node.id: [compile_expr(c, vocabulary) for c in node.constraints] for node in self.graph.nodes
-        }
-        self.recovery_map = RecoveryMap(self.graph)
-        self.nominal_next = {self.graph.edge(e).source: e for e in nominal_path(self.graph)}
+        self._compile(filtered.graph)
         # Per reached nominal node: the robot's keyframe (arm joints and grips), for backtracking.
         self.keyframes: dict[str, dict[str, tuple[np.ndarray, float]]] = {}
         self.visited_nominal: list[str] = []
@@ -152,6 +159,22 @@ class Executor:
         self._recovered: list[DisturbanceEvent] = []
         # Detected disturbances whose recovery has not merged back yet (a second one can interrupt the first's).
         self._unmerged: list[DisturbanceEvent] = []
+        # (edge, target) pairs a repair was attempted for: one attempt each.
+        self._repair_attempts: set[tuple[str, str]] = set()
+
+    def _compile(self, graph: TaskGraph) -> None:
+        """Adopt a (filtered) graph: compile what the tick loop evaluates.
+
+        Called before execution and again after an online repair; the world,
+        the trace and the episode's bookkeeping are left as they are.
+        """
+        self.graph = graph
+        vocabulary = Vocabulary(frozenset(graph.objects))
+        # Compile once, before execution: the tick loop only evaluates closures.
+        self.monitors = {edge.id: EdgeMonitors.compile(edge, vocabulary) for edge in graph.edges}
+        self.constraints = {node.id: [compile_expr(c, vocabulary) for c in node.constraints] for node in graph.nodes}
+        self.recovery_map = RecoveryMap(graph)
+        self.nominal_next = {graph.edge(e).source: e for e in nominal_path(graph)}
 
     # ------------------------------------------------------------- queries
     @property
@@ -166,6 +189,12 @@ class Executor:
     def violated_constraints(self, node_id: str) -> list[str]:
         """The source text of a node's constraints that do not hold now."""
         return [c.source for c in self.constraints[node_id] if c.scalar(self.frame) > 0.0]
+
+    def describe_violation(self, node_id: str) -> str:
+        """One line: each violated constraint of a node with its value now (the repair's observation)."""
+        values = ((c.source, c.scalar(self.frame)) for c in self.constraints[node_id])
+        violated = "; ".join(f"{source} = {value:.3g}" for source, value in values if value > 0.0)
+        return f"at {node_id}: {violated or 'no constraint violated'} (each should be <= 0)"
 
     # ------------------------------------------------------------ episode
     def run(self) -> EpisodeResult:
@@ -189,6 +218,7 @@ class Executor:
             path=self.path,
             failures_detected=len(self.trace.of("failure_detected")),
             recoveries=len(self.trace.of("recovery_switch")),
+            repairs=sum(e["accepted"] for e in self.trace.of("repair")),
             drops_injected=sum(e.kind == "drop" for e in injected),
             drops_detected=sum(e.kind == "drop" for e in self._detected),
             drops_recovered=sum(e.kind == "drop" for e in self._recovered),
@@ -280,6 +310,9 @@ class Executor:
         program = self.program
         self.trace.add(self.world.tick, "edge_end", edge=program.edge_id)
         self.program = None
+        detection = self._repair(program)
+        if detection is not None:
+            return self._on_failure(detection)
         target = self.graph.node(program.target) if program.kind != "backtrack" else None
         if target is not None and target.kind == "recovery":
             self.path.append(target.id)
@@ -304,7 +337,8 @@ class Executor:
             self._open_disturbance = None
         if self.fire_counts[key] > self.config.failure_budget:
             return False, f"failure budget exhausted: {detection.failure.name} on {detection.edge_id} fired {self.fire_counts[key]} times"
-        self.program.terminate(Status.INVALID)
+        if self.program is not None:  # None after an online repair: the failed edge had ended
+            self.program.terminate(Status.INVALID)
         failed_nominal = self.recovering_from or detection.edge_id
         program = self.strategy.recover(self, detection)
         if program is None:
@@ -314,6 +348,48 @@ class Executor:
                        to=program.edge_id, strategy=self.strategy.name, latency_ticks=self.world.tick - detection.onset_tick)
         self._start(program)
         return None
+
+    def _repair(self, program: EdgeProgram) -> Detection | None:
+        """Online repair of an unanticipated failure at the end of ``program``.
+
+        The program ended (so no monitor of its edge fired) but its target's
+        constraints do not hold. Within the budgets, ask the repairer for one new
+        failure mode on the edge, validate it, rebuild the compiled graph and
+        return the detection "as if" the new mode's monitor had fired now, so the
+        usual switch (the strategy's ``recover``: for AgentChord the new entry
+        edge) starts from where the robot is. The failed target is not "reached".
+
+        Returns:
+            The synthetic detection, or None to carry on as without a repairer.
+        """
+        if self.repairer is None or program.kind == "backtrack" or self.constraints_hold(program.target):
+            return None
+        key = (program.edge_id, program.target)
+        if len(self._repair_attempts) >= self.config.max_repairs or key in self._repair_attempts:
+            return None
+        self._repair_attempts.add(key)
+        edge = self.graph.edge(program.edge_id)
+        failure = UnanticipatedFailure(edge=edge.id, context=edge.source, observation=self.describe_violation(program.target))
+        record = {"edge": edge.id, "target": program.target, "context": edge.source, "observation": failure.observation}
+        started = time.perf_counter()
+        try:
+            proposal = self.repairer(self.graph, failure, self.frame)
+            if proposal is None:
+                raise RepairRejectedError(edge.id, "the repairer proposed no branch")
+            repair = validate_repair(self.graph, proposal, failure)
+        except (RepairRejectedError, ReasonerError) as error:
+            reason = error.reason if isinstance(error, RepairRejectedError) else error.headline
+            self.trace.add(self.world.tick, "repair", **record, failure=None, recovery=None, accepted=False,
+                           reason=reason, latency_s=time.perf_counter() - started)
+            return None
+        self._compile(repair.filtered.graph)
+        latency = time.perf_counter() - started
+        for removed in repair.filtered.removed:
+            self.trace.add(self.world.tick, "branch_removed", failure=removed.failure, edge=removed.edge, reason=removed.reason)
+        self.trace.add(self.world.tick, "repair", **record, failure=repair.failure.name, recovery=repair.recovery.id,
+                       accepted=True, latency_s=latency)
+        monitor = next(m for m in self.monitors[edge.id].monitors if m.failure.name == repair.failure.name)
+        return Detection(edge.id, repair.failure, self.world.tick, self.world.tick, monitor.expr.scalar(self.frame))
 
     # --------------------------------------------------------- hooks
     def _action_started(self, arm: str, action: ArmAction) -> None:

@@ -41,6 +41,8 @@ class SimTask(Protocol):
 
     name: str
     description: str
+    #: Named regions of the table the agents may use (optional): name -> (centre, radius, words).
+    regions: dict[str, tuple[tuple[float, float], float, str]]
 
     def sample_scene(self, rng: np.random.Generator) -> SceneSpec:
         """One trial's scene, drawn from the task's stated ranges."""

@@ -104,6 +104,8 @@ class HandoverBlock:
     #: The target region (fixed: the library graph names it).
     TARGET_XY = TARGET_XY
     TARGET_RADIUS = TARGET_RADIUS
+    #: Named regions the agents see: name -> (centre, radius, words).
+    regions = {"target": (TARGET_XY, TARGET_RADIUS, "target region on the right half of the table")}
 
     def sample_scene(self, rng: np.random.Generator) -> SceneSpec:
         """One trial's scene: the block's size, mass, colour, friction and pose from the stated ranges."""

@@ -146,6 +146,9 @@ class SetupCoffeeTray:
     CAPSULE_XY = ((-0.32, -0.25), (0.42, 0.58))
     FRICTION = (0.8, 1.2)
 
+    #: Named regions the agents see: name -> (centre, radius, words).
+    regions = {"forward": (TRAY_TARGET, 0.03, "forward front position where the tray goes")}
+
     def sample_scene(self, rng: np.random.Generator) -> SceneSpec:
         """One trial's scene: object instances and poses drawn from the stated ranges."""
         half_length = uniform(rng, self.TRAY_HALF_LENGTH)

@@ -1,0 +1,400 @@
+"""The offline arranger: failure modes, monitors and forward-moving recovery branches (Sec. III-C).
+
+Works on any nominal graph, the composer's or a hand-written one: it walks the nominal
+path and keeps a symbolic account of the atomic actions' effects (who holds what, which
+motions since the last grasp, what each arm's pose is relative to). For each nominal edge
+``e: s -> t`` it predicts, from what the edge does and that account:
+
+- a held object can drop or slip (Eq. 16-17): ``regrasp`` where it fell, restore the arm's
+  relative motions since the grasp, then finish ``e``;
+- an object the edge aims at (or places relative to) can drift (Eq. 14): ``re-approach``,
+  run ``e`` again on its new pose; if it must stand upright it can tip (Eq. 15): ``set upright``
+  with a free arm while the busy arm parks, then ``e`` again;
+- an object released inside or on another one can fall out when that one is carried (Eq. 19):
+  ``re-place`` it and take the carried one again;
+- with RGB-D perception, a tracked object can be lost from view (Eq. 18): ``re-observe``.
+
+Every recovery edge leaves the failure context ``s`` and merges at ``t`` (or, for a broken
+relation, at ``s``): nothing regresses, and the forward-moving filter (Eq. 8) checks it.
+Recovery edges carry drop monitors of their own; recovery grasps skip an object still held
+and recovery places skip an object already placed (an interrupted two-arm step).
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+
+from agentchord.agents.reasoner import Scene, SceneObject, UnanticipatedFailure
+from agentchord.agents.rules import knowledge as kb
+from agentchord.graph.models import ActionCall, Edge, FailureMode, Step, TaskGraph
+from agentchord.graph.progress import forward_filter, nominal_path
+
+ARMS = ("left", "right")
+ABSOLUTE = frozenset({"move_to_obj", "move_to_target", "place", "grasp", "back"})
+RELATIVE = frozenset({"rotate_eef", "move_by_offset"})
+
+
+@dataclass
+class ArmAccount:
+    """What one arm is doing at a node of the nominal path.
+
+    Attributes:
+        holding: Object held, if any.
+        grasp: The call that took it (``None`` when it was taken from the other arm).
+        since_grasp: Motions since the grasp that set the held object's pose (to replay).
+        relative_to: Object the arm's last absolute motion aimed at.
+    """
+
+    holding: str | None = None
+    grasp: ActionCall | None = None
+    since_grasp: list[ActionCall] = field(default_factory=list)
+    relative_to: str | None = None
+
+
+Account = dict[str, ArmAccount]
+
+
+def _apply(account: Account, step: Step) -> Account:
+    """The account after one step (both arms' calls of the step)."""
+    after = copy.deepcopy(account)
+    for arm, call in step.items():
+        if call is None:
+            continue
+        me = after[arm]
+        args = call.args
+        if call.fn == "grasp":
+            taken = any(after[a].holding == args["obj"] for a in ARMS if a != arm)
+            me.holding, me.grasp, me.since_grasp, me.relative_to = args["obj"], (None if taken else call), [], None
+            for other_arm in ARMS:
+                if other_arm != arm and after[other_arm].holding == args["obj"] and not taken:
+                    pass
+        elif call.fn == "place" or call.fn == "open_gripper":
+            me.holding, me.grasp, me.since_grasp, me.relative_to = None, None, [], None
+        elif call.fn == "back":
+            me.since_grasp, me.relative_to = [], None
+        elif call.fn in ("move_to_obj", "move_to_target"):
+            me.since_grasp = [call] if me.holding else []
+            me.relative_to = args.get("obj")
+        elif call.fn in RELATIVE and me.holding:
+            me.since_grasp = _cancel([*me.since_grasp, call])
+    return after
+
+
+def _cancel(calls: list[ActionCall]) -> list[ActionCall]:
+    """Drop a rotation undone by the next one (tilt, then tilt back)."""
+    out: list[ActionCall] = []
+    for call in calls:
+        if out and call.fn == "rotate_eef" and out[-1].fn == "rotate_eef" and abs(out[-1].args["angle"] + call.args["angle"]) < 1e-6:
+            out.pop()
+        else:
+            out.append(call)
+    return out
+
+
+def _holders(account: Account, obj: str) -> list[str]:
+    return [a for a in ARMS if account[a].holding == obj]
+
+
+def _calls(edge: Edge, arm: str) -> list[ActionCall]:
+    return [step[arm] for step in edge.steps if step.get(arm) is not None]
+
+
+def _with_skips(call: ActionCall) -> ActionCall:
+    if call.fn == "grasp":
+        return ActionCall(fn="grasp", args={**call.args, "skip_if_held": True})
+    if call.fn == "place":
+        return ActionCall(fn="place", args={**call.args, "skip_if_placed": True})
+    return call
+
+
+def _regrasp(account: Account, arm: str, obj: str) -> ActionCall:
+    grasp = account[arm].grasp
+    args = dict(grasp.args) if grasp is not None and grasp.args.get("obj") == obj else {"obj": obj}
+    return ActionCall(fn="grasp", args={**args, "skip_if_held": True})
+
+
+def _sequence(per_arm: dict[str, list[ActionCall]]) -> list[Step]:
+    """Steps that run each arm's calls in order, the arms side by side."""
+    longest = max((len(c) for c in per_arm.values()), default=0)
+    return [{arm: calls[k] for arm, calls in per_arm.items() if k < len(calls)} for k in range(longest)]
+
+
+def _replay_then_edge(account: Account, edge: Edge, arms: Iterable[str]) -> list[Step]:
+    """Restore each arm's relative motions since its grasp where ``edge`` continues them, then ``edge`` again."""
+    prefix: dict[str, list[ActionCall]] = {}
+    stripped: set[str] = set()
+    for arm in arms:
+        mine = _calls(edge, arm)
+        history = account[arm].since_grasp
+        if not mine or mine[0].fn not in RELATIVE or not history:
+            continue
+        remaining = _cancel([*history, *mine])
+        if len(remaining) < len(history):  # the edge undoes earlier motions: replay what is left, skip the edge's part
+            prefix[arm], _ = remaining, stripped.add(arm)
+        else:
+            prefix[arm] = history
+    steps = _sequence(prefix)
+    for step in edge.steps:
+        kept = {a: _with_skips(c) for a, c in step.items() if c is not None and a not in stripped}
+        if kept:
+            steps.append(kept)
+    return steps
+
+
+@dataclass
+class Arranger:
+    """The rule set. Thresholds come from :mod:`~agentchord.agents.rules.knowledge` and the scene.
+
+    Attributes:
+        scene: The first observation (sizes for thresholds, categories).
+        watch_visibility: Add lost-from-view monitors (RGB-D perception).
+    """
+
+    scene: Scene
+    watch_visibility: bool = False
+
+    def __post_init__(self) -> None:
+        self.objects: dict[str, SceneObject] = {o.name: o for o in self.scene.objects}
+
+    # --- the whole graph ---------------------------------------------------------------
+
+    def arrange(self, graph: TaskGraph) -> TaskGraph:
+        """The graph with recovery branches for every nominal edge, forward-filtered."""
+        out = graph.model_copy(deep=True)
+        accounts = self.accounts(graph)
+        nominal = {e.id: e for e in out.edges}
+        for edge_id, account in accounts.items():
+            edge = nominal[edge_id]
+            for mode, recovery in self.branches(graph, edge, account):
+                if any(f.name == mode.name for f in edge.failures):
+                    continue
+                edge.failures.append(mode)
+                if recovery is not None:
+                    out.edges.append(recovery)
+        self._monitor_recoveries(out)
+        return forward_filter(out).graph
+
+    def accounts(self, graph: TaskGraph) -> dict[str, Account]:
+        """The account at the source of every nominal edge, along the nominal path."""
+        account: Account = {arm: ArmAccount() for arm in ARMS}
+        for arm in self.scene.arms:
+            if arm.holding:
+                account[arm.name].holding = arm.holding
+        out: dict[str, Account] = {}
+        for edge_id in nominal_path(graph):
+            edge = graph.edge(edge_id)
+            out[edge_id] = account
+            for step in edge.steps:
+                account = _apply(account, step)
+        return out
+
+    # --- one edge ----------------------------------------------------------------------
+
+    def branches(self, graph: TaskGraph, edge: Edge, account: Account) -> list[tuple[FailureMode, Edge | None]]:
+        """Failure modes of one nominal edge and their recovery entry edges."""
+        after = account
+        for step in edge.steps:
+            after = _apply(after, step)
+        out = []
+        held = [o for o in dict.fromkeys([a.holding for a in account.values()] + [a.holding for a in after.values()]) if o]
+        for obj in held:
+            out.append(self._drop(edge, account, after, obj))
+        busy = {arm for step in edge.steps for arm, call in step.items() if call is not None}
+        for obj in self._aimed_at(graph, edge, account, held):
+            obj_info = self.objects.get(obj)
+            if obj_info is None:
+                continue
+            replay = Edge(
+                id=f"{edge.id}_r_{obj}_moved", source=edge.source, target=edge.target, kind="recovery",
+                actions=_replay_then_edge(account, edge, busy),
+            )
+            if kb.keeps_upright(obj_info):
+                tipped = self._set_upright(edge, account, obj, busy)
+                if tipped is not None:
+                    out.append(tipped)
+            out.append((FailureMode(name=f"{obj}_shifted", monitor=f"drift({obj}, {kb.drift_tolerance(obj_info):g})", window=kb.WINDOW, intent="re-approach", recovery=replay.id), replay))
+            if self.watch_visibility:
+                out.append((FailureMode(name=f"{obj}_lost", monitor=f"lost_view({obj}, {kb.MIN_POINTS})", window=kb.WINDOW, intent="re-observe", recovery=replay.id), None))
+        out += self._relations(graph, edge, account, after)
+        return out
+
+    def _drop(self, edge: Edge, before: Account, after: Account, obj: str) -> tuple[FailureMode, Edge]:
+        at_s, at_t = _holders(before, obj), _holders(after, obj)
+        if at_s and at_t and at_s != at_t:  # passed between the arms: someone must hold it throughout
+            monitor = f"0.5 - max(holding(left, {obj}), holding(right, {obj}))"
+        else:
+            arms = at_s or at_t
+            deliberate = not at_s or not at_t  # grasped or released on purpose: trust the latched grasp-done signal
+            terms = [f"{a}.closed * (0.5 - holding({a}, {obj}))" if deliberate else f"0.5 - holding({a}, {obj})" for a in arms]
+            monitor = terms[0] if len(terms) == 1 else f"max({', '.join(terms)})"
+        if not at_s:  # grasped during the edge: finish the grasp
+            steps = [{a: _with_skips(c) for a, c in step.items() if c is not None} for step in edge.steps]
+        else:
+            busy = {arm for step in edge.steps for arm, call in step.items() if call is not None}
+            regrasp: Step = {a: _regrasp(before, a, obj) for a in at_s}
+            # An arm of this edge with empty hands gets out of the way while the object is taken again.
+            regrasp.update({a: ActionCall(fn="back") for a in busy if a not in at_s and before[a].holding is None})
+            steps = [regrasp, *_replay_then_edge(before, edge, at_s or busy)]
+        recovery = Edge(id=f"{edge.id}_r_{obj}_dropped", source=edge.source, target=edge.target, kind="recovery", actions=steps)
+        mode = FailureMode(name=f"{obj}_dropped", monitor=monitor, window=kb.WINDOW, intent="regrasp", recovery=recovery.id)
+        return mode, recovery
+
+    def _aimed_at(self, graph: TaskGraph, edge: Edge, account: Account, held: list[str]) -> list[str]:
+        """Objects the edge aims at (or keeps a pose relative to) whose pose its target constrains."""
+        names: list[str] = []
+        for arm in ARMS:
+            calls = _calls(edge, arm)
+            for call in calls:
+                for key in ("obj", "relative_to"):
+                    name = call.args.get(key)
+                    if name and (call.fn != "grasp") and (call.fn != "place" or key == "relative_to"):
+                        names.append(name)
+            if calls and calls[0].fn in RELATIVE and account[arm].relative_to:
+                names.append(account[arm].relative_to)
+        target = graph.node(edge.target)
+        text = " ".join(target.constraints)
+        return [
+            n for n in dict.fromkeys(names)
+            if n not in held and not kb.is_cloth_corner(n) and (f"{n}." in text or f"({n}" in text or f" {n})" in text)
+        ]
+
+    def _set_upright(self, edge: Edge, account: Account, obj: str, busy: set[str]) -> tuple[FailureMode, Edge] | None:
+        free = [a for a in ARMS if account[a].holding is None and a not in busy]
+        if not free:
+            return None
+        helper = free[0]
+        parked = {a: ActionCall(fn="move_to_target", args={"pos": list(kb.PARK_POSE[a][0]), "yaw": kb.PARK_POSE[a][1]}) for a in busy if account[a].holding}
+        steps: list[Step] = [parked] if parked else []
+        steps += [{helper: ActionCall(fn="grasp", args={"obj": obj})}, {helper: ActionCall(fn="place", args={"obj": obj})}, {helper: ActionCall(fn="back")}]
+        steps += _replay_then_edge(account, edge, busy) if not parked else self._after_park(account, edge, busy)
+        recovery = Edge(id=f"{edge.id}_r_{obj}_tipped", source=edge.source, target=edge.target, kind="recovery", actions=steps)
+        mode = FailureMode(name=f"{obj}_tipped", monitor=f"tipped({obj}, {kb.TIP_DEG:g})", window=kb.WINDOW, intent="set upright", recovery=recovery.id)
+        return mode, recovery
+
+    @staticmethod
+    def _after_park(account: Account, edge: Edge, busy: set[str]) -> list[Step]:
+        # Parking is an absolute move: restore the whole pose since the grasp, then the edge.
+        history = {a: account[a].since_grasp for a in busy if account[a].since_grasp}
+        steps = _sequence(history)
+        for step in edge.steps:
+            kept = {a: _with_skips(c) for a, c in step.items() if c is not None}
+            if kept:
+                steps.append(kept)
+        return steps
+
+    def _relations(self, graph: TaskGraph, edge: Edge, before: Account, after: Account) -> list[tuple[FailureMode, Edge]]:
+        """Objects released in or on one that this edge carries (Eq. 19): put them back, take the carrier again."""
+        out = []
+        path = nominal_path(graph)
+        placed: dict[str, tuple[str, str, ActionCall, ActionCall]] = {}  # obj -> (host, arm, grasp, place)
+        account: Account = {arm: ArmAccount() for arm in ARMS}
+        for edge_id in path:
+            if edge_id == edge.id:
+                break
+            for step in graph.edge(edge_id).steps:
+                for arm, call in step.items():
+                    if call is not None and call.fn == "place" and call.args.get("relative_to") and account[arm].grasp is not None:
+                        dx, dy = call.args.get("target") or (0.0, 0.0)
+                        if abs(dx) < 1e-9 and abs(dy) < 1e-9:
+                            placed[call.args["obj"]] = (call.args["relative_to"], arm, account[arm].grasp, call)
+                account = _apply(account, step)
+        carried = {before[a].holding for a in ARMS if before[a].holding} & {after[a].holding for a in ARMS if after[a].holding}
+        for obj, (host, arm, grasp, place) in placed.items():
+            if host not in carried or host not in self.objects:
+                continue
+            holders = _holders(before, host)
+            tol = round(0.5 * min(self.objects[host].extent[0], self.objects[host].extent[1]), 3)
+            steps: list[Step] = [{a: ActionCall(fn="place", args={"obj": host, "skip_if_placed": True}) for a in holders}]
+            steps += [{arm: _with_skips(grasp)}, {arm: place}]
+            steps.append({a: _regrasp(before, a, host) for a in holders})
+            steps += _sequence({a: before[a].since_grasp for a in holders if before[a].since_grasp})
+            recovery = Edge(id=f"{edge.id}_r_{obj}_out", source=edge.source, target=edge.source, kind="recovery", actions=steps)
+            mode = FailureMode(name=f"{obj}_out", monitor=f"misaligned({obj}.pos, {host}.pos, {tol:g})", window=kb.WINDOW, intent="re-place", recovery=recovery.id)
+            out.append((mode, recovery))
+        return out
+
+    def _monitor_recoveries(self, graph: TaskGraph) -> None:
+        """Drop monitors on recovery edges: a second drop re-enters that object's recovery from the same context.
+
+        Watched: what the arms hold at the recovery's source and what the recovery grasps. The
+        grasp-done signal gates every such monitor: a recovery grasps and places on purpose.
+        """
+        entries = {(e.source, f.name): f.recovery for e in graph.nominal_edges() for f in e.failures if f.intent == "regrasp"}
+        accounts = {graph.edge(edge_id).source: account for edge_id, account in self.accounts(graph).items()}
+        for edge in graph.recovery_edges():
+            if edge.failures:
+                continue
+            source = accounts.get(edge.source)
+            held: list[tuple[str, str]] = [(a, source[a].holding) for a in ARMS if source is not None and source[a].holding]
+            for step in edge.steps:
+                for arm, call in step.items():
+                    if call is not None and call.fn == "grasp" and (arm, call.args["obj"]) not in held:
+                        held.append((arm, call.args["obj"]))
+            for arm, obj in held:
+                name = f"{obj}_dropped"
+                recovery = entries.get((edge.source, name))
+                if recovery is None or any(f.name == name for f in edge.failures):
+                    continue
+                edge.failures.append(
+                    FailureMode(name=name, monitor=f"{arm}.closed * (0.5 - holding({arm}, {obj}))", window=kb.WINDOW, intent="regrasp", recovery=recovery)
+                )
+
+    # --- online repair -----------------------------------------------------------------
+
+    def repair(self, graph: TaskGraph, failure: UnanticipatedFailure, now: Scene) -> TaskGraph | None:
+        """One new branch for an unanticipated failure at the end of a nominal edge, or ``None``.
+
+        Reads the current observation ``now`` against the nominal account at the edge's source: a held
+        object no longer held is a drop; a held object tilted in the hand is a slipped grasp
+        (set it down upright, take it again); an upright object lying on its side is a tip.
+        """
+        accounts = self.accounts(graph)
+        if failure.edge not in accounts:
+            return None
+        edge = graph.edge(failure.edge)
+        before = accounts[failure.edge]
+        after = before
+        for step in edge.steps:
+            after = _apply(after, step)
+        current = {o.name: o for o in now.objects}
+        holding = {(a.name, a.holding) for a in now.arms if a.holding}
+        branch: tuple[FailureMode, Edge] | None = None
+        for arm in ARMS:
+            obj = after[arm].holding
+            if not obj or obj not in current:
+                continue
+            info = self.objects.get(obj)
+            if (arm, obj) not in holding:
+                mode, recovery = self._drop(edge, before, after, obj)
+                branch = (mode.model_copy(update={"name": f"{obj}_lost_unforeseen"}), recovery.model_copy(update={"id": f"{edge.id}_r_{obj}_lost_unforeseen"}))
+            elif info is not None and kb.is_tall(info) and _tilt(current[obj]) > 15.0 and before[arm].holding == obj:
+                steps: list[Step] = [{arm: ActionCall(fn="place", args={"obj": obj})}, {arm: _regrasp(before, arm, obj)}]
+                steps += _replay_then_edge(before, edge, {arm})
+                recovery = Edge(id=f"{edge.id}_r_{obj}_slipped", source=edge.source, target=edge.target, kind="recovery", actions=steps)
+                mode = FailureMode(name=f"{obj}_slipped", monitor=f"holding({arm}, {obj}) * tipped({obj}, 15)", window=kb.WINDOW, intent="reseat", recovery=recovery.id)
+                branch = (mode, recovery)
+            if branch:
+                break
+        if branch is None:
+            for name, info in self.objects.items():
+                if name in current and kb.keeps_upright(info) and not any((a, name) in holding for a in ARMS) and _tilt(current[name]) > kb.TIP_DEG:
+                    busy = {a for step in edge.steps for a, c in step.items() if c is not None}
+                    branch = self._set_upright(edge, before, name, busy)
+                    if branch:
+                        break
+        if branch is None:
+            return None
+        mode, recovery = branch
+        if any(f.name == mode.name for f in edge.failures) or any(e.id == recovery.id for e in graph.edges):
+            return None
+        out = graph.model_copy(deep=True)
+        out.edge(edge.id).failures.append(mode)
+        out.edges.append(recovery)
+        return out
+
+
+def _tilt(obj: SceneObject) -> float:
+    return math.degrees(math.acos(max(-1.0, min(1.0, float(obj.axis[2])))))

@@ -1,0 +1,153 @@
+"""What the offline reasoner knows about objects and skills, independent of any task.
+
+Object categories come from names and descriptions (a lexicon) and from geometry
+(tall, flat, wider than one gripper). Skill parameters are the ones measured to work
+on the simulated ALOHA (the ViperX grippers, the 50 Hz controller): a pour offset and
+tilt, the heights of a two-gripper handover on one bar, clearance lifts, park poses.
+They are knowledge about the robot and object categories, not about a task: the same
+numbers serve every scene in which the category appears.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+from agentchord.agents.reasoner import SceneObject
+
+# --- categories ---------------------------------------------------------------------------
+
+#: Words that make an object a container (something can be poured or put into it).
+CONTAINER_WORDS = frozenset({"cup", "mug", "glass", "bowl", "tray", "box", "basket", "bin", "pot", "jar"})
+#: Words that make an object a pouring vessel.
+POURABLE_WORDS = frozenset({"bottle", "jug", "pitcher", "kettle", "carafe", "flask"})
+#: Suffixes of a cloth's corner points (bottom = near edge, top = far edge; l = -x, r = +x).
+CLOTH_CORNERS = ("bl", "br", "tl", "tr")
+#: Widest horizontal extent one parallel gripper closes on (m); wider objects take both arms.
+ONE_HAND_WIDTH = 0.10
+#: An object this much taller than wide stands upright and is grasped from the side.
+TALL_RATIO = 1.5
+#: Thinner than this (m) is flat: grasped from the top and lifted clear before it is carried.
+FLAT_HEIGHT = 0.03
+
+# --- skill parameters (measured on the simulated ALOHA) -----------------------------------
+
+#: Tool offset from the receiving container's top point for pouring (m), and the tool's yaw.
+POUR_OFFSET = (0.0, -0.09, 0.08)
+POUR_YAW = 180.0
+#: Roll of the tool that tips the vessel's mouth into the container (deg).
+POUR_TILT = 95.0
+#: Smallest tilt (deg) that counts as pouring, and the container-mouth tolerance.
+POUR_MIN_TILT = 70.0
+#: Where the holding arm presents a container to be poured into (m), and its yaw.
+RECEIVE_POSE = (0.0, 0.62, 0.15)
+#: Where the giving arm holds an object for a handover (m).
+HANDOVER_POSE = (0.0, 0.50, 0.25)
+#: Side-grasp heights (fraction of the object's height) of the giver and the receiver of a
+#: handover: two grippers on one bar need ~11 cm between their tool centres.
+HANDOVER_GIVER_HEIGHT = 0.85
+HANDOVER_RECEIVER_HEIGHT = 0.2
+#: The giver's retreat after opening (m, along its own side of the table).
+HANDOVER_RETREAT = 0.10
+#: Clearance lift of a flat object before it is carried (m), and of a tray held by both arms.
+FLAT_LIFT = 0.06
+TWO_ARM_LIFT = 0.05
+#: How far inside a wide object's end its handle is grasped (m).
+HANDLE_INSET = 0.025
+#: Poses where an arm holding something waits while the other arm works near it (m, yaw).
+PARK_POSE = {"left": ((-0.12, 0.72, 0.22), 0.0), "right": ((0.16, 0.42, 0.25), 180.0)}
+#: Table-setting convention: utensils lie this far (m) left and right of the plate's centre.
+BESIDE_DISTANCE = 0.17
+#: Release height above a container's floor or a support's top (m).
+RELEASE_CLEARANCE = 0.005
+#: Folding a cloth: carry the near corner to this offset from the far corner (m), first high
+#: and short of it, then above it; release it this far short of the far corner, this high.
+FOLD_LIFT_OFFSET = (0.0, -0.17, 0.10)
+FOLD_OVER_OFFSET = (0.0, -0.02, 0.10)
+FOLD_PLACE_OFFSET = (0.0, -0.04)
+FOLD_RELEASE_HEIGHT = 0.012
+#: A pinch of a flat cloth corner: just below the vertex, no lift.
+PINCH_DEPTH = 0.002
+
+# --- monitor thresholds -------------------------------------------------------------------
+
+#: Drift of an object that must stay put (m): the larger of this and a fraction of its size.
+DRIFT_MIN = 0.02
+DRIFT_FRACTION = 0.5
+#: Tilt (deg) beyond which an upright object has tipped over.
+TIP_DEG = 30.0
+#: Persistence window (ticks) of every monitor: 60 ms at 50 Hz.
+WINDOW = 3
+#: Fewest visible points of a tracked object (RGB-D) before it counts as lost from view.
+MIN_POINTS = 30
+
+
+def words(obj: SceneObject) -> set[str]:
+    """The words naming an object: its name's parts and its description."""
+    return set(obj.name.lower().replace("_", " ").split()) | set(obj.description.lower().replace(",", " ").split())
+
+
+def is_container(obj: SceneObject) -> bool:
+    """Whether things can be poured or put into the object."""
+    return bool(words(obj) & CONTAINER_WORDS)
+
+
+def is_pourable(obj: SceneObject) -> bool:
+    """Whether the object is a vessel to pour from."""
+    return bool(words(obj) & POURABLE_WORDS)
+
+
+def is_tall(obj: SceneObject) -> bool:
+    """Whether the object stands upright, taller than wide (grasped from the side)."""
+    return obj.extent[2] > TALL_RATIO * max(obj.extent[0], obj.extent[1]) or (is_pourable(obj) and obj.extent[2] > obj.extent[0])
+
+
+def keeps_upright(obj: SceneObject) -> bool:
+    """Whether the object must stay upright (it holds liquid or stands on end)."""
+    return is_tall(obj) or (is_container(obj) and not is_wide(obj))
+
+
+def is_flat(obj: SceneObject) -> bool:
+    """Whether the object is flat (utensils, plates): top grasp, lifted clear before carrying."""
+    return obj.extent[2] < FLAT_HEIGHT
+
+
+def is_wide(obj: SceneObject) -> bool:
+    """Whether one gripper cannot hold the object (it takes both arms, by its ends)."""
+    return min(obj.extent[0], obj.extent[1]) > ONE_HAND_WIDTH or max(obj.extent[0], obj.extent[1]) > 2.5 * ONE_HAND_WIDTH
+
+
+def is_cloth_corner(name: str) -> bool:
+    """Whether ``name`` is a cloth's corner point (``towel_bl``)."""
+    return "_" in name and name.rsplit("_", 1)[1] in CLOTH_CORNERS
+
+
+def cloth_names(names: Iterable[str]) -> list[str]:
+    """Cloths whose four corner points are all in ``names``."""
+    names = set(names)
+    stems = sorted({n.rsplit("_", 1)[0] for n in names if is_cloth_corner(n)})
+    return [s for s in stems if all(f"{s}_{c}" in names for c in CLOTH_CORNERS)]
+
+
+def near_arm(obj: SceneObject) -> str:
+    """The arm on the object's side of the table (left: x < 0)."""
+    return "left" if obj.pos[0] < 0.0 else "right"
+
+
+def grasp_args(obj: SceneObject) -> dict:
+    """Arguments of a one-arm ``grasp`` of ``obj`` by its category."""
+    if is_cloth_corner(obj.name):
+        return {"obj": obj.name, "mode": "top", "offset": [0.0, 0.0, -PINCH_DEPTH], "lift": 0.0}
+    if is_flat(obj) or not (is_tall(obj) or is_container(obj)):
+        return {"obj": obj.name, "mode": "top"}
+    return {"obj": obj.name}  # auto: from the side when upright and tall, from the top when fallen
+
+
+def handle_offset(obj: SceneObject, arm: str) -> list[float]:
+    """Object-frame offset of the handle an arm takes on a wide object (its end on the arm's side)."""
+    half = 0.5 * max(obj.extent[0], obj.extent[1]) - HANDLE_INSET
+    return [-half if arm == "left" else half, 0.0, 0.0]
+
+
+def drift_tolerance(obj: SceneObject) -> float:
+    """Drift (m) of ``obj`` that counts as moved: scaled to its footprint."""
+    return round(max(DRIFT_MIN, DRIFT_FRACTION * min(obj.extent[0], obj.extent[1])), 3)
