@@ -18,6 +18,7 @@ from agentchord import __version__
 from agentchord.graph.cli import graph_group, import_release_command, schema_command
 
 STRATEGY_NAMES = ("agentchord", "agentchord-bt")
+REASONER_NAMES = ("rules", "llm")
 PERCEPTION_NAMES = ("oracle", "rgbd")
 DISTURB_HELP = "Disturbance kinds, comma-separated: drop, pull, perturb, shift, knock."
 
@@ -81,6 +82,65 @@ def _load_graph_option(graph_path: str | None):
 
 
 @main.command()
+@click.argument("instruction", required=False)
+@click.option("--task", required=True, help="Simulated task whose seeded scene is the first observation.")
+@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the scene.")
+@click.option("--goal", "goal_path", type=click.Path(exists=True, dir_okay=False), help="A goal spec (YAML/JSON) instead of reading INSTRUCTION.")
+@click.option("--reasoner", type=click.Choice(REASONER_NAMES), default="rules", show_default=True)
+@click.option("--perception", type=click.Choice(PERCEPTION_NAMES), default="oracle", show_default=True)
+@click.option("-o", "--output", type=click.Path(dir_okay=False), required=True, help="Where to write the augmented graph (.yaml/.json).")
+@click.option("--render", "render_path", type=click.Path(dir_okay=False), help="Also draw it (.svg, .png, .pdf, .dot, .mmd).")
+@click.option("--trace", "trace_path", type=click.Path(dir_okay=False), help="Write the agents' calls as JSON lines.")
+def plan(instruction, task, seed, goal_path, reasoner, perception, output, render_path, trace_path) -> None:
+    """Compose, arrange and conduct the graph for INSTRUCTION in TASK's scene; write it to --output.
+
+    Exit status 0 when a valid graph was written, 2 when the instruction cannot be planned.
+    """
+    import numpy as np  # noqa: PLC0415
+
+    from agentchord.agents.exceptions import ReasonerError  # noqa: PLC0415
+    from agentchord.agents.observe import observe, task_regions  # noqa: PLC0415
+    from agentchord.agents.pipeline import make_reasoner, plan_task  # noqa: PLC0415
+    from agentchord.execution.trace import Trace  # noqa: PLC0415
+    from agentchord.graph.loader import dump_graph  # noqa: PLC0415
+    from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: PLC0415
+    from agentchord.worlds.sim.world import SimWorld  # noqa: PLC0415
+
+    _task_name(task, "--task")
+    goal = _load_goal_option(goal_path)
+    if not instruction and goal is None:
+        raise click.UsageError("give an INSTRUCTION or --goal")
+    sim_task = SIM_TASKS[task]
+    world = SimWorld(sim_task.sample_scene(np.random.default_rng([seed, 0x5CE7E])))
+    scene = observe(world, task_regions(sim_task), perception)
+    try:
+        agent = make_reasoner(reasoner, goal=goal, watch_visibility=perception == "rgbd")
+        result = plan_task(instruction or "", scene, agent, task=task)
+    except ReasonerError as exc:
+        raise click.UsageError(str(exc)) from exc
+    console = Console()
+    graph = result.graph
+    dump_graph(graph, output)
+    modes = sum(len(e.failures) for e in graph.edges)
+    console.print(f"[bold]{task}[/bold] (seed {seed}): {len(result.nominal.edges)} nominal edges, {modes} failure modes, "
+                  f"{len(graph.recovery_edges())} recovery edges, {len(graph.recovery_nodes())} recovery nodes")
+    for removed in result.filtered.removed:
+        console.print(f"  forward-moving filter removed {removed.failure} on {removed.edge}: {removed.reason}")
+    timing = ", ".join(f"{agent} {1000 * s:.0f} ms" for agent, s in result.seconds.items())
+    console.print(f"  {timing} ({reasoner} reasoner)")
+    console.print(f"graph: {output}")
+    if render_path:
+        from agentchord.graph.render import render  # noqa: PLC0415
+
+        console.print(f"figure: {render(graph, render_path)}")
+    if trace_path:
+        trace = Trace()
+        for call in result.calls:
+            trace.add(0, "reasoner_call", **call.to_trace_event())
+        console.print(f"trace: {trace.write(trace_path)}")
+
+
+@main.command()
 @click.argument("task")
 @click.option("--strategy", type=click.Choice(STRATEGY_NAMES), default="agentchord", show_default=True)
 @click.option("--p", "p", type=click.FloatRange(0.0, 1.0), default=0.0, show_default=True, help="Disturbance probability per atomic action.")
@@ -89,11 +149,16 @@ def _load_graph_option(graph_path: str | None):
 @click.option("--perception", type=click.Choice(PERCEPTION_NAMES), default="oracle", show_default=True)
 @click.option("--seed", type=int, default=0, show_default=True)
 @click.option("--graph", "graph_path", type=click.Path(exists=True, dir_okay=False), help="Graph file (default: the task library's).")
+@click.option("--instruction", help="Plan the graph from this instruction on the episode's first observation.")
+@click.option("--goal", "goal_path", type=click.Path(exists=True, dir_okay=False), help="Plan from a goal spec file (YAML/JSON) instead.")
+@click.option("--reasoner", type=click.Choice(REASONER_NAMES), default="rules", show_default=True, help="Who plans: offline rules or an LLM.")
+@click.option("--repair/--no-repair", default=None, help="Online repair of unanticipated failures (default: on for a planned graph).")
 @click.option("--trace", "trace_path", type=click.Path(dir_okay=False), help="Write the trace as JSON lines.")
 @click.option("--json", "json_path", type=click.Path(dir_okay=False), help="Write the episode summary as JSON.")
 @click.option("--video", "video_path", type=click.Path(dir_okay=False), help="Write an MP4 of the episode.")
 @click.option("--camera", default="front", show_default=True, help="Scene camera for --video.")
-def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, trace_path, json_path, video_path, camera) -> None:
+def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, instruction, goal_path, reasoner, repair,
+        trace_path, json_path, video_path, camera) -> None:
     """Run one episode of TASK and print its path through the graph.
 
     Exit status 0 when the task succeeded, 1 when it failed, 2 on bad input.
@@ -102,6 +167,9 @@ def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, trac
 
     _task_name(task, "TASK")
     graph = _load_graph_option(graph_path)
+    goal = _load_goal_option(goal_path)
+    if graph is not None and (instruction or goal):
+        raise click.UsageError("give either --graph or --instruction/--goal, not both")
     console = Console()
     recorder = {}
 
@@ -126,8 +194,9 @@ def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, trac
         caption = f"{task}  node {executor.node}  edge {program.edge_id if program else '-'} ({program.kind if program else ''})"
         video.capture(caption)
 
-    spec = EpisodeSpec(task=task, strategy=strategy, p=p, seed=seed, graph=graph, disturb=disturb, protocol=protocol, perception=perception)
-    result = run_episode(spec, on_tick=on_tick)
+    spec = EpisodeSpec(task=task, strategy=strategy, p=p, seed=seed, graph=graph, disturb=disturb, protocol=protocol,
+                       perception=perception, instruction=instruction, goal=goal, reasoner=reasoner, repair=repair)
+    result = _run_or_explain(spec, on_tick)
     _print_episode(console, result)
     if trace_path:
         result.trace.write(trace_path)
@@ -139,6 +208,30 @@ def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, trac
     if video_path and "video" in recorder:
         console.print(f"video: {recorder['video'].write()}")
     sys.exit(0 if result.success else 1)
+
+
+def _run_or_explain(spec, on_tick=None):
+    """Run an episode; a reasoner that cannot plan is bad input (exit 2), not a crash."""
+    from agentchord.agents.exceptions import ReasonerError  # noqa: PLC0415
+    from agentchord.execution.episode import run_episode  # noqa: PLC0415
+
+    try:
+        return run_episode(spec, on_tick=on_tick)
+    except ReasonerError as exc:
+        raise click.UsageError(str(exc)) from exc
+
+
+def _load_goal_option(goal_path: str | None):
+    if goal_path is None:
+        return None
+    from agentchord.agents.rules.goals import GoalSpec  # noqa: PLC0415
+    from agentchord.graph.exceptions import GraphFileError  # noqa: PLC0415
+    from agentchord.graph.loader import load_model  # noqa: PLC0415
+
+    try:
+        return load_model(goal_path, GoalSpec)
+    except GraphFileError as exc:
+        raise click.UsageError(str(exc)) from exc
 
 
 def _print_episode(console: Console, result) -> None:
@@ -159,6 +252,12 @@ def _print_episode(console: Console, result) -> None:
             console.print(f"{tick}  [red]failure detected[/red]: {event['failure']} on {event['edge']} (violated since tick {event['onset_tick']})")
         elif kind == "recovery_switch":
             console.print(f"{tick}  [magenta]recovery switch[/magenta] -> {event['to']} ({event['latency_ticks']} ticks after onset)")
+        elif kind == "repair":
+            state = "added" if event["accepted"] else f"rejected ({event.get('reason')})"
+            console.print(f"{tick}  [cyan]online repair[/cyan] after {event['edge']}: {event['observation']} -> {event['failure']} / {event['recovery']} {state}")
+        elif kind == "reasoner_call":
+            status = "ok" if event["ok"] else f"failed: {event['error']}"
+            console.print(f"{tick}  {event['agent']} ({event['reasoner']}): {status}, {1000 * event['latency_s']:.0f} ms")
         elif kind == "branch_removed":
             console.print(f"{tick}  forward-moving filter removed {event['failure']} on {event['edge']}: {event['reason']}")
     verdict = "[green]SUCCESS[/green]" if result.success else "[red]FAILURE[/red]"
@@ -177,8 +276,11 @@ def _print_episode(console: Console, result) -> None:
 @click.option("--perception", type=click.Choice(PERCEPTION_NAMES), default="oracle", show_default=True)
 @click.option("--strategies", default=",".join(STRATEGY_NAMES), show_default=True, help="Comma-separated strategies to compare.")
 @click.option("--workers", type=click.IntRange(1, 64), default=None, help="Worker processes (default: one per core).")
+@click.option("--planned", is_flag=True, help="Plan each episode's graph with --reasoner from the task's instruction instead of the library graph.")
+@click.option("--instruction", help="Plan each episode's graph from this instruction (implies --planned).")
+@click.option("--reasoner", type=click.Choice(REASONER_NAMES), default="rules", show_default=True)
 @click.option("--json", "json_path", type=click.Path(dir_okay=False), help="Write the aggregates as JSON.")
-def demo(task, trials, p, disturb, protocol, perception, strategies, workers, json_path) -> None:
+def demo(task, trials, p, disturb, protocol, perception, strategies, workers, planned, instruction, reasoner, json_path) -> None:
     """Seeded episodes of each strategy under random drops, then a table per strategy."""
     from agentchord.bench.report import aggregate, paired_steps, print_tables  # noqa: PLC0415
     from agentchord.bench.runner import run_many  # noqa: PLC0415
@@ -192,7 +294,14 @@ def demo(task, trials, p, disturb, protocol, perception, strategies, workers, js
     schedule = "1-2 disturbances per trial (real-world protocol)" if protocol else f"probability p = {p} per atomic action"
     console.print(f"[bold]{task}[/bold]: {trials} seeded episodes per strategy; disturbances {', '.join(disturb)}, "
                   f"{schedule}; perception {perception}")
-    specs = [EpisodeSpec(task=task, strategy=name, p=p, seed=seed, disturb=disturb, protocol=protocol, perception=perception)
+    if planned and instruction is None:
+        from agentchord.tasks import load_task_graph  # noqa: PLC0415
+
+        instruction = load_task_graph(task).instruction
+    if instruction:
+        console.print(f"graphs planned per episode by the {reasoner} reasoner from: {instruction!r}")
+    specs = [EpisodeSpec(task=task, strategy=name, p=p, seed=seed, disturb=disturb, protocol=protocol, perception=perception,
+                         instruction=instruction, reasoner=reasoner)
              for name in names for seed in range(trials)]
     summaries: dict[str, list[dict]] = {name: [] for name in names}
     with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(), console=console) as bar:
@@ -207,7 +316,7 @@ def demo(task, trials, p, disturb, protocol, perception, strategies, workers, js
     print_tables(results, console, paired)
     if json_path:
         payload = {"task": task, "p": p, "trials": trials, "disturb": list(disturb), "protocol": protocol,
-                   "perception": perception, "strategies": results, "paired_steps": paired}
+                   "perception": perception, "instruction": instruction, "reasoner": reasoner if instruction else None, "strategies": results, "paired_steps": paired}
         Path(json_path).parent.mkdir(parents=True, exist_ok=True)
         Path(json_path).write_text(json.dumps(payload, indent=2) + "\n")
         console.print(f"aggregates: {json_path}")

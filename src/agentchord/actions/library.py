@@ -17,7 +17,7 @@ from agentchord.actions import catalog
 from agentchord.actions.base import ActionFailed, ArmAction
 from agentchord.actions.controller import RobotController
 from agentchord.actions.motion import grasp_frame, grip, move_joints, move_to, pose_from_matrix, settle, wait_for_rest
-from agentchord.worlds.sim.scene import ARM_JOINTS, ARM_PREFIX, HOME_Q
+from agentchord.worlds.sim.scene import ARM_JOINTS, ARM_PREFIX, FINGER_GAP_OFFSET, FINGER_RANGE, HOME_Q
 
 #: Tilt (deg) beyond which an object counts as fallen for a side grasp.
 UPRIGHT_TOLERANCE_DEG = 25.0
@@ -346,6 +346,12 @@ class RotateEef(ArmAction):
         yield from settle(robot, arm, max_ticks=10)
 
 
+#: Finger gap beyond the object's width (m) when releasing it inside a rim.
+RELEASE_MARGIN = 0.02
+#: Height (m) by which a placed object clears the top of the object it is placed relative to.
+RIM_CLEARANCE = 0.02
+
+
 class Place(ArmAction):
     """Lower the held object onto the table, release it, retreat."""
 
@@ -390,16 +396,35 @@ class Place(ArmAction):
             # Put the object's centre, not the tool, over the target.
             above[:2] += target - obj.pos[:2]
         above[2] = max(above[2], tool.pos[2])
+        if self.args.relative_to is not None:
+            # Carry the object over the reference's rim (into a cup, onto a block), not through it.
+            host_top = robot.frame.objects[self.args.relative_to].top[2]
+            above[2] = max(above[2], tool.pos[2] + host_top + RIM_CLEARANCE - obj.bottom[2])
         yield from move_to(robot, arm, pose_from_matrix(above, rotation))
         obj = robot.frame.objects[self.args.obj]
         drop = obj.bottom[2] - (self.args.z_offset + 0.004)
         down = robot.commanded_pose(arm).pos - np.array([0.0, 0.0, drop])
         yield from move_to(robot, arm, pose_from_matrix(down, rotation), speed=0.12)
         yield from settle(robot, arm, max_ticks=10)
-        yield from grip(robot, arm, 0.0, ticks=8)
+        yield from grip(robot, arm, self._release_grip(robot), ticks=8)
         # Back off along the approach (straight up after a top grasp).
         retreat = down - 0.08 * rotation[:, 0] + np.array([0.0, 0.0, 0.04 if rotation[2, 0] > -0.7 else 0.0])
         yield from move_to(robot, arm, pose_from_matrix(retreat, rotation))
+        if robot.targets[arm].grip > 0.0:
+            yield from grip(robot, arm, 0.0, ticks=6)  # clear of the rim: open fully for the next grasp
+
+    def _release_grip(self, robot: RobotController) -> float:
+        """Fully open, unless the object sits inside a rim (a cup): then just wider than the object,
+        so the fingers do not press on the walls and lift the container on the way out."""
+        if self.args.relative_to is None:
+            return 0.0
+        obj = robot.frame.objects[self.args.obj]
+        if robot.frame.objects[self.args.relative_to].top[2] < obj.bottom[2] + 0.01:
+            return 0.0
+        gap = float(min(obj.extent[0], obj.extent[1])) + RELEASE_MARGIN
+        lo, hi = FINGER_RANGE
+        q = 0.5 * (gap + FINGER_GAP_OFFSET)
+        return float(np.clip((hi - q) / (hi - lo), 0.0, 1.0))
 
     def _standing(self, robot: RobotController) -> bool:
         """Whether the object already stands upright on the table (an earlier place released it)."""

@@ -93,17 +93,22 @@ def run_episode(spec: EpisodeSpec, on_tick: Callable[[Executor], None] | None = 
         reasoner = make_reasoner(spec.reasoner, goal=spec.goal, watch_visibility=spec.perception == "rgbd")
         planned = plan_task(spec.instruction or "", observe(world, regions, spec.perception), reasoner, task=spec.task)
         graph, calls = planned.graph, planned.calls
+        tracker = task.success_tracker()
+        if hasattr(tracker, "expect"):  # a task judged by the goal it was planned for
+            goal = spec.goal or getattr(reasoner, "last_goal", None)
+            tracker.expect(goal, graph.node(graph.goal).constraints, getattr(task, "regions", {}))
         if repairer is None and spec.repair is not False:
             repairer = ReasonerRepairer(reasoner, regions)
     else:
         graph = spec.graph or load_task_graph(spec.task)
+        tracker = task.success_tracker()
         if repairer is None and spec.repair:
             repairer = ReasonerRepairer(make_reasoner("rules"), task_regions(task))
     executor = Executor(
         graph=graph,
         world=world,
         strategy=make_strategy(spec.strategy),
-        tracker=task.success_tracker(),
+        tracker=tracker,
         disturbance=spec.make_disturbance(),
         config=spec.config,
         on_tick=on_tick,

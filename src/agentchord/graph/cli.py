@@ -17,8 +17,14 @@ from agentchord.graph.validation import check_file
 
 
 @click.command("schema")
-def schema_command() -> None:
-    """Print the JSON Schema of task-graph files."""
+@click.argument("kind", type=click.Choice(["graph", "goal"]), default="graph")
+def schema_command(kind: str) -> None:
+    """Print the JSON Schema of task-graph files (KIND graph) or of goal specs (KIND goal)."""
+    if kind == "goal":
+        from agentchord.agents.rules.goals import GoalSpec  # noqa: PLC0415
+
+        click.echo(json.dumps(GoalSpec.model_json_schema(), indent=2))
+        return
     click.echo(json.dumps(TaskGraph.model_json_schema(), indent=2))
 
 

@@ -47,6 +47,20 @@ def load_graph(path: str | Path) -> TaskGraph:
         raise GraphFileError(path, validation_messages(error, data)) from None
 
 
+def load_model(path: str | Path, model: type[BaseModel]) -> BaseModel:
+    """Load any pydantic model (a goal spec, ...) from a YAML or JSON file, with the same error lines.
+
+    Raises:
+        GraphFileError: The file cannot be read or parsed, or does not match the model.
+    """
+    path = Path(path)
+    data = _read(path)
+    try:
+        return model.model_validate(data)
+    except ValidationError as error:
+        raise GraphFileError(path, validation_messages(error, data if isinstance(data, dict) else {})) from None
+
+
 def dump_graph(graph: TaskGraph, path: str | Path) -> Path:
     """Write ``graph`` as YAML or JSON, chosen by the suffix of ``path``.
 

@@ -301,7 +301,7 @@ class Arranger:
                         if abs(dx) < 1e-9 and abs(dy) < 1e-9:
                             placed[call.args["obj"]] = (call.args["relative_to"], arm, account[arm].grasp, call)
                 account = _apply(account, step)
-        carried = {before[a].holding for a in ARMS if before[a].holding} & {after[a].holding for a in ARMS if after[a].holding}
+        carried = {before[a].holding for a in ARMS if before[a].holding}  # held at the source: this edge moves it
         for obj, (host, arm, grasp, place) in placed.items():
             if host not in carried or host not in self.objects:
                 continue
@@ -369,7 +369,8 @@ class Arranger:
             info = self.objects.get(obj)
             if (arm, obj) not in holding:
                 mode, recovery = self._drop(edge, before, after, obj)
-                branch = (mode.model_copy(update={"name": f"{obj}_lost_unforeseen"}), recovery.model_copy(update={"id": f"{edge.id}_r_{obj}_lost_unforeseen"}))
+                entry = f"{edge.id}_r_{obj}_lost_unforeseen"
+                branch = (mode.model_copy(update={"name": f"{obj}_lost_unforeseen", "recovery": entry}), recovery.model_copy(update={"id": entry}))
             elif info is not None and kb.is_tall(info) and _tilt(current[obj]) > 15.0 and before[arm].holding == obj:
                 steps: list[Step] = [{arm: ActionCall(fn="place", args={"obj": obj})}, {arm: _regrasp(before, arm, obj)}]
                 steps += _replay_then_edge(before, edge, {arm})

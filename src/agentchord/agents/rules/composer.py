@@ -57,6 +57,9 @@ def compose(goal: GoalSpec, scene: Scene, task: str = "", instruction: str = "")
 
 
 def _graph(rounds: list[Round], states: list[State], goal: GoalSpec, scene: Scene, task: str, instruction: str) -> TaskGraph:
+    # Only objects the goal or the plan touch are constrained: the rest of the table is not the task's.
+    relevant = set(goal.objects()) | {name for rnd in rounds for op in rnd.operators for name in op.objects}
+    states = [frozenset(f for f in state if f[0] not in ("upright", "on_table") or f[1] in relevant) for state in states]
     nodes = [Node(id="v0", semantic=_initial_semantic(scene, goal), constraints=_constraints(states[0], frozenset(), scene, initial=True))]
     edges = []
     for i, rnd in enumerate(rounds, start=1):
@@ -71,14 +74,10 @@ def _graph(rounds: list[Round], states: list[State], goal: GoalSpec, scene: Scen
         instruction=instruction,
         start="v0",
         goal=f"v{len(rounds)}",
-        objects=[o.name for o in scene.objects if o.name in goal.objects() or _named(o.name, rounds)],
+        objects=[o.name for o in scene.objects if o.name in relevant],
         nodes=nodes,
         edges=edges,
     )
-
-
-def _named(name: str, rounds: list[Round]) -> bool:
-    return any(name in op.objects for rnd in rounds for op in rnd.operators)
 
 
 def _initial_semantic(scene: Scene, goal: GoalSpec) -> str:

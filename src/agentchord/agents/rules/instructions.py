@@ -15,6 +15,7 @@ import re
 from collections.abc import Callable
 
 from agentchord.agents.exceptions import InstructionNotGroundedError
+from agentchord.agents.observe import COLOURS
 from agentchord.agents.reasoner import Scene
 from agentchord.agents.rules.goals import Folded, Goal, GoalSpec, HandedOver, Inside, On, Placed, Poured
 from agentchord.agents.rules.knowledge import BESIDE_DISTANCE, cloth_names
@@ -53,7 +54,8 @@ class _Context:
         if len(candidates) != 1:
             # The head noun alone (the last word) may still be unique: "coffee capsule" -> capsule.
             head = [o.name for o in self.scene.objects if words[-1] in set(o.name.lower().split("_")) | set(o.description.lower().split())]
-            if len(candidates) == 0 and len(head) == 1:
+            # A colour that does not match is a contradiction, not a modifier to ignore.
+            if len(candidates) == 0 and len(head) == 1 and not set(words[:-1]) & set(COLOURS):
                 candidates = head
         if not candidates:
             raise self._error(phrase, f"names no scene object (the scene has {', '.join(self.scene.object_names)})")

@@ -49,12 +49,15 @@ class RulesReasoner:
         self.goal = goal
         self.watch_visibility = watch_visibility
         self.conductor = conductor or Conductor()
+        #: The goal spec of the last compose call (read from the instruction or given).
+        self.last_goal: GoalSpec | None = None
 
     def compose(self, request: ComposeRequest) -> TaskGraph:
         """The nominal graph (raises :class:`InstructionNotGroundedError` or :class:`PlanningError`)."""
 
         def answer() -> TaskGraph:
             goal = self.goal or ground_instruction(request.instruction, request.scene)
+            self.last_goal = goal
             return compose(goal, request.scene, request.task, request.instruction).graph
 
         return self._call(request, answer)

@@ -1,0 +1,104 @@
+"""Judge an episode by the goal it was planned for, for tasks with no fixed success check.
+
+The judge reads the world (not the planner's constraints): an object is *inside* a
+container when it rests, released, within the container's footprint and below its rim;
+*on* a support when its bottom rests on the support's top within its footprint; *placed*
+when it rests released at the stated place. Predicates it cannot judge physically
+(poured, handed over, folded) fall back to the planned graph's goal-node constraints.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from agentchord.features.frame import FeatureFrame
+from agentchord.worlds.sim.tasks.base import Verdict, resting_on_table
+from agentchord.worlds.sim.world import SimWorld
+
+#: Largest speed (m/s) of an object at rest.
+REST_SPEED = 0.02
+
+
+@dataclass
+class GoalTracker:
+    """Success = the goal predicates hold at the end.
+
+    Attributes:
+        goal: The goal spec (:class:`~agentchord.agents.rules.goals.GoalSpec`), if known.
+        constraints: The planned graph's goal-node constraints (the fallback).
+        regions: Named regions (name -> (centre, radius)) for placed-in-region goals.
+    """
+
+    goal: object | None = None
+    constraints: list[str] = field(default_factory=list)
+    regions: dict = field(default_factory=dict)
+
+    def expect(self, goal: object | None, constraints: list[str], regions: dict | None = None) -> None:
+        """Tell the tracker what the episode was planned to achieve."""
+        self.goal, self.constraints, self.regions = goal, list(constraints), dict(regions or {})
+
+    def observe(self, frame: FeatureFrame) -> None:
+        """Nothing to watch during the episode."""
+
+    def verdict(self, frame: FeatureFrame, world: SimWorld) -> Verdict:
+        """Judge every goal predicate on the end state."""
+        if self.goal is None and not self.constraints:
+            return Verdict(False, "no goal was given to judge this task by (plan it from an instruction or a goal spec)")
+        failures: list[str] = []
+        judged_all = self.goal is not None
+        for goal in getattr(self.goal, "goals", []):
+            reason = self._judge(goal, frame, world)
+            if reason is None:
+                judged_all = False
+            elif reason:
+                failures.append(reason)
+        if not judged_all and self.constraints:
+            failures += self._constraints(frame)
+        if failures:
+            return Verdict(False, "; ".join(failures))
+        return Verdict(True, "every goal predicate holds at the end")
+
+    def _judge(self, goal, frame: FeatureFrame, world: SimWorld) -> str | None:
+        """'' when the predicate holds, a reason when not, None when it cannot be judged here."""
+        kind = getattr(goal, "kind", "")
+        if kind not in ("inside", "on", "placed"):
+            return None
+        obj = frame.objects[goal.obj]
+        held = any(name == goal.obj for _, name in frame.holding)
+        if held:
+            return f"the {goal.obj} is still held"
+        if world.object_velocity(goal.obj) > REST_SPEED:
+            return f"the {goal.obj} is still moving"
+        if kind in ("inside", "on"):
+            host_name = goal.container if kind == "inside" else goal.support
+            host = frame.objects[host_name]
+            offset = float(np.linalg.norm(obj.pos[:2] - host.pos[:2]))
+            reach = 0.5 * float(min(host.extent[0], host.extent[1]))
+            if offset > reach:
+                return f"the {goal.obj} is {100 * offset:.1f} cm from the {host_name}'s centre (more than its half-width {100 * reach:.1f} cm)"
+            if kind == "inside" and obj.bottom[2] > host.top[2]:
+                return f"the {goal.obj} is not inside the {host_name} (its bottom is above the rim)"
+            if kind == "on" and abs(float(obj.bottom[2] - host.top[2])) > 0.015:
+                return f"the {goal.obj} does not rest on the {host_name} (gap {100 * float(obj.bottom[2] - host.top[2]):.1f} cm)"
+            return ""
+        if goal.region and goal.region in self.regions:
+            centre, radius = self.regions[goal.region][:2]
+            error = float(np.linalg.norm(obj.pos[:2] - np.asarray(centre)))
+            if error > radius:
+                return f"the {goal.obj} is {100 * error:.1f} cm from the {goal.region} region"
+        if not resting_on_table(world, goal.obj, frame):
+            return f"the {goal.obj} is not resting on the table"
+        return ""
+
+    def _constraints(self, frame: FeatureFrame) -> list[str]:
+        from agentchord.expr import Vocabulary, compile_expr  # noqa: PLC0415
+
+        vocabulary = Vocabulary(frozenset(frame.objects))
+        failed = []
+        for source in self.constraints:
+            value = compile_expr(source, vocabulary)(frame)
+            if not value <= 0.0:
+                failed.append(f"{source} = {value:.3g} (should be <= 0)")
+        return failed

@@ -1,0 +1,108 @@
+"""The arranger's rules on graphs it has never seen: hand-written library graphs stripped of their branches."""
+
+from __future__ import annotations
+
+import pytest
+
+from agentchord.agents.reasoner import ArmState, ArrangeRequest, Scene, UnanticipatedFailure, check_reply
+from agentchord.agents.rules import RulesReasoner
+from agentchord.agents.rules.arranger import Arranger
+from agentchord.graph.progress import forward_filter
+from agentchord.tasks import load_task_graph
+from test_agents_rules_composer import scene_of
+
+
+def nominal_only(task: str):
+    graph = load_task_graph(task).model_copy(deep=True)
+    graph.edges = [e for e in graph.edges if not e.is_recovery]
+    graph.nodes = [n for n in graph.nodes if not n.is_recovery]
+    for edge in graph.edges:
+        edge.failures = []
+    return graph
+
+
+def holds_something(graph, arranger, edge_id):
+    account = arranger.accounts(graph)[edge_id]
+    edge = graph.edge(edge_id)
+    grasps = any(call.fn == "grasp" for _, call in edge.calls)
+    return grasps or any(a.holding for a in account.values())
+
+
+@pytest.mark.parametrize("task", ["single_arm_pour_water", "dual_arm_pour_water", "rearrange_table", "handover_block", "setup_coffee_tray", "fold_towel"])
+def test_every_edge_that_holds_an_object_gets_a_drop_branch(task):
+    graph, scene = nominal_only(task), scene_of(task)
+    request = ArrangeRequest(graph=graph, scene=scene)
+    out = RulesReasoner().arrange(request)
+    assert check_reply(request, out) == []
+    assert forward_filter(out).removed == []
+    arranger = Arranger(scene)
+    for edge in graph.edges:
+        modes = {f.intent for f in out.edge(edge.id).failures}
+        if holds_something(graph, arranger, edge.id):
+            assert "regrasp" in modes, f"{task}: {edge.id} holds an object but has no regrasp branch"
+    for edge in out.recovery_edges():
+        assert edge.source == out.edge(edge.id).source and edge.target in {n.id for n in out.nodes}
+
+
+def test_single_arm_pour_branches_match_the_hand_written_ones():
+    out = Arranger(scene_of("single_arm_pour_water")).arrange(nominal_only("single_arm_pour_water"))
+    e3 = {f.name: f for f in out.edge("e3").failures}
+    assert set(e3) == {"bottle_dropped", "cup_tipped", "cup_shifted"}
+    regrasp = out.edge(e3["bottle_dropped"].recovery)
+    # Regrasp, restore the pouring offset, tilt again: merge at the failed edge's target.
+    assert [c.fn for _, c in regrasp.calls] == ["grasp", "move_to_obj", "rotate_eef"] and regrasp.target == "v3"
+    assert regrasp.steps[0]["right"].args["skip_if_held"] is True
+    upright = out.edge(e3["cup_tipped"].recovery)
+    assert [(a, c.fn) for a, c in upright.calls][:4] == [("right", "move_to_target"), ("left", "grasp"), ("left", "place"), ("left", "back")]
+    # A grasp or a place opens the gripper on purpose: those monitors are gated by the grasp-done signal.
+    assert out.edge("e1").failures[0].monitor.startswith("right.closed *")
+    # The place edge's regrasp goes straight to placing again (place is an absolute motion).
+    assert [c.fn for _, c in out.edge("e5_r_bottle_dropped").calls] == ["grasp", "place"]
+
+
+def test_a_synchronous_place_finishes_the_other_arm_and_skips_what_is_placed():
+    out = Arranger(scene_of("rearrange_table")).arrange(nominal_only("rearrange_table"))
+    fork = out.edge(next(f.recovery for f in out.edge("e3").failures if f.name == "fork_dropped"))
+    last = fork.steps[-1]
+    assert last["left"].fn == "place" and last["right"].args.get("skip_if_placed") is True
+
+
+def test_a_capsule_carried_in_the_tray_is_watched():
+    out = Arranger(scene_of("setup_coffee_tray")).arrange(nominal_only("setup_coffee_tray"))
+    carry = out.edge("e4")
+    out_mode = next(f for f in carry.failures if f.name == "capsule_out")
+    assert out_mode.monitor.startswith("misaligned(capsule.pos, tray.pos") and out_mode.intent == "re-place"
+    assert out.edge(out_mode.recovery).target == carry.source
+
+
+def test_visibility_monitors_only_for_rgbd():
+    graph, scene = nominal_only("single_arm_pour_water"), scene_of("single_arm_pour_water")
+    plain = Arranger(scene).arrange(graph)
+    watched = Arranger(scene, watch_visibility=True).arrange(graph)
+    assert not any("lost_view" in f.monitor for _, f in plain.failures())
+    assert any(f.monitor.startswith("lost_view(cup") for _, f in watched.failures())
+
+
+def test_online_repair_reads_a_dropped_object_from_the_observation():
+    graph = load_task_graph("single_arm_pour_water").model_copy(deep=True)
+    graph.edge("e2").failures = [f for f in graph.edge("e2").failures if f.name != "bottle_dropped"]
+    base = scene_of("single_arm_pour_water")
+    now = Scene(objects=base.objects, arms=[ArmState(name="right", ee=(0.1, 0.5, 0.2)), ArmState(name="left", ee=(-0.1, 0.5, 0.2))])
+    failure = UnanticipatedFailure(edge="e2", context="v1", observation="at v2: 0.5 - holding(right, bottle) = 0.5")
+    repaired = RulesReasoner().arrange(ArrangeRequest(graph=graph, scene=now, failure=failure))
+    added = [f for f in repaired.edge("e2").failures if f.name not in {g.name for g in graph.edge("e2").failures}]
+    assert len(added) == 1 and added[0].intent == "regrasp"
+    branch = repaired.edge(added[0].recovery)
+    assert branch.source == "v1" and branch.target == "v2" and branch.steps[0]["right"].fn == "grasp"
+
+
+def test_online_repair_with_nothing_to_explain_is_a_reasoner_error():
+    from agentchord.agents.exceptions import ReasonerError
+
+    graph = load_task_graph("single_arm_pour_water")
+    now = scene_of("single_arm_pour_water")
+    now = Scene(objects=now.objects, arms=[ArmState(name="right", ee=(0.1, 0.5, 0.2), holding="bottle")])
+    failure = UnanticipatedFailure(edge="e2", context="v1", observation="at v2: a mystery")
+    with pytest.raises(ReasonerError, match="no rule explains"):
+        RulesReasoner().arrange(ArrangeRequest(graph=graph, scene=now, failure=failure))
+

@@ -1,0 +1,67 @@
+"""The offline composer on real scenes of the six tasks: valid nominal graphs with the expected structure."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from agentchord.agents.observe import observe, task_regions
+from agentchord.agents.reasoner import ComposeRequest, check_reply
+from agentchord.agents.rules import RulesReasoner
+from agentchord.tasks import load_task_graph
+from agentchord.worlds.sim.tasks import SIM_TASKS
+from agentchord.worlds.sim.world import SimWorld
+
+
+def scene_of(task: str, seed: int = 1):
+    sim = SIM_TASKS[task]
+    return observe(SimWorld(sim.sample_scene(np.random.default_rng([seed, 0x5CE7E]))), task_regions(sim))
+
+
+def fns(graph):
+    return [sorted((arm, call.fn) for arm, call in step.items() if call) for edge in graph.edges for step in edge.steps]
+
+
+@pytest.mark.parametrize("task", ["single_arm_pour_water", "dual_arm_pour_water", "rearrange_table", "handover_block", "setup_coffee_tray", "fold_towel"])
+def test_each_paper_instruction_plans_a_valid_nominal_graph(task):
+    request = ComposeRequest(instruction=load_task_graph(task).instruction, scene=scene_of(task), task=task)
+    graph = RulesReasoner().compose(request)
+    assert check_reply(request, graph) == []
+    assert graph.goal == graph.nodes[-1].id and not graph.recovery_edges()
+    # Every episode ends with both arms home.
+    assert {arm for arm, call in graph.edges[-1].steps[-1].items() if call and call.fn == "back"} or any(
+        call.fn == "back" for edge in graph.edges[-2:] for step in edge.steps for call in step.values() if call
+    )
+
+
+def test_single_arm_pour_is_grasp_approach_tilt_untilt_place_home():
+    graph = RulesReasoner().compose(ComposeRequest(instruction=load_task_graph("single_arm_pour_water").instruction, scene=scene_of("single_arm_pour_water")))
+    assert fns(graph) == [[("right", "grasp")], [("right", "move_to_obj")], [("right", "rotate_eef")], [("right", "rotate_eef")], [("right", "place")], [("right", "back")]]
+    v3 = graph.node("v3").constraints
+    assert "70 - tilt(bottle)" in v3 and "0.5 - holding(right, bottle)" in v3
+
+
+def test_the_two_arms_work_at_once_where_they_are_independent():
+    graph = RulesReasoner().compose(ComposeRequest(instruction=load_task_graph("rearrange_table").instruction, scene=scene_of("rearrange_table")))
+    assert fns(graph)[0] == [("left", "grasp"), ("right", "grasp")]
+    assert [("left", "place"), ("right", "place")] in fns(graph)
+
+
+def test_handover_takes_before_it_lets_go():
+    graph = RulesReasoner().compose(ComposeRequest(instruction=load_task_graph("handover_block").instruction, scene=scene_of("handover_block")))
+    handover = next(e for e in graph.edges if len(e.steps) == 3)
+    assert [sorted(s) for s in handover.steps] == [["right"], ["left"], ["left"]]
+    assert handover.steps[0]["right"].fn == "grasp" and handover.steps[1]["left"].fn == "open_gripper"
+
+
+def test_same_scene_same_graph():
+    request = ComposeRequest(instruction=load_task_graph("dual_arm_pour_water").instruction, scene=scene_of("dual_arm_pour_water"))
+    assert RulesReasoner().compose(request) == RulesReasoner().compose(request)
+
+
+def test_a_goal_spec_replaces_the_instruction():
+    from agentchord.agents.rules.goals import GoalSpec, Inside
+
+    scene = scene_of("blocks_and_cup")
+    graph = RulesReasoner(GoalSpec(goals=[Inside(obj="red_block", container="cup")])).compose(ComposeRequest(instruction="", scene=scene))
+    assert any(c.fn == "place" and c.args.get("relative_to") == "cup" for _, c in graph.edges[1].calls)
