@@ -53,6 +53,9 @@ class MoveToObjArgs(_Args):
     obj: str
     offset: Vec3 = (0.0, 0.0, 0.1)
     keep_orientation: bool = Field(False, description="Keep the tool's orientation (else: level side-grasp frame).")
+    path: Literal["direct", "solved"] = Field(
+        "direct", description="direct: a straight line; solved: the receding-horizon path solver, clear of other objects."
+    )
     yaw: float | None = Field(
         None, ge=-180.0, le=180.0,
         description="Orientation hint: world yaw (deg) of the tool's horizontal approach axis; None keeps the current one.",
@@ -87,6 +90,9 @@ class MoveToTargetArgs(_Args):
 
     pos: Vec3
     yaw: float | None = Field(None, ge=-180.0, le=180.0, description="World yaw of a level tool's approach (deg); None keeps the orientation.")
+    path: Literal["direct", "solved"] = Field(
+        "direct", description="direct: a straight line; solved: the receding-horizon path solver, clear of other objects."
+    )
 
 
 class MoveByOffsetArgs(_Args):

@@ -51,6 +51,8 @@ class RobotController:
         self.targets: dict[str, ArmTarget] = {}
         #: The latest feature frame: what actions perceive (set by the executor each tick).
         self.frame: FeatureFrame | None = None
+        #: Wall seconds of every receding-horizon path solve (for the benchmarks).
+        self.path_solves: list[float] = []
         self.sync_from_world()
 
     def sync_from_world(self) -> None:

@@ -16,7 +16,17 @@ from scipy.spatial.transform import Rotation
 from agentchord.actions import catalog
 from agentchord.actions.base import ActionFailed, ArmAction
 from agentchord.actions.controller import RobotController
-from agentchord.actions.motion import grasp_frame, grip, move_joints, move_to, pose_from_matrix, settle, wait_for_rest
+from agentchord.actions.motion import (
+    grasp_frame,
+    grip,
+    move_along_solved_path,
+    move_joints,
+    move_to,
+    pose_from_matrix,
+    settle,
+    wait_for_rest,
+)
+from agentchord.solvers.obstacles import held_spheres, scene_spheres
 from agentchord.worlds.sim.scene import ARM_JOINTS, ARM_PREFIX, FINGER_GAP_OFFSET, FINGER_RANGE, HOME_Q
 
 #: Tilt (deg) beyond which an object counts as fallen for a side grasp.
@@ -307,6 +317,12 @@ class Grasp(ArmAction):
         yield from settle(robot, arm)
 
 
+def _avoid(robot: RobotController, arm: str, exclude: tuple[str, ...]):
+    """Obstacles (every object not held and not excluded) and what ``arm`` carries, from the latest frame."""
+    frame = robot.frame
+    return scene_spheres(frame, exclude=exclude), held_spheres(frame, arm)
+
+
 class MoveToObj(ArmAction):
     """Move the tool (and what it holds) to an offset from an object's top point, upright."""
 
@@ -325,7 +341,11 @@ class MoveToObj(ArmAction):
             yaw = np.radians(self.args.yaw)
             rotation = grasp_frame(np.array([np.cos(yaw), np.sin(yaw), 0.0]))
         target = robot.frame.objects[self.args.obj].top + np.asarray(self.args.offset)
-        yield from move_to(robot, arm, pose_from_matrix(target, rotation))
+        if self.args.path == "solved":
+            # The object aimed at is the goal, not an obstacle.
+            yield from move_along_solved_path(robot, arm, pose_from_matrix(target, rotation), lambda: _avoid(robot, arm, (self.args.obj,)))
+        else:
+            yield from move_to(robot, arm, pose_from_matrix(target, rotation))
         # Re-aim at the object's latest position (it may have been moved).
         target = robot.frame.objects[self.args.obj].top + np.asarray(self.args.offset)
         yield from move_to(robot, arm, pose_from_matrix(target, rotation), speed=0.15)
@@ -454,7 +474,11 @@ class MoveToTarget(ArmAction):
         else:
             yaw = np.radians(self.args.yaw)
             rotation = grasp_frame(np.array([np.cos(yaw), np.sin(yaw), 0.0]))
-        yield from move_to(robot, self.arm, pose_from_matrix(np.asarray(self.args.pos, dtype=float), rotation))
+        goal = pose_from_matrix(np.asarray(self.args.pos, dtype=float), rotation)
+        if self.args.path == "solved":
+            yield from move_along_solved_path(robot, self.arm, goal, lambda: _avoid(robot, self.arm, ()))
+        else:
+            yield from move_to(robot, self.arm, goal)
         yield from settle(robot, self.arm)
 
 

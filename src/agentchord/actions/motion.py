@@ -7,7 +7,7 @@ once per control tick, so an action script reads as a plain sequence:
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 
 import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
@@ -15,6 +15,7 @@ from scipy.spatial.transform import Rotation, Slerp
 from agentchord.actions.base import ActionFailed
 from agentchord.actions.controller import RobotController
 from agentchord.solvers.ik import PoseTarget
+from agentchord.solvers.obstacles import Spheres
 from agentchord.worlds.sim.scene import TABLE_HALF
 
 #: Cartesian speed limits of the tool (m/s, rad/s).
@@ -76,6 +77,51 @@ def move_to(robot: RobotController, arm: str, goal: PoseTarget, speed: float = L
         s = min_jerk(k / ticks)
         robot.set_pose(arm, PoseTarget(pos=start.pos + s * (goal_pos - start.pos), quat=_to_quat(slerp(s))))
         yield
+
+
+#: Receding-horizon path following: waypoints planned per solve, executed before re-solving.
+PATH_HORIZON = 20
+PATH_EXECUTE = 5
+#: Longest tool move per tick on a solved path (m): the linear speed limit.
+PATH_STEP = LINEAR_SPEED / 50.0
+#: Solves before a solved path gives up and finishes with a straight move.
+PATH_MAX_SOLVES = 120
+
+
+def move_along_solved_path(
+    robot: RobotController, arm: str, goal: PoseTarget, avoid: Callable[[], tuple[Spheres, Spheres]]
+) -> Iterator[None]:
+    """Move the tool to ``goal`` along a path re-planned every few ticks (paper Eq. 10).
+
+    Every ``PATH_EXECUTE`` ticks the receding-horizon solver plans ``PATH_HORIZON`` waypoints
+    from the commanded tool position on the latest frame (``avoid()`` returns the obstacle
+    spheres and what the tool carries), warm-started from the last plan; the orientation
+    turns toward the goal's in step with the distance covered. The last centimetres are a
+    straight move, so the pose at the end is exactly ``goal``.
+    """
+    from agentchord.solvers.path import RecedingHorizonPathSolver  # noqa: PLC0415  (scipy only when used)
+
+    start = robot.commanded_pose(arm)
+    goal_pos = clip_to_workspace(goal.pos)
+    total = max(float(np.linalg.norm(goal_pos - start.pos)), 1e-6)
+    slerp = Slerp([0.0, 1.0], Rotation.concatenate([_to_rotation(start.quat), _to_rotation(goal.quat)]))
+    warm = None
+    previous = start.pos
+    for _ in range(PATH_MAX_SOLVES):
+        current = robot.commanded_pose(arm).pos
+        if float(np.linalg.norm(goal_pos - current)) < 2 * PATH_STEP:
+            break
+        obstacles, held = avoid()
+        solver = RecedingHorizonPathSolver(PATH_HORIZON, PATH_EXECUTE, step=PATH_STEP, arm=arm, held=held)
+        plan = solver.step(current, goal_pos, obstacles, warm=warm, previous=previous)
+        robot.path_solves.append(plan.seconds)
+        for waypoint in plan.waypoints[:PATH_EXECUTE]:
+            previous = robot.commanded_pose(arm).pos
+            done = 1.0 - min(1.0, float(np.linalg.norm(goal_pos - waypoint)) / total)
+            robot.set_pose(arm, PoseTarget(pos=waypoint, quat=_to_quat(slerp(done))))
+            yield
+        warm = plan
+    yield from move_to(robot, arm, PoseTarget(pos=goal_pos, quat=goal.quat), speed=0.15)
 
 
 def settle(

@@ -1,0 +1,54 @@
+"""Exceptions of the constrained solvers (sub-goal and receding-horizon path).
+
+Each failure has its own class; every one is a :class:`SolverError`. A solver that
+ran but could not meet its hard constraints attaches what it found, so a caller can
+still inspect (or knowingly use) the best compromise.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from agentchord.solvers.path import ExecutedPath
+    from agentchord.solvers.subgoal import SubgoalSolution
+
+
+class SolverError(Exception):
+    """Base class of the solvers' errors."""
+
+
+class SolverProblemError(SolverError, ValueError):
+    """A problem description is malformed (unknown arm, empty bounds, wrong shapes)."""
+
+
+class InfeasibleSubgoalError(SolverError):
+    """The sub-goal solver found no point meeting every hard constraint (raised on request only).
+
+    Attributes:
+        solution: The best compromise found; ``solution.violations`` says which constraints fail.
+    """
+
+    def __init__(self, message: str, solution: SubgoalSolution) -> None:
+        self.solution = solution
+        super().__init__(message)
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        # The bench runner ships errors between processes: keep the attached result.
+        return (type(self), (str(self), self.solution))
+
+
+class PathNotReachedError(SolverError):
+    """``plan_path`` ran out of solves before the tool reached the goal (raised on request only).
+
+    Attributes:
+        path: What was executed before giving up.
+    """
+
+    def __init__(self, message: str, path: ExecutedPath) -> None:
+        self.path = path
+        super().__init__(message)
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        # The bench runner ships errors between processes: keep the attached result.
+        return (type(self), (str(self), self.path))
