@@ -59,3 +59,35 @@ def test_demo_refuses_an_unknown_strategy():
     result = CliRunner().invoke(main, ["demo", "--strategies", "magic"])
     assert result.exit_code == 2
     assert "unknown strategy" in result.output
+
+
+def test_plan_writes_a_valid_augmented_graph_and_renders_it(tmp_path):
+    from agentchord.graph.loader import load_graph
+    from agentchord.graph.validation import check_graph
+
+    out, figure = tmp_path / "g.yaml", tmp_path / "g.mmd"
+    result = CliRunner().invoke(main, ["plan", "put the red block into the cup", "--task", "blocks_and_cup", "-o", str(out), "--render", str(figure)])
+    assert result.exit_code == 0, result.output
+    graph = load_graph(out)
+    assert check_graph(graph) == [] and graph.recovery_edges()
+    assert figure.read_text().startswith("flowchart")
+
+
+def test_plan_from_a_goal_spec_file(tmp_path):
+    goal = tmp_path / "goal.yaml"
+    goal.write_text("goals:\n  - {kind: on_top_of, obj: red_block, support: blue_block}\n")
+    result = CliRunner().invoke(main, ["plan", "--goal", str(goal), "--task", "blocks_and_cup", "-o", str(tmp_path / "g.yaml")])
+    assert result.exit_code == 0, result.output
+
+
+def test_plan_refuses_what_it_cannot_ground_with_exit_2():
+    result = CliRunner().invoke(main, ["plan", "juggle the cup", "--task", "blocks_and_cup", "-o", "/tmp/never.yaml"])
+    assert result.exit_code == 2
+    assert "no rule reads the clause 'juggle the cup'" in result.output and "--reasoner llm" in result.output
+
+
+def test_schema_goal_prints_the_goal_spec_schema():
+    import json
+
+    result = CliRunner().invoke(main, ["schema", "goal"])
+    assert result.exit_code == 0 and "goals" in json.loads(result.output)["properties"]

@@ -29,8 +29,9 @@ from agentchord.solvers.subgoal import SubgoalProblem, SubgoalSolution, SubgoalS
 
 #: Clearance (m) kept between a keyframe (tool, held or placed object) and other objects.
 MARGIN = 0.02
-#: How far (m) a place spot may move from the rules' spot (the placing tolerance).
-PLACE_SLACK = 0.03
+#: How far (m) a free place spot may move from the rules' spot; a spot in a named region
+#: stays inside the region.
+PLACE_SLACK = 0.08
 #: A solution closer than this (m) to the rules' value leaves the value as it is.
 KEEP = 0.002
 
@@ -91,7 +92,7 @@ class Conductor:
                     elif call.fn == "place" and call.args.get("target") is not None and call.args.get("relative_to") is None:
                         two_arm = sum(1 for c in step.values() if c is not None and c.fn == "place" and c.args.get("obj") == call.args["obj"]) > 1
                         if not two_arm:  # a two-arm carry keeps its one target for both grippers
-                            self._place_spot(edge, index, arm, call, objects)
+                            self._place_spot(edge, index, arm, call, objects, scene)
                     if edge.path_constraints and call.fn in ("move_to_obj", "move_to_target") and account[arm].holding:
                         # A carried object under a path constraint: the receding-horizon path solver keeps it clear.
                         call.args["path"] = "solved"
@@ -110,18 +111,22 @@ class Conductor:
         )
         self._solve(edge, index, arm, call, "pos", problem, lambda p: p)
 
-    def _place_spot(self, edge: Edge, index: int, arm: str, call: ActionCall, objects: dict[str, SceneObject]) -> None:
+    def _place_spot(self, edge: Edge, index: int, arm: str, call: ActionCall, objects: dict[str, SceneObject], scene: Scene) -> None:
         obj = objects.get(call.args["obj"])
         if obj is None:
             return
         height = float(obj.pos[2])
         target = np.array([*call.args["target"], height])
+        slack = PLACE_SLACK
+        for region in scene.regions:
+            if float(np.hypot(target[0] - region.center[0], target[1] - region.center[1])) <= region.radius:
+                slack = min(slack, max(0.0, 0.7 * region.radius))
         # Decide the object's centre on the table: a "tool" as wide as the object, at its own height,
-        # within the placing tolerance of the rules' spot.
+        # near the rules' spot (inside its region, if the spot is in one).
         problem = SubgoalProblem(
             arms=(arm,),
-            low=np.array([target[0] - PLACE_SLACK, target[1] - PLACE_SLACK, height - 1e-3]),
-            high=np.array([target[0] + PLACE_SLACK, target[1] + PLACE_SLACK, height + 1e-3]),
+            low=np.array([target[0] - slack, target[1] - slack, height - 1e-3]),
+            high=np.array([target[0] + slack + 1e-6, target[1] + slack + 1e-6, height + 1e-3]),
             obstacles=_spheres([o for name, o in objects.items() if name != obj.name]),
             preferred={arm: target},
             tool_radius=0.5 * float(max(obj.extent[0], obj.extent[1])),

@@ -89,7 +89,7 @@ class Inside(_Goal):
 class On(_Goal):
     """``obj`` released on top of ``support`` (a stack)."""
 
-    kind: Literal["on"] = "on"
+    kind: Literal["on_top_of"] = "on_top_of"  # not "on": YAML reads a bare on as true
     obj: str
     support: str
     arm: Arm | None = None

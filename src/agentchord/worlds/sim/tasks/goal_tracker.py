@@ -63,7 +63,7 @@ class GoalTracker:
     def _judge(self, goal, frame: FeatureFrame, world: SimWorld) -> str | None:
         """'' when the predicate holds, a reason when not, None when it cannot be judged here."""
         kind = getattr(goal, "kind", "")
-        if kind not in ("inside", "on", "placed"):
+        if kind not in ("inside", "on_top_of", "placed"):
             return None
         obj = frame.objects[goal.obj]
         held = any(name == goal.obj for _, name in frame.holding)
@@ -71,7 +71,7 @@ class GoalTracker:
             return f"the {goal.obj} is still held"
         if world.object_velocity(goal.obj) > REST_SPEED:
             return f"the {goal.obj} is still moving"
-        if kind in ("inside", "on"):
+        if kind in ("inside", "on_top_of"):
             host_name = goal.container if kind == "inside" else goal.support
             host = frame.objects[host_name]
             offset = float(np.linalg.norm(obj.pos[:2] - host.pos[:2]))
@@ -80,7 +80,7 @@ class GoalTracker:
                 return f"the {goal.obj} is {100 * offset:.1f} cm from the {host_name}'s centre (more than its half-width {100 * reach:.1f} cm)"
             if kind == "inside" and obj.bottom[2] > host.top[2]:
                 return f"the {goal.obj} is not inside the {host_name} (its bottom is above the rim)"
-            if kind == "on" and abs(float(obj.bottom[2] - host.top[2])) > 0.015:
+            if kind == "on_top_of" and abs(float(obj.bottom[2] - host.top[2])) > 0.015:
                 return f"the {goal.obj} does not rest on the {host_name} (gap {100 * float(obj.bottom[2] - host.top[2]):.1f} cm)"
             return ""
         if goal.region and goal.region in self.regions:
