@@ -366,6 +366,8 @@ class RotateEef(ArmAction):
         yield from settle(robot, arm, max_ticks=10)
 
 
+#: A tall object tilted more than this in the hand (deg) is turned upright before it is put down.
+LEVEL_IN_HAND_DEG = 4.0
 #: Finger gap beyond the object's width (m) when releasing it inside a rim.
 RELEASE_MARGIN = 0.02
 #: Height (m) by which a placed object clears the top of the object it is placed relative to.
@@ -415,6 +417,7 @@ class Place(ArmAction):
         elif target is not None:
             # Put the object's centre, not the tool, over the target.
             above[:2] += target - obj.pos[:2]
+        rotation, above = self._upright_in_hand(robot, obj, tool, rotation, above)
         above[2] = max(above[2], tool.pos[2])
         if self.args.relative_to is not None:
             # Carry the object over the reference's rim (into a cup, onto a block), not through it.
@@ -432,6 +435,28 @@ class Place(ArmAction):
         yield from move_to(robot, arm, pose_from_matrix(retreat, rotation))
         if robot.targets[arm].grip > 0.0:
             yield from grip(robot, arm, 0.0, ticks=6)  # clear of the rim: open fully for the next grasp
+
+    def _upright_in_hand(self, robot: RobotController, obj, tool, rotation: np.ndarray, above: np.ndarray):
+        """Turn the tool so that a tall object held askew (a regrasp off-centre) goes down upright.
+
+        Released at a tilt, a tall object topples or leans; the correction is the smallest rotation
+        that maps the object's axis, as it will be with the planned tool rotation, to vertical, and
+        the tool shifts so that the object's centre still ends over the same spot.
+        """
+        if obj.extent[2] <= 1.5 * max(obj.extent[0], obj.extent[1]):
+            return rotation, above
+        current = robot.rotation(self.arm)
+        axis = rotation @ current.T @ obj.axis
+        angle = float(np.degrees(np.arccos(np.clip(axis[2], -1.0, 1.0))))
+        if angle < LEVEL_IN_HAND_DEG or angle > UPRIGHT_TOLERANCE_DEG:
+            return rotation, above
+        fix = Rotation.align_vectors([[0.0, 0.0, 1.0]], [axis])[0].as_matrix()
+        turned = fix @ rotation
+        held = obj.pos - tool.pos
+        goal = above[:2] + (rotation @ current.T @ held)[:2]  # where the centre would have gone
+        above = above.copy()
+        above[:2] = goal - (turned @ current.T @ held)[:2]
+        return turned, above
 
     def _release_grip(self, robot: RobotController) -> float:
         """Fully open, unless the object sits inside a rim (a cup): then just wider than the object,

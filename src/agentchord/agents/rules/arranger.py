@@ -33,6 +33,8 @@ from agentchord.graph.models import ActionCall, Edge, FailureMode, Step, TaskGra
 from agentchord.graph.progress import forward_filter, nominal_path
 
 ARMS = ("left", "right")
+#: Tilt (deg) of a placed upright object beyond which it leans (the placed constraints allow 10).
+PLACED_TILT_DEG = 10.0
 ABSOLUTE = frozenset({"move_to_obj", "move_to_target", "place", "grasp", "back"})
 RELATIVE = frozenset({"rotate_eef", "move_by_offset"})
 
@@ -110,9 +112,13 @@ def _with_skips(call: ActionCall) -> ActionCall:
     return call
 
 
-def _regrasp(account: Account, arm: str, obj: str) -> ActionCall:
+def _regrasp(account: Account, arm: str, obj: str, tall: bool = False) -> ActionCall:
     grasp = account[arm].grasp
     args = dict(grasp.args) if grasp is not None and grasp.args.get("obj") == obj else {"obj": obj}
+    if tall and args.get("mode", "auto") != "top":
+        # A tall object that fell is taken again from its side once upright: the nominal hold,
+        # not the off-centre fallen-object hold (a pour or an upright place needs it).
+        args["reseat"] = True
     return ActionCall(fn="grasp", args={**args, "skip_if_held": True})
 
 
@@ -234,7 +240,8 @@ class Arranger:
             steps = [{a: _with_skips(c) for a, c in step.items() if c is not None} for step in edge.steps]
         else:
             busy = {arm for step in edge.steps for arm, call in step.items() if call is not None}
-            regrasp: Step = {a: _regrasp(before, a, obj) for a in at_s}
+            tall = obj in self.objects and kb.is_tall(self.objects[obj])
+            regrasp: Step = {a: _regrasp(before, a, obj, tall) for a in at_s}
             # An arm of this edge with empty hands gets out of the way while the object is taken again.
             regrasp.update({a: ActionCall(fn="back") for a in busy if a not in at_s and before[a].holding is None})
             steps = [regrasp, *_replay_then_edge(before, edge, at_s or busy)]
@@ -344,6 +351,23 @@ class Arranger:
 
     # --- online repair -----------------------------------------------------------------
 
+    def _replace_tilted(self, edge: Edge, before: Account, current: dict[str, SceneObject], holding: set) -> tuple[FailureMode, Edge] | None:
+        """An upright object this edge put down leans (released on something, or held off-centre): place it again."""
+        for arm in ARMS:
+            for call in _calls(edge, arm):
+                obj = call.args.get("obj")
+                info = self.objects.get(obj or "")
+                if call.fn != "place" or info is None or obj not in current or (arm, obj) in holding:
+                    continue
+                if not kb.keeps_upright(info) or _tilt(current[obj]) <= PLACED_TILT_DEG:
+                    continue
+                steps: list[Step] = [{arm: _regrasp(before, arm, obj, kb.is_tall(info))}, {arm: call}]
+                recovery = Edge(id=f"{edge.id}_r_{obj}_leaning", source=edge.source, target=edge.target, kind="recovery", actions=steps)
+                monitor = f"(1 - {arm}.closed) * tipped({obj}, {PLACED_TILT_DEG + 2:g})"
+                mode = FailureMode(name=f"{obj}_leaning", monitor=monitor, window=kb.WINDOW, intent="re-place", recovery=recovery.id)
+                return mode, recovery
+        return None
+
     def repair(self, graph: TaskGraph, failure: UnanticipatedFailure, now: Scene) -> TaskGraph | None:
         """One new branch for an unanticipated failure at the end of a nominal edge, or ``None``.
 
@@ -352,19 +376,23 @@ class Arranger:
         (set it down upright, take it again); an upright object lying on its side is a tip.
         """
         accounts = self.accounts(graph)
-        if failure.edge not in accounts:
-            return None
         edge = graph.edge(failure.edge)
-        before = accounts[failure.edge]
+        # A recovery edge starts where a nominal edge does: the account there is the same.
+        by_source = {graph.edge(e).source: a for e, a in accounts.items()}
+        before = accounts.get(edge.id) or by_source.get(edge.source)
+        if before is None:
+            return None
         after = before
         for step in edge.steps:
             after = _apply(after, step)
         current = {o.name: o for o in now.objects}
         holding = {(a.name, a.holding) for a in now.arms if a.holding}
         branch: tuple[FailureMode, Edge] | None = None
+        # A recovery edge's own calls are all that is known of where it left things.
+        touched = {c.args.get("obj") for _, c in edge.calls} if edge.is_recovery else None
         for arm in ARMS:
             obj = after[arm].holding
-            if not obj or obj not in current:
+            if not obj or obj not in current or (touched is not None and obj not in touched):
                 continue
             info = self.objects.get(obj)
             if (arm, obj) not in holding:
@@ -379,6 +407,8 @@ class Arranger:
                 branch = (mode, recovery)
             if branch:
                 break
+        if branch is None:
+            branch = self._replace_tilted(edge, before, current, holding)
         if branch is None:
             for name, info in self.objects.items():
                 if name in current and kb.keeps_upright(info) and not any((a, name) in holding for a in ARMS) and _tilt(current[name]) > kb.TIP_DEG:
