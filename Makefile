@@ -43,6 +43,8 @@ bench: install
 	$(BIN)/python benchmarks/bench_monitors.py
 	$(BIN)/python benchmarks/bench_recovery_cost.py
 	$(BIN)/python benchmarks/bench_perception.py
+	$(BIN)/python benchmarks/bench_planning.py
+	$(BIN)/python benchmarks/bench_solvers.py
 
 clean:
 	rm -rf $(VENV) .pytest_cache .hypothesis

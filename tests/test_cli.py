@@ -91,3 +91,33 @@ def test_schema_goal_prints_the_goal_spec_schema():
 
     result = CliRunner().invoke(main, ["schema", "goal"])
     assert result.exit_code == 0 and "goals" in json.loads(result.output)["properties"]
+
+
+def test_plan_with_the_llm_reasoner_against_a_replay_server(tmp_path, monkeypatch):
+    # The replies an LLM would give (here: what the rules answer), served by a local replay server.
+    import numpy as np
+    from replay_server import Completion, ReplayServer
+
+    from agentchord.agents.observe import observe, task_regions
+    from agentchord.agents.pipeline import plan_task
+    from agentchord.agents.rules import RulesReasoner
+    from agentchord.graph.loader import load_graph
+    from agentchord.worlds.sim.tasks import SIM_TASKS
+    from agentchord.worlds.sim.world import SimWorld
+
+    sim = SIM_TASKS["blocks_and_cup"]
+    scene = observe(SimWorld(sim.sample_scene(np.random.default_rng([0, 0x5CE7E]))), task_regions(sim))
+    rules = RulesReasoner()
+    plan_task("put the red block into the cup", scene, rules, "blocks_and_cup")
+    with ReplayServer() as server:
+        for call in rules.calls:
+            server.push(Completion(json.dumps(call.reply)))
+        monkeypatch.setenv("AGENTCHORD_LLM_BASE_URL", server.base_url)
+        monkeypatch.setenv("AGENTCHORD_LLM_MODEL", "replay-model")
+        monkeypatch.setenv("AGENTCHORD_LLM_API_KEY", "test-key")
+        out = tmp_path / "g.yaml"
+        result = CliRunner().invoke(main, ["plan", "put the red block into the cup", "--task", "blocks_and_cup",
+                                           "--reasoner", "llm", "-o", str(out)])
+        assert result.exit_code == 0, result.output
+        assert len(server.requests) == 3
+    assert load_graph(out).recovery_edges()

@@ -151,3 +151,12 @@ def test_max_repairs_zero_keeps_the_old_behaviour():
     assert not result.success
     assert repairer.calls == [] and result.trace.of("repair") == []
     assert result.summary()["repairs"] == 0
+
+
+def test_the_rules_arranger_repairs_the_same_unforeseen_failure_online():
+    # No scripted branch: the rules read the tilted bottle in the hand from the observation.
+    drop = ScriptedDrop(action="move_to_obj", nth=0, after=AFTER)
+    result = run_episode(EpisodeSpec(TASK, seed=SEED, graph=unanticipated_graph(), disturbance=drop, repair=True))
+    repairs = [e for e in result.trace.of("repair") if e["accepted"]]
+    assert result.success, result.reason
+    assert result.repairs >= 1 and repairs[0]["failure"] == "bottle_slipped"
