@@ -10,10 +10,13 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
+from agentchord.actions.catalog import PlaceArgs
 from agentchord.cli import main
 from agentchord.graph import check_graph, load_graph
 from agentchord.graph.interop import (
     CARRY_Z,
+    PLACE_Z,
+    PRE_PLACE_DIS,
     TABLE_XY,
     WORKSPACE,
     FrameMap,
@@ -141,6 +144,28 @@ def test_single_arm_example_maps_the_pour() -> None:
     assert (entry.source, entry.target) == ("v0_start", "v1_bottle_grasped")
 
 
+@needs_examples
+def test_rearrangement_example_places_by_release_along_the_release_x() -> None:
+    result = import_release(*_pair("Rearrangement"))
+    graph = result.graph
+    # The move before the release's open_gripper carries each utensil above its spot ...
+    carry = graph.edge("e03_move_to_plate_offsets").steps[0]
+    assert carry["left"].args == {"obj": "plate", "offset": [-0.16, 0.0, PRE_PLACE_DIS], "keep_orientation": True}
+    assert carry["right"].args["offset"] == [0.16, 0.0, PRE_PLACE_DIS]
+    # ... and the open_gripper is a place there, the long axis along the release's x (our y).
+    release = graph.edge("e04_release").steps[0]
+    assert (release["left"].fn, release["left"].args) == (
+        "place", {"obj": "fork", "target": [-0.16, 0.0], "relative_to": "plate", "yaw": 90.0})
+    assert release["right"].args == {"obj": "spoon", "target": [0.16, 0.0], "relative_to": "plate", "yaw": 90.0}
+    # The recovery that retries the move carries to the same stand-off before merging at v3.
+    retry = graph.edge("e03_move_to_plate_offsets_r_hold_lost_during_move").steps[-1]
+    assert retry["left"].args["offset"] == [-0.16, 0.0, PRE_PLACE_DIS]
+    assert graph.node("v4_placed").constraints == ["holding(left, fork) - 0.5", "holding(right, spoon) - 0.5"]
+    assert any("edges[3].left_arm_action" in n and "place by release" in n for n in result.notes)
+    assert any("edges[3].left_arm_action" in n and "place yaw 90" in n and "orient_eef 'down' is absolute" in n
+               for n in result.notes)
+
+
 def test_task_override_and_unknown_task_slug() -> None:
     assert _import(POUR, task="my_task").graph.task == "my_task"
     result = _import(POUR)
@@ -256,6 +281,64 @@ def test_orient_eef_without_a_grasp_pitches_the_tool() -> None:
     assert _args(down, "e1", "left") == ("move_by_offset", {"angles": [0.0, 90.0, 0.0], "frame": "intrinsic"})
     front = _import(_graph((_call("left", "orient_eef", direction="front"), None)))
     assert _args(front, "e1", "left")[1]["angles"] == [0.0, -90.0, 0.0]
+
+
+#: Rearrangement-like chain: grasp, orient down, move beside the plate, open.
+SET_DOWN = _graph(
+    (_call("left", "grasp", obj_name="fork"), None),
+    (_call("left", "orient_eef", direction="down"), None),
+    (_call("left", "move_relative_to_object", obj_name="plate", x_offset=0.0, y_offset=0.16, z_offset=0.0), None),
+    (_call("left", "open_gripper"), None),
+)
+
+
+def test_move_then_open_while_holding_is_a_place_at_the_offset() -> None:
+    result = _import(SET_DOWN)
+    assert _args(result, "e3", "left") == (
+        "move_to_obj", {"obj": "plate", "offset": [-0.16, 0.0, PRE_PLACE_DIS], "keep_orientation": True})
+    assert _args(result, "e4", "left") == (
+        "place", {"obj": "fork", "target": [-0.16, 0.0], "relative_to": "plate", "yaw": 90.0})
+    # A release height above the reference becomes our place's release height.
+    high = copy.deepcopy(SET_DOWN)
+    high["edges"][2]["left_arm_action"]["kwargs"]["z_offset"] = 0.05
+    assert _args(_import(high), "e4", "left")[1]["z_offset"] == 0.05
+    bounds = PlaceArgs.model_fields["z_offset"].metadata
+    assert PLACE_Z == (bounds[0].ge, bounds[1].le)  # kept in step with the catalogue
+    # Without an object in hand an open is an open, and the move keeps the release's offset.
+    empty = _graph(
+        (_call("left", "move_relative_to_object", obj_name="plate", x_offset=0.0, y_offset=0.16, z_offset=0.0), None),
+        (_call("left", "open_gripper"), None),
+    )
+    result = _import(empty)
+    assert _args(result, "e1", "left")[1]["offset"] == [-0.16, 0.0, 0.0]
+    assert _args(result, "e2", "left") == ("open_gripper", {})
+
+
+def test_place_yaw_follows_the_release_x_and_only_an_unturned_down_tool() -> None:
+    # The release's x in our frame: 90 deg with the aloha frame, 0 with identity, 30 for yaw=-60.
+    assert _args(_import(SET_DOWN, frame="identity"), "e4", "left")[1]["yaw"] == 0.0
+    assert _args(_import(SET_DOWN, frame="yaw=-60"), "e4", "left")[1]["yaw"] == pytest.approx(-60.0)
+    # place_on_table after orient 'down' gets it too.
+    table = _graph(
+        (_call("left", "grasp", obj_name="fork"), None),
+        (_call("left", "orient_eef", direction="down"), None),
+        (_call("left", "place_on_table", obj_name="fork", x=0.6, y=0.1), None),
+    )
+    assert _args(_import(table), "e3", "left")[1]["yaw"] == 90.0
+    # A roll after the orient turns the object: no fixed yaw. No orient: no yaw either.
+    rolled = copy.deepcopy(table)
+    rolled["edges"].insert(2, {"id": "e2b", "source": "v2", "target": "v2b", "left_arm_action": _call(
+        "left", "rotate_eef", degree=30), "right_arm_action": None})
+    rolled["nodes"].append({"id": "v2b", "semantic": "rolled"})
+    rolled["edges"][3]["source"] = "v2b"
+    assert "yaw" not in _args(_import(rolled), "e3", "left")[1]
+    plain = _graph(
+        (_call("left", "grasp", obj_name="fork"), None),
+        (_call("left", "move_relative_to_object", obj_name="plate", x_offset=0.0, y_offset=0.16, z_offset=0.0), None),
+        (_call("left", "open_gripper"), None),
+    )
+    assert _args(_import(plain), "e3", "left") == ("place", {"obj": "fork", "target": [-0.16, 0.0],
+                                                             "relative_to": "plate"})
 
 
 def test_frame_parse_and_identity() -> None:
@@ -522,5 +605,17 @@ def test_single_arm_imported_graph_runs_one_episode(tmp_path: Path) -> None:
     result = CliRunner().invoke(main, ["import-release", str(g), str(s), "-o", str(out), "--quiet"])
     assert result.exit_code == 0, result.output
     run = CliRunner().invoke(main, ["run", "single_arm_pour_water", "--graph", str(out), "--seed", "1"])
+    assert run.exit_code == 0, run.output
+    assert "SUCCESS" in run.output
+
+
+@needs_examples
+@pytest.mark.slow
+def test_rearrangement_imported_graph_succeeds_on_one_seed(tmp_path: Path) -> None:
+    g, s = _pair("Rearrangement")
+    out = tmp_path / "imported.yaml"
+    result = CliRunner().invoke(main, ["import-release", str(g), str(s), "-o", str(out), "--quiet"])
+    assert result.exit_code == 0, result.output
+    run = CliRunner().invoke(main, ["run", "rearrange_table", "--graph", str(out), "--seed", "1"])
     assert run.exit_code == 0, run.output
     assert "SUCCESS" in run.output

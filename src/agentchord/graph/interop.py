@@ -32,7 +32,9 @@ release                          ours
 ``move_relative_to_object``      ``move_to_obj(obj=obj_name, offset=R (x_offset, y_offset,
                                  z_offset))``; the release keeps the tool's orientation:
                                  ``keep_orientation: true``, except before a roll
-                                 (``rotate_eef`` next on that arm), see *pouring* below
+                                 (``rotate_eef`` next on that arm), see *pouring* below,
+                                 and before an ``open_gripper`` while holding: offset
+                                 z -> ``PRE_PLACE_DIS``, see *placing by release*
 ``move_to_absolute_position``    ``move_to_target(pos=frame(x, y, z))``, clipped to our
                                  workspace; ``z: null`` (keep the height) -> ``CARRY_Z``;
                                  ``x``/``y`` null cannot be mapped (error)
@@ -43,9 +45,11 @@ release                          ours
 ``rotate_eef``                   ``rotate_eef(angle=degree)`` (same sign, see *pouring*)
 ``place_on_table``               ``place(obj=obj_name, target=frame(x, y))``, clipped to
                                  the table; both null -> ``target`` omitted (straight
-                                 down); ``pre_place_dis`` dropped
+                                 down); ``pre_place_dis`` dropped; ``yaw`` after
+                                 ``orient_eef`` down, see *placing by release*
 ``back_to_initial_pose``         ``back``
-``open_gripper``                 ``open_gripper``
+``open_gripper``                 ``open_gripper``; right after ``move_relative_to_object``
+                                 while holding: ``place``, see *placing by release*
 ``close_gripper``                ``close_gripper``
 ``orient_eef``                   no absolute-orientation action in our catalogue. Right
                                  after a grasp of that arm: the grasp gets ``mode: top``
@@ -86,7 +90,26 @@ the chain or of the recovery) therefore gets ``yaw``: the approach axis is set
 perpendicular to the horizontal offset, turned so that the roll (sign kept: negative
 tips the top toward the tool's +y, ours as the release's) tips the held object's top
 toward the object. With the release's pour offset the bottle's mouth ends within
-1-3 cm of the cup's axis.
+1-3 cm of the cup's axis. The angle is kept: it is a roll of the release's wrist joint
+(its tool frame), and our tool rolls by exactly that; nothing in the release says the
+held object should turn further. (Our tool reaches the release's dual-arm -70 deg, but
+the bottle lags 0.2-0.5 deg in the fingers, just short of the 70 deg that
+``dual_arm_pour_water`` counts as pouring; that gap is our simulation's, not a convention.)
+
+Placing by release: the release has no place relative to an object; it moves what it holds
+to an offset from the object's base-pose origin (its centre; ``z_offset: 0`` is the table
+for an object resting on it) and then opens the gripper. ``move_relative_to_object``
+followed on the same arm by ``open_gripper`` while the arm holds an object is therefore a
+place: the move becomes a carry to the offset ``PRE_PLACE_DIS`` (0.08 m, the release's own
+``place_on_table`` stand-off) above the object's top point (lowered there, the held object
+would be dragged into the table), and the open becomes ``place(obj=held, target=R (x_offset,
+y_offset), relative_to=obj)``, with ``z_offset`` (our release height) from a non-zero
+release ``z_offset``. The release's ``orient_eef`` sets an absolute orientation: ``down``
+is its tool x forward, tool z down, fingers closing along its y. A thin object grasped
+across its narrow side (ours, like any parallel gripper's) is then carried with its long
+axis along the release's x; our top grasp keeps the object's own yaw and only ``place``
+can set it, so a place of an object grasped ``mode: top`` (orient ``down``) gets ``yaw``:
+the release's x in our frame (90 with ``aloha``), unless the tool rolled since.
 
 Monitors
 --------
@@ -151,6 +174,11 @@ CARRY_Z = 0.15
 #: Our workspace (m), as ``agentchord.actions.motion`` clips every pose target (kept in
 #: step by a test; that module imports the simulator).
 WORKSPACE = ((-0.56, 0.22, 0.015), (0.56, 0.95, 0.55))
+#: Stand-off (m) above the spot where the release lets go of what it holds (its ``place_on_table``
+#: default ``pre_place_dis``): our carry stops there, our place lowers the object.
+PRE_PLACE_DIS = 0.08
+#: Range (m) of our place's ``z_offset`` (``PlaceArgs``).
+PLACE_Z = (-0.05, 0.2)
 #: Table positions a place may target (m): the table top less a 5 cm margin.
 TABLE_XY = ((-0.56, 0.27), (0.56, 0.93))
 #: Kwargs dropped from every release call, and why.
@@ -365,6 +393,52 @@ _RawStep = dict[str, "_Raw | None"]
 
 
 @dataclass
+class _Track:
+    """Each arm's history along a translation.
+
+    Attributes:
+        before: The arm's last release call.
+        previous: Our last action on the arm.
+        turned: Arms whose tool turned (a roll, a pitch) since they last grasped.
+    """
+
+    before: dict[str, _Raw] = field(default_factory=dict)
+    previous: dict[str, str] = field(default_factory=dict)
+    turned: set[str] = field(default_factory=set)
+
+    def update(self, arm: str, call: ActionCall) -> None:
+        self.previous[arm] = call.fn
+        if call.fn == "grasp":
+            self.turned.discard(arm)
+        elif call.fn == "rotate_eef" or any(call.args.get("angles", ())):
+            self.turned.add(arm)
+
+    def copy(self) -> _Track:
+        return _Track(dict(self.before), dict(self.previous), set(self.turned))
+
+
+@dataclass
+class _Ctx:
+    """What one release call is translated in view of.
+
+    Attributes:
+        arm: The call's arm.
+        nxt: The arm's next release call (later in the steps, then in the continuation).
+        before: The arm's previous release call.
+        previous: Our previous action on the arm.
+        holds: What each arm holds.
+        turned: Whether the arm's tool turned since it last grasped.
+    """
+
+    arm: str
+    nxt: _Raw | None
+    before: _Raw | None
+    previous: str | None
+    holds: dict[str, str]
+    turned: bool
+
+
+@dataclass
 class _Binding:
     index: int
     edge_id: str
@@ -426,14 +500,15 @@ class _Importer:
         # Nominal edges, with what each arm holds before each edge.
         holds_before: dict[str, dict[str, str]] = {}
         holds: dict[str, str] = {}
-        last_fn: dict[str, str] = {}
+        track = _Track()
+        track_before: dict[str, _Track] = {}
         released_into: dict[str, list[tuple[str, str]]] = {}
         nominal: dict[str, list[dict[str, ActionCall | None]]] = {}
         for k, edge_id in enumerate(order):
             holds_before[edge_id] = dict(holds)
+            track_before[edge_id] = track.copy()
             continuation = [s for later in order[k + 1:] for s in steps[later]]
-            nominal[edge_id] = self._translate(steps[edge_id], continuation, holds, last_fn)
-            last_fn.update({arm: call.fn for arm, call in _calls(nominal[edge_id])})
+            nominal[edge_id] = self._translate(steps[edge_id], continuation, holds, track)
             released_into[edge_id] = _released(holds_before[edge_id], nominal[edge_id])
             holds = _after(holds, nominal[edge_id])
 
@@ -463,7 +538,8 @@ class _Importer:
                            f"recovery edge id {rec_id!r} is already taken")
                 continue
             existing.add(rec_id)
-            actions = self._translate(binding.steps, continuation, holds_before[binding.edge_id])
+            actions = self._translate(binding.steps, continuation, holds_before[binding.edge_id],
+                                      track_before[binding.edge_id].copy())
             entry_of[binding.index] = rec_id
             recovery_edges.append(
                 Edge(id=rec_id, kind="recovery", source=failed.source, target=target, actions=actions or [{}])
@@ -791,12 +867,15 @@ class _Importer:
 
     def _translate(
         self, steps: list[_RawStep], continuation: list[_RawStep], holds: dict[str, str],
-        previous: dict[str, str] | None = None,
+        track: _Track | None = None,
     ) -> list[dict[str, ActionCall | None]]:
-        """Our steps for ``steps``; ``continuation`` is what runs after them, ``previous`` each arm's last fn."""
+        """Our steps for ``steps``; ``continuation`` is what runs after them.
+
+        ``track`` (each arm's history before ``steps``) is brought up to date in place.
+        """
         out: list[dict[str, ActionCall | None]] = []
         holds = dict(holds)
-        previous = dict(previous or {})
+        track = track if track is not None else _Track()
         for k, step in enumerate(steps):
             ours: dict[str, ActionCall | None] = {}
             for arm, raw in step.items():
@@ -804,17 +883,19 @@ class _Importer:
                     continue
                 after = steps[k + 1:] + continuation
                 nxt = next((s[arm] for s in after if s.get(arm) is not None), None)
-                call = self._call(raw, arm, nxt, previous.get(arm), holds)
+                ctx = _Ctx(arm, nxt, track.before.get(arm), track.previous.get(arm), holds, arm in track.turned)
+                call = self._call(raw, ctx)
+                track.before[arm] = raw
                 if call is not None:
                     ours[arm] = call
-                    previous[arm] = call.fn
+                    track.update(arm, call)
             if ours:
                 out.append(ours)
                 holds = _after(holds, [ours])
         return out
 
-    def _call(self, raw: _Raw, arm: str, nxt: _Raw | None, previous: str | None,
-              holds: dict[str, str]) -> ActionCall | None:
+    def _call(self, raw: _Raw, ctx: _Ctx) -> ActionCall | None:
+        arm = ctx.arm
         f, path = raw.file, raw.path
         call = raw.call
         fn = call.get("fn")
@@ -843,7 +924,7 @@ class _Importer:
             self.error(f, f"{path}.fn", f"cannot map release action {fn!r}; mapped actions: {known}")
             return None
         before = len(self.problems)
-        result = handler(kwargs, raw, arm, nxt, previous, holds)
+        result = handler(kwargs, raw, ctx)
         if len(self.problems) > before or result is None:
             return None
         for key in kwargs:  # the handlers pop what they map
@@ -879,7 +960,7 @@ class _Importer:
             out[name] = None if value is None or not ok else float(value)
         return out if ok else None
 
-    def _fn_grasp(self, kwargs, raw, arm, nxt, previous, holds):
+    def _fn_grasp(self, kwargs: dict, raw: _Raw, ctx: _Ctx) -> tuple[str, dict] | None:
         obj = self._obj_kwarg(kwargs, raw, "grasp")
         pre = kwargs.pop("pre_grasp_dis", None)
         if raw.extra.get("pre_grasp_dis") is not None:  # a recovery step's own pre_grasp_dis wins
@@ -892,7 +973,7 @@ class _Importer:
                 self.error(raw.file, f"{raw.path}.kwargs.pre_grasp_dis", f"expected a number (m), got {pre!r}")
                 return None
             args["pre_grasp_dis"] = float(pre)
-        mode = self.grasp_modes.get((arm, obj))
+        mode = self.grasp_modes.get((ctx.arm, obj))
         if mode is not None:
             args["mode"] = mode
             self.note(raw.file, raw.path, f"grasp mode {mode!r}: the release orients this arm's tool "
@@ -901,14 +982,24 @@ class _Importer:
             args["skip_if_held"] = True
         return "grasp", args
 
-    def _fn_move_relative_to_object(self, kwargs, raw, arm, nxt, previous, holds):
+    def _fn_move_relative_to_object(self, kwargs: dict, raw: _Raw, ctx: _Ctx) -> tuple[str, dict] | None:
         obj = self._obj_kwarg(kwargs, raw, "move_relative_to_object")
         d = self._numbers(kwargs, raw, ("x_offset", "y_offset", "z_offset"))
         if obj is None or d is None:
             return None
         offset = self.frame.vector((d["x_offset"], d["y_offset"], d["z_offset"]))
+        held = ctx.holds.get(ctx.arm)
+        if held is not None and _fn_of(ctx.nxt) == "open_gripper":
+            # The release lowers what it holds to this offset and lets go there: a place. Ours
+            # carries it above the spot; the open_gripper after it becomes our place.
+            carry = [offset[0], offset[1], PRE_PLACE_DIS]
+            self.note(raw.file, raw.path,
+                      f"offset {_fmt_vec(offset)} then open_gripper: the release sets {held} down there; our "
+                      f"move_to_obj carries it to {_fmt_vec(carry)} from {obj}'s top point (the release's "
+                      f"pre_place_dis stand-off) and the open_gripper becomes our place")
+            return "move_to_obj", {"obj": obj, "offset": carry, "keep_orientation": True}
         args: dict[str, Any] = {"obj": obj, "offset": list(offset)}
-        roll = _roll_of(nxt)
+        roll = _roll_of(ctx.nxt)
         horizontal = math.hypot(offset[0], offset[1])
         if roll and horizontal > 1e-6:
             ox, oy = offset[0] / horizontal, offset[1] / horizontal
@@ -924,7 +1015,7 @@ class _Importer:
                                       "(the release's: from its base-pose origin)")
         return "move_to_obj", args
 
-    def _fn_move_to_absolute_position(self, kwargs, raw, arm, nxt, previous, holds):
+    def _fn_move_to_absolute_position(self, kwargs: dict, raw: _Raw, ctx: _Ctx) -> tuple[str, dict] | None:
         d = self._numbers(kwargs, raw, ("x", "y", "z"), default=None)
         if d is None:
             return None
@@ -946,7 +1037,7 @@ class _Importer:
                                       f"-> {_fmt_vec(clipped)} in ours")
         return "move_to_target", {"pos": list(clipped)}
 
-    def _fn_move_by_relative_offset(self, kwargs, raw, arm, nxt, previous, holds):
+    def _fn_move_by_relative_offset(self, kwargs: dict, raw: _Raw, ctx: _Ctx) -> tuple[str, dict] | None:
         d = self._numbers(kwargs, raw, ("dx", "dy", "dz"))
         mode = kwargs.pop("mode", "extrinsic")
         if d is None:
@@ -964,13 +1055,13 @@ class _Importer:
         self.error(raw.file, f"{raw.path}.kwargs.mode", f"expected 'extrinsic' or 'intrinsic', got {mode!r}")
         return None
 
-    def _fn_rotate_eef(self, kwargs, raw, arm, nxt, previous, holds):
+    def _fn_rotate_eef(self, kwargs: dict, raw: _Raw, ctx: _Ctx) -> tuple[str, dict] | None:
         d = self._numbers(kwargs, raw, ("degree",))
         if d is None:
             return None
         return "rotate_eef", {"angle": d["degree"]}
 
-    def _fn_place_on_table(self, kwargs, raw, arm, nxt, previous, holds):
+    def _fn_place_on_table(self, kwargs: dict, raw: _Raw, ctx: _Ctx) -> tuple[str, dict] | None:
         obj = self._obj_kwarg(kwargs, raw, "place_on_table")
         d = self._numbers(kwargs, raw, ("x", "y"), default=None)
         if "pre_place_dis" in kwargs:
@@ -979,7 +1070,7 @@ class _Importer:
                       "dropped: our place lowers from the carrying height, no stand-off parameter")
         if obj is None or d is None:
             return None
-        args: dict[str, Any] = {"obj": obj}
+        args: dict[str, Any] = {"obj": obj, **self._place_yaw(raw, ctx, obj)}
         if d["x"] is None and d["y"] is None:
             return "place", args
         if d["x"] is None or d["y"] is None:
@@ -996,29 +1087,65 @@ class _Importer:
         args["target"] = list(target)
         return "place", args
 
-    def _fn_back_to_initial_pose(self, kwargs, raw, arm, nxt, previous, holds):
+    def _fn_back_to_initial_pose(self, kwargs: dict, raw: _Raw, ctx: _Ctx) -> tuple[str, dict] | None:
         return "back", {}
 
-    def _fn_open_gripper(self, kwargs, raw, arm, nxt, previous, holds):
-        return "open_gripper", {}
+    def _fn_open_gripper(self, kwargs: dict, raw: _Raw, ctx: _Ctx) -> tuple[str, dict] | None:
+        held = ctx.holds.get(ctx.arm)
+        if held is None or _fn_of(ctx.before) != "move_relative_to_object":
+            return "open_gripper", {}
+        # The move before it took what the arm holds to its release point: place it there.
+        move = ctx.before.call.get("kwargs") or {}
+        ref = self.renames.get(move.get("obj_name"), move.get("obj_name"))
+        d = {k: move.get(k, 0.0) for k in ("x_offset", "y_offset", "z_offset")}
+        if not isinstance(ref, str) or not all(_number(v) for v in d.values()):
+            return "open_gripper", {}  # the move itself reports what is wrong with it
+        dx, dy, _ = self.frame.vector((d["x_offset"], d["y_offset"], 0.0))
+        args: dict[str, Any] = {"obj": held, "target": [dx, dy], "relative_to": ref}
+        z = _round(min(max(float(d["z_offset"]), PLACE_Z[0]), PLACE_Z[1]))
+        if z:
+            args["z_offset"] = z
+        args.update(self._place_yaw(raw, ctx, held))
+        self.note(raw.file, raw.path,
+                  f"open_gripper after move_relative_to_object({ref}) while holding {held}: the release's place by "
+                  f"release -> place({held}, target ({_fmt(dx)}, {_fmt(dy)}) from {ref}'s centre"
+                  f"{f', z_offset {_fmt(z)}' if z else ''}): ours lowers {held} onto the table, opens, backs off")
+        return "place", args
 
-    def _fn_close_gripper(self, kwargs, raw, arm, nxt, previous, holds):
+    def _fn_close_gripper(self, kwargs: dict, raw: _Raw, ctx: _Ctx) -> tuple[str, dict] | None:
         return "close_gripper", {}
 
-    def _fn_orient_eef(self, kwargs, raw, arm, nxt, previous, holds):
+    def _fn_orient_eef(self, kwargs: dict, raw: _Raw, ctx: _Ctx) -> tuple[str, dict] | None:
         direction = kwargs.pop("direction", "front")
         if direction not in ("down", "front"):
             self.error(raw.file, f"{raw.path}.kwargs.direction", f"expected 'down' or 'front', got {direction!r}")
             return None
-        held = holds.get(arm)
-        if previous == "grasp" and held is not None and (arm, held) in self.grasp_modes:
+        held = ctx.holds.get(ctx.arm)
+        if ctx.previous == "grasp" and held is not None and (ctx.arm, held) in self.grasp_modes:
             self.note(raw.file, raw.path, f"orient_eef {direction!r} -> zero move_by_offset (hold): the grasp before "
-                                          f"it takes {held} with mode {self.grasp_modes[(arm, held)]!r}")
+                                          f"it takes {held} with mode {self.grasp_modes[(ctx.arm, held)]!r}")
             return "move_by_offset", {}
         pitch = 90.0 if direction == "down" else -90.0
         self.note(raw.file, raw.path, f"orient_eef {direction!r} -> move_by_offset angles (0, {_fmt(pitch)}, 0) "
                                       f"intrinsic: assumes a {'level' if direction == 'down' else 'top-down'} tool")
         return "move_by_offset", {"angles": [0.0, pitch, 0.0], "frame": "intrinsic"}
+
+    def _place_yaw(self, raw: _Raw, ctx: _Ctx, obj: str) -> dict[str, float]:
+        """``{"yaw": ...}`` for a place of ``obj`` held as the release's ``orient_eef 'down'`` left it, else ``{}``.
+
+        That orientation is absolute (tool x along the release's x, fingers closing along its y), so a
+        thin object grasped across its narrow side is carried with its long axis along the release's
+        x; our top grasp keeps the object's own yaw and only a place can set it.
+        """
+        if self.grasp_modes.get((ctx.arm, obj)) != "top" or ctx.turned:
+            return {}
+        ax, ay, _ = self.frame.vector((1.0, 0.0, 0.0))
+        yaw = _round((math.degrees(math.atan2(ay, ax)) + 90.0) % 180.0 - 90.0)  # a long axis: mod 180
+        yaw = 90.0 if yaw == -90.0 else yaw
+        self.note(raw.file, raw.path,
+                  f"place yaw {_fmt(yaw)}: the release's orient_eef 'down' is absolute (its tool x forward, fingers "
+                  f"closing along its y), so {obj}, grasped across its narrow side, lies along the release's x")
+        return {"yaw": yaw}
 
     # ------------------------------------------------------------ monitors
     def _failure(self, binding: _Binding, edge: Edge, holds: dict[str, str], entry: str) -> FailureMode:
@@ -1094,8 +1221,9 @@ def _roll_of(raw: _Raw | None) -> float:
     return float(degree) if _number(degree) else 0.0
 
 
-def _calls(steps: list[dict[str, ActionCall | None]]) -> list[tuple[str, ActionCall]]:
-    return [(arm, call) for step in steps for arm, call in step.items() if call is not None]
+def _fn_of(raw: _Raw | None) -> str | None:
+    """The release action name of a call, None for none."""
+    return raw.call.get("fn") if raw is not None and isinstance(raw.call, dict) else None
 
 
 def _after(holds: dict[str, str], steps: list[dict[str, ActionCall | None]]) -> dict[str, str]:
