@@ -366,6 +366,8 @@ class RotateEef(ArmAction):
         yield from settle(robot, arm, max_ticks=10)
 
 
+#: Largest extent (m) of a point feature (a cloth corner) rather than a body.
+POINT_EXTENT = 0.01
 #: A tall object tilted more than this in the hand (deg) is turned upright before it is put down.
 LEVEL_IN_HAND_DEG = 4.0
 #: Finger gap beyond the object's width (m) when releasing it inside a rim.
@@ -474,6 +476,8 @@ class Place(ArmAction):
     def _standing(self, robot: RobotController) -> bool:
         """Whether the object already stands upright on the table (an earlier place released it)."""
         feats = robot.frame.objects[self.args.obj]
+        if float(np.max(feats.extent)) < POINT_EXTENT:
+            return True  # a point feature (a cloth's corner) released is placed wherever it lies
         return _tilt_deg(feats.axis) <= UPRIGHT_TOLERANCE_DEG and min(feats.bottom[2], feats.top[2]) < 0.01
 
     def _release_and_retreat(self, robot: RobotController) -> Iterator[None]:

@@ -33,6 +33,8 @@ from agentchord.graph.models import ActionCall, Edge, FailureMode, Step, TaskGra
 from agentchord.graph.progress import forward_filter, nominal_path
 
 ARMS = ("left", "right")
+#: Ticks a placed relation must stay broken before it counts (a released cloth settles).
+MISPLACED_WINDOW = 10
 #: Tilt (deg) of a placed upright object beyond which it leans (the placed constraints allow 10).
 PLACED_TILT_DEG = 10.0
 ABSOLUTE = frozenset({"move_to_obj", "move_to_target", "place", "grasp", "back"})
@@ -225,7 +227,61 @@ class Arranger:
             if self.watch_visibility:
                 out.append((FailureMode(name=f"{obj}_lost", monitor=f"lost_view({obj}, {kb.MIN_POINTS})", window=kb.WINDOW, intent="re-observe", recovery=replay.id), None))
         out += self._relations(graph, edge, account, after)
+        out += self._misplaced(graph, edge, account)
         return out
+
+    def _misplaced(self, graph: TaskGraph, edge: Edge, before: Account) -> list[tuple[FailureMode, Edge]]:
+        """Objects released relative to another one earlier, left alone by this edge: the relation the
+        target node states can break as they settle (Eq. 19). Re-place: take it again and put it on the
+        anchor itself (a second place does not drag what it lies on); two at once are re-placed together."""
+        placed = self._placements(graph, edge)
+        target = graph.node(edge.target).constraints
+        singles: list[tuple[FailureMode, Edge, str, list[Step]]] = []
+        carried = {before[a].holding for a in ARMS if before[a].holding}
+        for obj, (host, arm, grasp, place) in placed.items():
+            if any(before[a].holding == obj for a in ARMS) or any(c.args.get("obj") == obj for _, c in edge.calls):
+                continue
+            if host in carried or before[arm].holding is not None:
+                continue  # travels with a carried host (see _relations), or the placing arm's hands are full
+            relation = [c for c in target if obj in c and host in c]
+            if not relation:
+                continue
+            again = ActionCall(fn="place", args={**place.args, "target": [0.0, 0.0]}) if "dist(" in relation[0] else place
+            steps: list[Step] = [{arm: ActionCall(fn="grasp", args={**grasp.args})}, {arm: again}]
+            singles.append((FailureMode(name=f"{obj}_misplaced", monitor=relation[0], window=MISPLACED_WINDOW, intent="re-place",
+                                        recovery=f"{edge.id}_r_{obj}_misplaced"), None, arm, steps))
+        out: list[tuple[FailureMode, Edge]] = []
+        if len(singles) == 2 and singles[0][2] != singles[1][2]:
+            (m1, _, a1, s1), (m2, _, a2, s2) = singles
+            both = _sequence({a1: [c for st in s1 for c in st.values()], a2: [c for st in s2 for c in st.values()]})
+            entry = f"{edge.id}_r_both_misplaced"
+            monitor = f"min({m1.monitor}, {m2.monitor})"
+            out.append((FailureMode(name="both_misplaced", monitor=monitor, window=MISPLACED_WINDOW, intent="re-place", recovery=entry),
+                        Edge(id=entry, source=edge.source, target=edge.target, kind="recovery", actions=both + self._edge_again(edge))))
+        for mode, _, _, steps in singles:
+            out.append((mode, Edge(id=mode.recovery, source=edge.source, target=edge.target, kind="recovery", actions=steps + self._edge_again(edge))))
+        return out
+
+    @staticmethod
+    def _edge_again(edge: Edge) -> list[Step]:
+        """The edge's own steps, finishing what it had done (grasps skip what is held, places what is placed)."""
+        return [{a: _with_skips(c) for a, c in step.items() if c is not None} for step in edge.steps]
+
+    def _placements(self, graph: TaskGraph, edge: Edge) -> dict[str, tuple[str, str, ActionCall, ActionCall]]:
+        """Objects placed relative to another before ``edge`` on the nominal path: obj -> (host, arm, grasp, place)."""
+        placed: dict[str, tuple[str, str, ActionCall, ActionCall]] = {}
+        account: Account = {arm: ArmAccount() for arm in ARMS}
+        for edge_id in nominal_path(graph):
+            if edge_id == edge.id:
+                break
+            for step in graph.edge(edge_id).steps:
+                for arm, call in step.items():
+                    if call is not None and call.fn == "place" and call.args.get("relative_to") and account[arm].grasp is not None:
+                        placed[call.args["obj"]] = (call.args["relative_to"], arm, account[arm].grasp, call)
+                    elif call is not None and call.fn == "grasp":
+                        placed.pop(call.args["obj"], None)
+                account = _apply(account, step)
+        return placed
 
     def _drop(self, edge: Edge, before: Account, after: Account, obj: str) -> tuple[FailureMode, Edge]:
         at_s, at_t = _holders(before, obj), _holders(after, obj)
@@ -295,19 +351,8 @@ class Arranger:
     def _relations(self, graph: TaskGraph, edge: Edge, before: Account, after: Account) -> list[tuple[FailureMode, Edge]]:
         """Objects released in or on one that this edge carries (Eq. 19): put them back, take the carrier again."""
         out = []
-        path = nominal_path(graph)
-        placed: dict[str, tuple[str, str, ActionCall, ActionCall]] = {}  # obj -> (host, arm, grasp, place)
-        account: Account = {arm: ArmAccount() for arm in ARMS}
-        for edge_id in path:
-            if edge_id == edge.id:
-                break
-            for step in graph.edge(edge_id).steps:
-                for arm, call in step.items():
-                    if call is not None and call.fn == "place" and call.args.get("relative_to") and account[arm].grasp is not None:
-                        dx, dy = call.args.get("target") or (0.0, 0.0)
-                        if abs(dx) < 1e-9 and abs(dy) < 1e-9:
-                            placed[call.args["obj"]] = (call.args["relative_to"], arm, account[arm].grasp, call)
-                account = _apply(account, step)
+        # Released inside or on top of the host (no lateral offset): it travels with the host.
+        placed = {obj: p for obj, p in self._placements(graph, edge).items() if not any(abs(v) > 1e-9 for v in (p[3].args.get("target") or (0.0, 0.0)))}
         carried = {before[a].holding for a in ARMS if before[a].holding}  # held at the source: this edge moves it
         for obj, (host, arm, grasp, place) in placed.items():
             if host not in carried or host not in self.objects:
