@@ -368,8 +368,10 @@ class RotateEef(ArmAction):
 
 #: Largest extent (m) of a point feature (a cloth corner) rather than a body.
 POINT_EXTENT = 0.01
-#: A tall object tilted more than this in the hand (deg) is turned upright before it is put down.
+#: A tall object tilted more than this in the hand (deg) is turned upright before it is put down,
+#: with its bottom at least this high (m) while it turns.
 LEVEL_IN_HAND_DEG = 4.0
+LEVEL_CLEARANCE = 0.02
 #: Finger gap beyond the object's width (m) when releasing it inside a rim.
 RELEASE_MARGIN = 0.02
 #: Height (m) by which a placed object clears the top of the object it is placed relative to.
@@ -419,13 +421,13 @@ class Place(ArmAction):
         elif target is not None:
             # Put the object's centre, not the tool, over the target.
             above[:2] += target - obj.pos[:2]
-        rotation, above = self._upright_in_hand(robot, obj, tool, rotation, above)
         above[2] = max(above[2], tool.pos[2])
         if self.args.relative_to is not None:
             # Carry the object over the reference's rim (into a cup, onto a block), not through it.
             host_top = robot.frame.objects[self.args.relative_to].top[2]
             above[2] = max(above[2], tool.pos[2] + host_top + RIM_CLEARANCE - obj.bottom[2])
         yield from move_to(robot, arm, pose_from_matrix(above, rotation))
+        rotation = yield from self._upright_in_hand(robot, rotation)
         obj = robot.frame.objects[self.args.obj]
         drop = obj.bottom[2] - (self.args.z_offset + 0.004)
         down = robot.commanded_pose(arm).pos - np.array([0.0, 0.0, drop])
@@ -438,27 +440,29 @@ class Place(ArmAction):
         if robot.targets[arm].grip > 0.0:
             yield from grip(robot, arm, 0.0, ticks=6)  # clear of the rim: open fully for the next grasp
 
-    def _upright_in_hand(self, robot: RobotController, obj, tool, rotation: np.ndarray, above: np.ndarray):
-        """Turn the tool so that a tall object held askew (a regrasp off-centre) goes down upright.
+    def _upright_in_hand(self, robot: RobotController, rotation: np.ndarray) -> Iterator[None]:
+        """Over the spot, turn a tall object held askew (an off-centre regrasp) upright before lowering it.
 
-        Released at a tilt, a tall object topples or leans; the correction is the smallest rotation
-        that maps the object's axis, as it will be with the planned tool rotation, to vertical, and
-        the tool shifts so that the object's centre still ends over the same spot.
+        Released at a tilt, a tall object leans or topples. Measured where the transport ended (a weak
+        hold may slip on the way): the smallest tool rotation that makes the object's axis vertical,
+        about the object's centre, slowly, lifted clear of the table first if it hangs low. Returns the
+        tool rotation to lower with.
         """
+        obj = robot.frame.objects[self.args.obj]
         if obj.extent[2] <= 1.5 * max(obj.extent[0], obj.extent[1]):
-            return rotation, above
-        current = robot.rotation(self.arm)
-        axis = rotation @ current.T @ obj.axis
-        angle = float(np.degrees(np.arccos(np.clip(axis[2], -1.0, 1.0))))
+            return rotation
+        angle = _tilt_deg(obj.axis)
         if angle < LEVEL_IN_HAND_DEG or angle > UPRIGHT_TOLERANCE_DEG:
-            return rotation, above
-        fix = Rotation.align_vectors([[0.0, 0.0, 1.0]], [axis])[0].as_matrix()
+            return rotation
+        tool = robot.commanded_pose(self.arm).pos
+        lift = max(0.0, LEVEL_CLEARANCE - float(min(obj.bottom[2], obj.top[2])))
+        fix = Rotation.align_vectors([[0.0, 0.0, 1.0]], [obj.axis])[0].as_matrix()
+        centre = obj.pos + np.array([0.0, 0.0, lift])
         turned = fix @ rotation
-        held = obj.pos - tool.pos
-        goal = above[:2] + (rotation @ current.T @ held)[:2]  # where the centre would have gone
-        above = above.copy()
-        above[:2] = goal - (turned @ current.T @ held)[:2]
-        return turned, above
+        goal = centre - fix @ (obj.pos - tool)
+        yield from move_to(robot, self.arm, pose_from_matrix(goal, turned), speed=0.08)
+        yield from settle(robot, self.arm, max_ticks=10)
+        return turned
 
     def _release_grip(self, robot: RobotController) -> float:
         """Fully open, unless the object sits inside a rim (a cup): then just wider than the object,
