@@ -232,13 +232,15 @@ class Arranger:
 
     def _misplaced(self, graph: TaskGraph, edge: Edge, before: Account) -> list[tuple[FailureMode, Edge]]:
         """Objects released relative to another one earlier, left alone by this edge: the relation the
-        target node states can break as they settle (Eq. 19). Re-place: take it again and put it on the
-        anchor itself (a second place does not drag what it lies on); two at once are re-placed together."""
+        target node states can break as they settle (Eq. 19). Re-place: take it again, bring it over the
+        spot the way the nominal path's last motions did, put it on the anchor itself (a second place does not drag what it lies
+        on), and merge back at the edge's source, whose edge runs again under the same monitors. Two
+        broken at once are re-placed together."""
         placed = self._placements(graph, edge)
         target = graph.node(edge.target).constraints
         singles: list[tuple[FailureMode, Edge, str, list[Step]]] = []
         carried = {before[a].holding for a in ARMS if before[a].holding}
-        for obj, (host, arm, grasp, place) in placed.items():
+        for obj, (host, arm, grasp, place, carry) in placed.items():
             if any(before[a].holding == obj for a in ARMS) or any(c.args.get("obj") == obj for _, c in edge.calls):
                 continue
             if host in carried or before[arm].holding is not None:
@@ -247,7 +249,7 @@ class Arranger:
             if not relation:
                 continue
             again = ActionCall(fn="place", args={**place.args, "target": [0.0, 0.0]}) if "dist(" in relation[0] else place
-            steps: list[Step] = [{arm: ActionCall(fn="grasp", args={**grasp.args})}, {arm: again}]
+            steps: list[Step] = [{arm: ActionCall(fn="grasp", args={**grasp.args})}, *({arm: c} for c in carry), {arm: again}]
             singles.append((FailureMode(name=f"{obj}_misplaced", monitor=relation[0], window=MISPLACED_WINDOW, intent="re-place",
                                         recovery=f"{edge.id}_r_{obj}_misplaced"), None, arm, steps))
         out: list[tuple[FailureMode, Edge]] = []
@@ -257,19 +259,15 @@ class Arranger:
             entry = f"{edge.id}_r_both_misplaced"
             monitor = f"min({m1.monitor}, {m2.monitor})"
             out.append((FailureMode(name="both_misplaced", monitor=monitor, window=MISPLACED_WINDOW, intent="re-place", recovery=entry),
-                        Edge(id=entry, source=edge.source, target=edge.target, kind="recovery", actions=both + self._edge_again(edge))))
+                        Edge(id=entry, source=edge.source, target=edge.source, kind="recovery", actions=both)))
         for mode, _, _, steps in singles:
-            out.append((mode, Edge(id=mode.recovery, source=edge.source, target=edge.target, kind="recovery", actions=steps + self._edge_again(edge))))
+            out.append((mode, Edge(id=mode.recovery, source=edge.source, target=edge.source, kind="recovery", actions=steps)))
         return out
 
-    @staticmethod
-    def _edge_again(edge: Edge) -> list[Step]:
-        """The edge's own steps, finishing what it had done (grasps skip what is held, places what is placed)."""
-        return [{a: _with_skips(c) for a, c in step.items() if c is not None} for step in edge.steps]
-
-    def _placements(self, graph: TaskGraph, edge: Edge) -> dict[str, tuple[str, str, ActionCall, ActionCall]]:
-        """Objects placed relative to another before ``edge`` on the nominal path: obj -> (host, arm, grasp, place)."""
-        placed: dict[str, tuple[str, str, ActionCall, ActionCall]] = {}
+    def _placements(self, graph: TaskGraph, edge: Edge) -> dict[str, tuple[str, str, ActionCall, ActionCall, list[ActionCall]]]:
+        """Objects placed relative to another before ``edge`` on the nominal path:
+        obj -> (host, arm, grasp, place, the motions that brought it over the spot)."""
+        placed: dict[str, tuple[str, str, ActionCall, ActionCall, list[ActionCall]]] = {}
         account: Account = {arm: ArmAccount() for arm in ARMS}
         for edge_id in nominal_path(graph):
             if edge_id == edge.id:
@@ -277,7 +275,9 @@ class Arranger:
             for step in graph.edge(edge_id).steps:
                 for arm, call in step.items():
                     if call is not None and call.fn == "place" and call.args.get("relative_to") and account[arm].grasp is not None:
-                        placed[call.args["obj"]] = (call.args["relative_to"], arm, account[arm].grasp, call)
+                        # The last carrying motion (and what followed it) brought it over the spot: replay those,
+                        # not the whole carry (a cloth corner lifted from its start again would unfold it).
+                        placed[call.args["obj"]] = (call.args["relative_to"], arm, account[arm].grasp, call, list(account[arm].since_grasp))
                     elif call is not None and call.fn == "grasp":
                         placed.pop(call.args["obj"], None)
                 account = _apply(account, step)
@@ -354,7 +354,7 @@ class Arranger:
         # Released inside or on top of the host (no lateral offset): it travels with the host.
         placed = {obj: p for obj, p in self._placements(graph, edge).items() if not any(abs(v) > 1e-9 for v in (p[3].args.get("target") or (0.0, 0.0)))}
         carried = {before[a].holding for a in ARMS if before[a].holding}  # held at the source: this edge moves it
-        for obj, (host, arm, grasp, place) in placed.items():
+        for obj, (host, arm, grasp, place, _) in placed.items():
             if host not in carried or host not in self.objects:
                 continue
             holders = _holders(before, host)
