@@ -59,7 +59,10 @@ def tasks() -> None:
     graphs = set(library_tasks())
     width = max(len(name) for name in SIM_TASKS)
     for name, task in sorted(SIM_TASKS.items()):
-        mark = "" if name in graphs else "  (no library graph yet)"
+        if getattr(task, "goal_defined", False):
+            mark = "  (no library graph: plan it with --instruction)"
+        else:
+            mark = "" if name in graphs else "  (no library graph yet)"
         click.echo(f"{name:<{width}}  {task.description}{mark}")
 
 
