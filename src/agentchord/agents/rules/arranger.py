@@ -70,11 +70,9 @@ def _apply(account: Account, step: Step) -> Account:
         me = after[arm]
         args = call.args
         if call.fn == "grasp":
-            taken = any(after[a].holding == args["obj"] for a in ARMS if a != arm)
+            # Taken from the other arm (a handover) only if it held it before this step: a two-arm grasp is not.
+            taken = any(account[a].holding == args["obj"] for a in ARMS if a != arm)
             me.holding, me.grasp, me.since_grasp, me.relative_to = args["obj"], (None if taken else call), [], None
-            for other_arm in ARMS:
-                if other_arm != arm and after[other_arm].holding == args["obj"] and not taken:
-                    pass
         elif call.fn == "place" or call.fn == "open_gripper":
             me.holding, me.grasp, me.since_grasp, me.relative_to = None, None, [], None
         elif call.fn == "back":
@@ -114,14 +112,14 @@ def _with_skips(call: ActionCall) -> ActionCall:
     return call
 
 
-def _regrasp(account: Account, arm: str, obj: str, tall: bool = False) -> ActionCall:
+def _regrasp(account: Account, arm: str, obj: str, tall: bool = False, skip_if_held: bool = True) -> ActionCall:
     grasp = account[arm].grasp
     args = dict(grasp.args) if grasp is not None and grasp.args.get("obj") == obj else {"obj": obj}
     if tall and args.get("mode", "auto") != "top":
         # A tall object that fell is taken again from its side once upright: the nominal hold,
         # not the off-centre fallen-object hold (a pour or an upright place needs it).
         args["reseat"] = True
-    return ActionCall(fn="grasp", args={**args, "skip_if_held": True})
+    return ActionCall(fn="grasp", args={**args, "skip_if_held": skip_if_held})
 
 
 def _sequence(per_arm: dict[str, list[ActionCall]]) -> list[Step]:
@@ -297,7 +295,9 @@ class Arranger:
         else:
             busy = {arm for step in edge.steps for arm, call in step.items() if call is not None}
             tall = obj in self.objects and kb.is_tall(self.objects[obj])
-            regrasp: Step = {a: _regrasp(before, a, obj, tall) for a in at_s}
+            # Carried by two arms and lost by one, it hangs from the other: both let go (a grasp opens
+            # first), so it lands flat, and both take it again.
+            regrasp: Step = {a: _regrasp(before, a, obj, tall, skip_if_held=len(at_s) < 2) for a in at_s}
             # An arm of this edge with empty hands gets out of the way while the object is taken again.
             regrasp.update({a: ActionCall(fn="back") for a in busy if a not in at_s and before[a].holding is None})
             steps = [regrasp, *_replay_then_edge(before, edge, at_s or busy)]
@@ -380,19 +380,22 @@ class Arranger:
             if edge.failures:
                 continue
             source = accounts.get(edge.source)
-            held: list[tuple[str, str]] = [(a, source[a].holding) for a in ARMS if source is not None and source[a].holding]
+            held: dict[str, list[str]] = {}  # object -> arms
+            for arm in ARMS:
+                if source is not None and source[arm].holding:
+                    held.setdefault(source[arm].holding, []).append(arm)
             for step in edge.steps:
                 for arm, call in step.items():
-                    if call is not None and call.fn == "grasp" and (arm, call.args["obj"]) not in held:
-                        held.append((arm, call.args["obj"]))
-            for arm, obj in held:
+                    if call is not None and call.fn == "grasp" and arm not in held.setdefault(call.args["obj"], []):
+                        held[call.args["obj"]].append(arm)
+            for obj, arms in held.items():
                 name = f"{obj}_dropped"
                 recovery = entries.get((edge.source, name))
-                if recovery is None or any(f.name == name for f in edge.failures):
+                if recovery is None or not arms:
                     continue
-                edge.failures.append(
-                    FailureMode(name=name, monitor=f"{arm}.closed * (0.5 - holding({arm}, {obj}))", window=kb.WINDOW, intent="regrasp", recovery=recovery)
-                )
+                terms = [f"{arm}.closed * (0.5 - holding({arm}, {obj}))" for arm in arms]
+                monitor = terms[0] if len(terms) == 1 else f"max({', '.join(terms)})"
+                edge.failures.append(FailureMode(name=name, monitor=monitor, window=kb.WINDOW, intent="regrasp", recovery=recovery))
 
     # --- online repair -----------------------------------------------------------------
 
