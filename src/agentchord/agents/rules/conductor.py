@@ -24,7 +24,8 @@ import numpy as np
 from agentchord.agents.reasoner import Scene, SceneObject
 from agentchord.agents.rules.arranger import ARMS, Account, ArmAccount, Arranger, _apply
 from agentchord.graph.models import ActionCall, Edge, TaskGraph
-from agentchord.solvers.obstacles import Spheres
+from agentchord.features.frame import FeatureFrame, make_static_frame
+from agentchord.solvers.obstacles import object_spheres, scene_spheres
 from agentchord.solvers.subgoal import SubgoalProblem, SubgoalSolution, SubgoalSolver
 
 #: Clearance (m) kept between a keyframe (tool, held or placed object) and other objects.
@@ -78,6 +79,7 @@ class Conductor:
         """The graph with its free keyframes solved; structure unchanged."""
         out = graph.model_copy(deep=True)
         objects = {o.name: o for o in scene.objects}
+        frame = make_static_frame({o.name: {"pos": o.pos, "quat": o.quat, "axis": o.axis, "extent": o.extent} for o in scene.objects})
         accounts = Arranger(scene).accounts(graph)
         by_source = {graph.edge(e).source: a for e, a in accounts.items()}
         self.report = []
@@ -88,30 +90,36 @@ class Conductor:
                     if call is None:
                         continue
                     if call.fn == "move_to_target":
-                        self._tool_target(edge, index, arm, call, account, objects)
+                        self._tool_target(edge, index, arm, call, account, objects, frame)
                     elif call.fn == "place" and call.args.get("target") is not None and call.args.get("relative_to") is None:
                         two_arm = sum(1 for c in step.values() if c is not None and c.fn == "place" and c.args.get("obj") == call.args["obj"]) > 1
                         if not two_arm:  # a two-arm carry keeps its one target for both grippers
-                            self._place_spot(edge, index, arm, call, objects, scene)
+                            self._place_spot(edge, index, arm, call, objects, scene, frame)
                     if edge.path_constraints and call.fn in ("move_to_obj", "move_to_target") and account[arm].holding:
                         # A carried object under a path constraint: the receding-horizon path solver keeps it clear.
                         call.args["path"] = "solved"
                 account = _apply(account, step)
         return out
 
-    def _tool_target(self, edge: Edge, index: int, arm: str, call: ActionCall, account: Account, objects: dict[str, SceneObject]) -> None:
+    def _tool_target(
+        self, edge: Edge, index: int, arm: str, call: ActionCall, account: Account, objects: dict[str, SceneObject], frame: FeatureFrame
+    ) -> None:
         held = account[arm].holding
-        others = [o for name, o in objects.items() if name != held and not any(account[a].holding == name for a in ARMS)]
+        in_hand = [account[a].holding for a in ARMS if account[a].holding]
+        # What the tool carries is centred on it (a side grasp at mid-height).
+        carried = {arm: object_spheres(held, frame.objects[held]).translated(-frame.objects[held].pos)} if held in objects else {}
         problem = SubgoalProblem(
             arms=(arm,),
-            obstacles=_spheres(others),
-            held={arm: _carried(objects[held])} if held in objects else {},
+            obstacles=scene_spheres(frame, exclude=in_hand, skip_held=False),
+            held=carried,
             preferred={arm: np.asarray(call.args["pos"], dtype=float)},
             margin=MARGIN,
         )
         self._solve(edge, index, arm, call, "pos", problem, lambda p: p)
 
-    def _place_spot(self, edge: Edge, index: int, arm: str, call: ActionCall, objects: dict[str, SceneObject], scene: Scene) -> None:
+    def _place_spot(
+        self, edge: Edge, index: int, arm: str, call: ActionCall, objects: dict[str, SceneObject], scene: Scene, frame: FeatureFrame
+    ) -> None:
         obj = objects.get(call.args["obj"])
         if obj is None:
             return
@@ -127,7 +135,7 @@ class Conductor:
             arms=(arm,),
             low=np.array([target[0] - slack, target[1] - slack, height - 1e-3]),
             high=np.array([target[0] + slack + 1e-6, target[1] + slack + 1e-6, height + 1e-3]),
-            obstacles=_spheres([o for name, o in objects.items() if name != obj.name]),
+            obstacles=scene_spheres(frame, exclude=[obj.name], skip_held=False),
             preferred={arm: target},
             tool_radius=0.5 * float(max(obj.extent[0], obj.extent[1])),
             margin=MARGIN,
@@ -152,23 +160,3 @@ class Conductor:
                 call.args[field_name] = after
         self.report.append(Keyframe(edge.id, arm, call.fn, before, after, solution.feasible, "warm" if warm else "cold", round(ms, 2)))
 
-
-def _spheres(objects: list[SceneObject]) -> Spheres:
-    """A sphere per object: its footprint radius, at its centre (a tall object: one per radius of height)."""
-    centres, radii, labels = [], [], []
-    for obj in objects:
-        radius = 0.5 * float(max(obj.extent[0], obj.extent[1]))
-        height = float(obj.extent[2])
-        count = max(1, int(np.ceil(height / max(2 * radius, 1e-3))))
-        for k in range(count):
-            z = float(obj.pos[2]) - 0.5 * height + (k + 0.5) * height / count
-            centres.append([obj.pos[0], obj.pos[1], z])
-            radii.append(max(radius, 0.5 * height / count))
-            labels.append(obj.name)
-    return Spheres(np.asarray(centres).reshape(-1, 3), np.asarray(radii), tuple(labels))
-
-
-def _carried(obj: SceneObject) -> Spheres:
-    """What a tool carries, as offsets from it: the object centred on the tool (a side grasp at mid-height)."""
-    moved = obj.model_copy(update={"pos": (0.0, 0.0, 0.0)})
-    return _spheres([moved])
