@@ -19,6 +19,7 @@ from agentchord.agents.observe import COLOURS
 from agentchord.agents.reasoner import Scene
 from agentchord.agents.rules.goals import Folded, Goal, GoalSpec, HandedOver, Inside, On, Placed, Poured
 from agentchord.agents.rules.knowledge import BESIDE_DISTANCE, cloth_names
+from agentchord.agents.rules.knowledge import words as kb_words
 
 _ARTICLES = re.compile(r"\b(the|a|an|its|it's|some|water|of)\b")
 _VERB = r"(?:pick|place|put|pour|hand|move|fold|stack|set|carry|bring|grasp|take|slide|insert|drop)\b"
@@ -48,12 +49,11 @@ class _Context:
             return self.mentioned[-1]
         candidates = []
         for obj in self.scene.objects:
-            vocabulary = set(obj.name.lower().replace("_", " ").split()) | set(obj.description.lower().replace(",", " ").split())
-            if obj.name.lower() == " ".join(words).replace(" ", "_") or all(w in vocabulary for w in words):
+            if obj.name.lower() == "_".join(words) or all(w in kb_words(obj) for w in words):
                 candidates.append(obj.name)
         if len(candidates) != 1:
             # The head noun alone (the last word) may still be unique: "coffee capsule" -> capsule.
-            head = [o.name for o in self.scene.objects if words[-1] in set(o.name.lower().split("_")) | set(o.description.lower().split())]
+            head = [o.name for o in self.scene.objects if words[-1] in kb_words(o)]
             # A colour that does not match is a contradiction, not a modifier to ignore.
             if len(candidates) == 0 and len(head) == 1 and not set(words[:-1]) & set(COLOURS):
                 candidates = head
