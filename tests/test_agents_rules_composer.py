@@ -28,10 +28,11 @@ def test_each_paper_instruction_plans_a_valid_nominal_graph(task):
     graph = RulesReasoner().compose(request)
     assert check_reply(request, graph) == []
     assert graph.goal == graph.nodes[-1].id and not graph.recovery_edges()
-    # Every episode ends with both arms home.
-    assert {arm for arm, call in graph.edges[-1].steps[-1].items() if call and call.fn == "back"} or any(
-        call.fn == "back" for edge in graph.edges[-2:] for step in edge.steps for call in step.values() if call
-    )
+    # Every arm that moved ends at home: its last call is ``back``.
+    last = {}
+    for arm, call in graph.edges[0].calls + [c for edge in graph.edges[1:] for c in edge.calls]:
+        last[arm] = call.fn
+    assert last and all(fn == "back" for fn in last.values()), last
 
 
 def test_single_arm_pour_is_grasp_approach_tilt_untilt_place_home():

@@ -166,7 +166,7 @@ def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, inst
 
     Exit status 0 when the task succeeded, 1 when it failed, 2 on bad input.
     """
-    from agentchord.execution.episode import EpisodeSpec, run_episode  # noqa: PLC0415
+    from agentchord.execution.episode import EpisodeSpec  # noqa: PLC0415
 
     _task_name(task, "TASK")
     graph = _load_graph_option(graph_path)

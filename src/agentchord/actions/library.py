@@ -26,6 +26,7 @@ from agentchord.actions.motion import (
     settle,
     wait_for_rest,
 )
+from agentchord.features.frame import tilt_deg
 from agentchord.solvers.obstacles import held_spheres, scene_spheres
 from agentchord.worlds.sim.scene import ARM_JOINTS, ARM_PREFIX, FINGER_GAP_OFFSET, FINGER_RANGE, HOME_Q
 
@@ -35,10 +36,6 @@ UPRIGHT_TOLERANCE_DEG = 25.0
 
 class GraspMissed(ActionFailed):
     """The fingers closed but the object is not between them."""
-
-
-def _tilt_deg(axis: np.ndarray) -> float:
-    return float(np.degrees(np.arccos(np.clip(axis[2], -1.0, 1.0))))
 
 
 def _level(rotation: np.ndarray) -> np.ndarray:
@@ -55,7 +52,7 @@ def _matrix(quat: np.ndarray) -> np.ndarray:
 
 def _long_axis(feats) -> np.ndarray:
     """An object's long horizontal direction: its axis if lying, else its longer horizontal side."""
-    if _tilt_deg(feats.axis) >= Grasp.FALLEN_DEG:
+    if tilt_deg(feats.axis) >= Grasp.FALLEN_DEG:
         return feats.axis
     rot = _matrix(feats.quat)
     return rot[:, 0] if feats.extent[0] >= feats.extent[1] else rot[:, 1]
@@ -134,7 +131,7 @@ class Grasp(ArmAction):
         feats = robot.frame.objects[self.args.obj]
         if feats.pos[2] < -0.02:
             raise ActionFailed(f"{self.args.obj} fell off the table")
-        tilt = _tilt_deg(feats.axis)
+        tilt = tilt_deg(feats.axis)
         height = float(np.linalg.norm(feats.top - feats.bottom))
         mode = self.args.mode
         if mode == "auto":
@@ -169,7 +166,7 @@ class Grasp(ArmAction):
         yield from move_joints(robot, arm, HOME_Q)
         robot.set_pose(arm, robot.ik.tcp_pose(arm))
         yield from wait_for_rest(robot, self.args.obj)
-        if _tilt_deg(robot.frame.objects[self.args.obj].axis) > UPRIGHT_TOLERANCE_DEG:
+        if tilt_deg(robot.frame.objects[self.args.obj].axis) > UPRIGHT_TOLERANCE_DEG:
             # It fell over when set down: the retry loop grasps it again from where it lies.
             raise GraspMissed(f"{self.args.obj} did not stay upright when set down")
         yield from self._side_grasp(robot)
@@ -230,7 +227,7 @@ class Grasp(ArmAction):
         feats = robot.frame.objects[self.args.obj]
         rot = _matrix(feats.quat)
         # The object's horizontal principal direction: its axis if lying, else its longer side.
-        if _tilt_deg(feats.axis) >= self.FALLEN_DEG:
+        if tilt_deg(feats.axis) >= self.FALLEN_DEG:
             long_dir = feats.axis
         else:
             long_dir = rot[:, 0] if feats.extent[0] >= feats.extent[1] else rot[:, 1]
@@ -255,7 +252,7 @@ class Grasp(ArmAction):
             long_dir = far if keep < 0.0 and _wrist_margin(robot, self.arm, turn(far), feats.pos) > keep else near
         down = np.array([0.0, 0.0, -1.0])
         rotation = np.column_stack([down, np.cross(long_dir, down), long_dir])
-        lying = _tilt_deg(feats.axis) >= self.FALLEN_DEG
+        lying = tilt_deg(feats.axis) >= self.FALLEN_DEG
         top_z = feats.pos[2] + 0.5 * feats.extent[0] if lying else max(feats.top[2], feats.bottom[2])
         height = top_z - min(feats.bottom[2], feats.top[2]) if not lying else float(feats.extent[0])
         # Finger tips go 70% down the object (at most 3 cm), never closer than 4 mm to the table.
@@ -451,7 +448,7 @@ class Place(ArmAction):
         obj = robot.frame.objects[self.args.obj]
         if obj.extent[2] <= 1.5 * max(obj.extent[0], obj.extent[1]):
             return rotation
-        angle = _tilt_deg(obj.axis)
+        angle = tilt_deg(obj.axis)
         if angle < LEVEL_IN_HAND_DEG or angle > UPRIGHT_TOLERANCE_DEG:
             return rotation
         tool = robot.commanded_pose(self.arm).pos
@@ -482,7 +479,7 @@ class Place(ArmAction):
         feats = robot.frame.objects[self.args.obj]
         if float(np.max(feats.extent)) < POINT_EXTENT:
             return True  # a point feature (a cloth's corner) released is placed wherever it lies
-        return _tilt_deg(feats.axis) <= UPRIGHT_TOLERANCE_DEG and min(feats.bottom[2], feats.top[2]) < 0.01
+        return tilt_deg(feats.axis) <= UPRIGHT_TOLERANCE_DEG and min(feats.bottom[2], feats.top[2]) < 0.01
 
     def _release_and_retreat(self, robot: RobotController) -> Iterator[None]:
         """Open (if still closed) and back off from where the tool is: the rest of an interrupted place."""

@@ -7,7 +7,6 @@ step ends when every arm's action has ended, then the next step starts.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
 

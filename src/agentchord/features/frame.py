@@ -24,6 +24,11 @@ ARM_ATTRIBUTES = ("ee", "ee_quat", "q", "width", "closed")
 ARMS = ("left", "right")
 
 
+def tilt_deg(axis) -> float:
+    """Angle (deg) between a principal axis (bottom to top) and world up."""
+    return float(np.degrees(np.arccos(np.clip(axis[2], -1.0, 1.0))))
+
+
 @dataclass
 class ObjectFeatures:
     """Geometric features of one object.

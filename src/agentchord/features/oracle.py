@@ -6,10 +6,10 @@ Sec. IV-B): object poses from the physics, the grasp from finger contacts.
 
 from __future__ import annotations
 
-import mujoco
 import numpy as np
 
 from agentchord.features.frame import ARMS, ArmFeatures, FeatureFrame, ObjectFeatures
+from agentchord.features.pointcloud import quat_from_matrix
 from agentchord.worlds.sim.world import SimWorld
 
 
@@ -65,7 +65,7 @@ class OracleExtractor:
                 out = np.array([1.0, 0.0, 0.0])
             up = np.array([0.0, 0.0, 1.0])
             feats.pos = pos
-            feats.quat = _quat_from_matrix(np.column_stack([out, np.cross(up, out), up]))
+            feats.quat = quat_from_matrix(np.column_stack([out, np.cross(up, out), up]))
             feats.axis = up
             feats.top = pos + self._cloth_radius * up
             feats.bottom = pos - self._cloth_radius * up
@@ -80,23 +80,23 @@ class OracleExtractor:
             feats.axis = axis
             feats.top = pos + half
             feats.bottom = pos - half
-        holding = set()
-        for arm, feats in frame.arms.items():
-            ee, rot = world.tcp_pose(arm)
-            feats.ee = ee
-            feats.ee_quat = _quat_from_matrix(rot)
-            feats.q = world.arm_q(arm)
-            feats.width = world.gripper_width(arm)
-            feats.closed = 1.0 if self.grasp_signal(arm) else 0.0
-            for name in frame.objects:
-                if world.holding(arm, name):
-                    holding.add((arm, name))
-        frame.holding = holding
-        frame.tick = world.tick
+        update_robot_signals(frame, world, self.grasp_signal)
         return frame
 
 
-def _quat_from_matrix(rot: np.ndarray) -> np.ndarray:
-    quat = np.empty(4)
-    mujoco.mju_mat2Quat(quat, rot.reshape(-1))
-    return quat
+def update_robot_signals(frame: FeatureFrame, world: SimWorld, grasp_signal) -> None:
+    """The robot's own signals, read every tick in every perception mode: tool poses, joints,
+    gripper widths, the grasp-done signal, contact-based holding, the tick."""
+    holding = set()
+    for arm, feats in frame.arms.items():
+        ee, rot = world.tcp_pose(arm)
+        feats.ee = ee
+        feats.ee_quat = quat_from_matrix(rot)
+        feats.q = world.arm_q(arm)
+        feats.width = world.gripper_width(arm)
+        feats.closed = 1.0 if grasp_signal(arm) else 0.0
+        for name in frame.objects:
+            if world.holding(arm, name):
+                holding.add((arm, name))
+    frame.holding = holding
+    frame.tick = world.tick

@@ -27,6 +27,7 @@ import mujoco
 import numpy as np
 
 from agentchord.features.frame import ARMS, ArmFeatures, FeatureFrame, ObjectFeatures
+from agentchord.features.oracle import update_robot_signals
 from agentchord.features.pointcloud import ShapeFit, backproject, fit_box, fit_cylinder, quat_from_axis, quat_from_matrix, voxel_downsample
 from agentchord.features.segmentation import Segmenter, SimSegmenter
 from agentchord.worlds.sim.world import CONTROL_HZ, SimWorld
@@ -287,19 +288,7 @@ class RgbdExtractor:
         world, frame = self.world, self.frame
         if self.due():
             self.perceive()
-        holding = set()
-        for arm, feats in frame.arms.items():
-            ee, rot = world.tcp_pose(arm)
-            feats.ee = ee
-            feats.ee_quat = quat_from_matrix(rot)
-            feats.q = world.arm_q(arm)
-            feats.width = world.gripper_width(arm)
-            feats.closed = 1.0 if self.grasp_signal(arm) else 0.0
-            for name in frame.objects:
-                if world.holding(arm, name):
-                    holding.add((arm, name))
-        frame.holding = holding
-        frame.tick = world.tick
+        update_robot_signals(frame, world, self.grasp_signal)
         return frame
 
     # ------------------------------------------------------------------ perception

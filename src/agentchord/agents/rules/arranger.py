@@ -23,12 +23,12 @@ and recovery places skip an object already placed (an interrupted two-arm step).
 from __future__ import annotations
 
 import copy
-import math
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
 from agentchord.agents.reasoner import Scene, SceneObject, UnanticipatedFailure
 from agentchord.agents.rules import knowledge as kb
+from agentchord.features.frame import tilt_deg
 from agentchord.graph.models import ActionCall, Edge, FailureMode, Step, TaskGraph
 from agentchord.graph.progress import forward_filter, nominal_path
 
@@ -407,7 +407,7 @@ class Arranger:
                 info = self.objects.get(obj or "")
                 if call.fn != "place" or info is None or obj not in current or (arm, obj) in holding:
                     continue
-                if not kb.keeps_upright(info) or _tilt(current[obj]) <= PLACED_TILT_DEG:
+                if not kb.keeps_upright(info) or tilt_deg(current[obj].axis) <= PLACED_TILT_DEG:
                     continue
                 steps: list[Step] = [{arm: _regrasp(before, arm, obj, kb.is_tall(info))}, {arm: call}]
                 recovery = Edge(id=f"{edge.id}_r_{obj}_leaning", source=edge.source, target=edge.target, kind="recovery", actions=steps)
@@ -447,7 +447,7 @@ class Arranger:
                 mode, recovery = self._drop(edge, before, after, obj)
                 entry = f"{edge.id}_r_{obj}_lost_unforeseen"
                 branch = (mode.model_copy(update={"name": f"{obj}_lost_unforeseen", "recovery": entry}), recovery.model_copy(update={"id": entry}))
-            elif info is not None and kb.is_tall(info) and _tilt(current[obj]) > 15.0 and before[arm].holding == obj:
+            elif info is not None and kb.is_tall(info) and tilt_deg(current[obj].axis) > 15.0 and before[arm].holding == obj:
                 steps: list[Step] = [{arm: ActionCall(fn="place", args={"obj": obj})}, {arm: _regrasp(before, arm, obj)}]
                 steps += _replay_then_edge(before, edge, {arm})
                 recovery = Edge(id=f"{edge.id}_r_{obj}_slipped", source=edge.source, target=edge.target, kind="recovery", actions=steps)
@@ -459,7 +459,7 @@ class Arranger:
             branch = self._replace_tilted(edge, before, current, holding)
         if branch is None:
             for name, info in self.objects.items():
-                if name in current and kb.keeps_upright(info) and not any((a, name) in holding for a in ARMS) and _tilt(current[name]) > kb.TIP_DEG:
+                if name in current and kb.keeps_upright(info) and not any((a, name) in holding for a in ARMS) and tilt_deg(current[name].axis) > kb.TIP_DEG:
                     busy = {a for step in edge.steps for a, c in step.items() if c is not None}
                     branch = self._set_upright(edge, before, name, busy)
                     if branch:
@@ -474,6 +474,3 @@ class Arranger:
         out.edges.append(recovery)
         return out
 
-
-def _tilt(obj: SceneObject) -> float:
-    return math.degrees(math.acos(max(-1.0, min(1.0, float(obj.axis[2])))))

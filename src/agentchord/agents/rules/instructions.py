@@ -42,10 +42,10 @@ class _Context:
         """The scene object a noun phrase names (pronouns name the last object mentioned)."""
         words = _ARTICLES.sub(" ", phrase.lower()).split()
         if not words:
-            raise self._error(phrase, "names no object")
+            raise self.error(phrase, "names no object")
         if words in (["it"], ["one"]):
             if not self.mentioned:
-                raise self._error(phrase, "'it' has nothing to refer to")
+                raise self.error(phrase, "'it' has nothing to refer to")
             return self.mentioned[-1]
         candidates = []
         for obj in self.scene.objects:
@@ -58,13 +58,13 @@ class _Context:
             if len(candidates) == 0 and len(head) == 1 and not set(words[:-1]) & set(COLOURS):
                 candidates = head
         if not candidates:
-            raise self._error(phrase, f"names no scene object (the scene has {', '.join(self.scene.object_names)})")
+            raise self.error(phrase, f"names no scene object (the scene has {', '.join(self.scene.object_names)})")
         if len(candidates) > 1:
-            raise self._error(phrase, f"is ambiguous: it could be {', '.join(candidates)}; name one by colour or name")
+            raise self.error(phrase, f"is ambiguous: it could be {', '.join(candidates)}; name one by colour or name")
         self.mentioned.append(candidates[0])
         return candidates[0]
 
-    def _error(self, phrase: str, problem: str) -> InstructionNotGroundedError:
+    def error(self, phrase: str, problem: str) -> InstructionNotGroundedError:
         return InstructionNotGroundedError(self.instruction, f"{phrase.strip()!r} {problem}")
 
 
@@ -135,7 +135,7 @@ def _fold(m: re.Match[str], ctx: _Context) -> list[Goal]:
     word = m["cloth"].strip().lower().split()[-1]
     cloths = cloth_names(ctx.scene.object_names)
     if word not in cloths:
-        raise ctx._error(m["cloth"], f"is not a cloth of the scene (cloths: {', '.join(cloths) or 'none'})")
+        raise ctx.error(m["cloth"], f"is not a cloth of the scene (cloths: {', '.join(cloths) or 'none'})")
     ctx.mentioned += [f"{word}_{c}" for c in ("bl", "br", "tl", "tr")]
     return [Folded(cloth=word)]
 
@@ -147,7 +147,7 @@ def _region(phrase: str, ctx: _Context) -> str:
         if all(w in vocabulary for w in words):
             return region.name
     names = ", ".join(r.name for r in ctx.scene.regions) or "none"
-    raise ctx._error(phrase, f"names no region of the scene (regions: {names})")
+    raise ctx.error(phrase, f"names no region of the scene (regions: {names})")
 
 
 _NP = r"(?P<{}>[\w\s-]+?)"

@@ -131,9 +131,9 @@ def ground(scene: Scene, goal: GoalSpec) -> list[Operator]:
         ops += _fold_ops(cloth, objects)
     for g in goal.goals:
         if isinstance(g, Poured):
-            ops += _pour_ops(g, objects)
+            ops += _pour_ops(g)
         if isinstance(g, HandedOver):
-            ops += _handover_ops(g, objects[g.obj])
+            ops += _handover_ops(g)
     for arm in ARMS:
         ops.append(
             Operator(
@@ -144,7 +144,7 @@ def ground(scene: Scene, goal: GoalSpec) -> list[Operator]:
         )
     for obj in objects.values():
         if kb.keeps_upright(obj):
-            ops += _set_upright_ops(obj, objects)
+            ops += _set_upright_ops(obj)
     return ops
 
 
@@ -271,7 +271,7 @@ def _two_arm_ops(obj: SceneObject, scene: Scene, dests: list[tuple[str, str | No
     return ops
 
 
-def _pour_ops(goal: Poured, objects: dict[str, SceneObject]) -> list[Operator]:
+def _pour_ops(goal: Poured) -> list[Operator]:
     s, c = goal.source, goal.target
     ops = []
     for arm in ARMS:
@@ -320,7 +320,7 @@ def _pour_ops(goal: Poured, objects: dict[str, SceneObject]) -> list[Operator]:
     return ops
 
 
-def _handover_ops(goal: HandedOver, obj: SceneObject) -> list[Operator]:
+def _handover_ops(goal: HandedOver) -> list[Operator]:
     g, r, o = goal.giver, goal.receiver, goal.obj
     yaw_g, yaw_r = (0.0, 180.0) if g == "left" else (180.0, 0.0)
     retreat = [-kb.HANDOVER_RETREAT if g == "left" else kb.HANDOVER_RETREAT, 0.0, 0.03]
@@ -379,7 +379,7 @@ def _fold_ops(cloth: str, objects: dict[str, SceneObject]) -> list[Operator]:
     return ops
 
 
-def _set_upright_ops(obj: SceneObject, objects: dict[str, SceneObject]) -> list[Operator]:
+def _set_upright_ops(obj: SceneObject) -> list[Operator]:
     """Recovery skill: a free arm sets a fallen object upright (the busy arm parks out of its way)."""
     name = obj.name
     ops = []
@@ -389,7 +389,6 @@ def _set_upright_ops(obj: SceneObject, objects: dict[str, SceneObject]) -> list[
         ops.append(
             Operator(
                 name=f"set_upright({arm}, {name})", arms=(arm,), objects=(name,), pre=frozenset({("free", arm), ("fallen", name)}),
-                pre_not=frozenset({("free", busy)}) if False else frozenset(),
                 add=frozenset({("upright", name), ("on_table", name), ("home", arm)}), delete=frozenset({("fallen", name)}),
                 cost=560 + (0 if kb.near_arm(obj) == arm else 200),
                 steps=({busy: _call("move_to_target", pos=list(kb.PARK_POSE[busy][0]), yaw=kb.PARK_POSE[busy][1])}, *steps),

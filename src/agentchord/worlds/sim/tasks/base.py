@@ -13,7 +13,7 @@ from typing import Protocol
 
 import numpy as np
 
-from agentchord.features.frame import FeatureFrame
+from agentchord.features.frame import FeatureFrame, ObjectFeatures, tilt_deg  # noqa: F401  (re-exported for the task modules)
 from agentchord.worlds.sim.scene import SceneSpec
 from agentchord.worlds.sim.world import SimWorld
 
@@ -56,9 +56,13 @@ def uniform(rng: np.random.Generator, bounds: tuple[float, float]) -> float:
     return float(rng.uniform(*bounds))
 
 
-def tilt_deg(axis: np.ndarray) -> float:
-    """Angle (deg) between an object's axis and world up."""
-    return float(np.degrees(np.arccos(np.clip(axis[2], -1.0, 1.0))))
+def pouring(bottle: ObjectFeatures, cup: ObjectFeatures, min_tilt_deg: float = 70.0, lateral_margin: float = 0.01) -> bool:
+    """Whether a vessel pours into a cup now: tilted at least ``min_tilt_deg``, its mouth (top
+    point) above the cup's rim and within the cup's radius + ``lateral_margin`` of its axis in xy."""
+    if tilt_deg(bottle.axis) < min_tilt_deg:
+        return False
+    lateral = float(np.linalg.norm((bottle.top - cup.top)[:2]))
+    return lateral <= 0.5 * float(cup.extent[0]) + lateral_margin and bottle.top[2] > cup.top[2]
 
 
 def resting_on_table(world: SimWorld, name: str, frame: FeatureFrame, max_speed: float = 0.02) -> bool:

@@ -19,7 +19,7 @@ import numpy as np
 
 from agentchord.features.frame import FeatureFrame
 from agentchord.worlds.sim.scene import ObjectSpec, SceneSpec
-from agentchord.worlds.sim.tasks.base import Verdict, resting_on_table, tilt_deg, uniform
+from agentchord.worlds.sim.tasks.base import Verdict, pouring, resting_on_table, tilt_deg, uniform
 from agentchord.worlds.sim.world import SimWorld
 
 
@@ -52,12 +52,7 @@ class DualPourTracker:
             return
         if not (frame.is_holding("right", "bottle") and frame.is_holding("left", "cup")):
             return
-        bottle, cup = frame.objects["bottle"], frame.objects["cup"]
-        if tilt_deg(bottle.axis) < self.pour_tilt_deg:
-            return
-        # Lateral distance of the bottle's top from the cup's axis (the cup is held upright).
-        lateral = np.linalg.norm((bottle.top - cup.top)[:2])
-        if lateral <= 0.5 * cup.extent[0] + self.lateral_margin and bottle.top[2] > cup.top[2]:
+        if pouring(frame.objects["bottle"], frame.objects["cup"], self.pour_tilt_deg, self.lateral_margin):
             self.poured = True
             self.poured_tick = frame.tick
 

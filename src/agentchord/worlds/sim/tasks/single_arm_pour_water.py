@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from agentchord.features.frame import FeatureFrame
 from agentchord.worlds.sim.scene import ObjectSpec, SceneSpec
-from agentchord.worlds.sim.tasks.base import Verdict, resting_on_table, tilt_deg, uniform
+from agentchord.worlds.sim.tasks.base import Verdict, pouring, resting_on_table, tilt_deg, uniform
 from agentchord.worlds.sim.world import SimWorld
 
 
@@ -29,18 +29,12 @@ class PourTracker:
     pour_tilt_deg: float = 70.0
     poured: bool = False
     poured_tick: int | None = None
-    events: list[str] = field(default_factory=list)
 
     def observe(self, frame: FeatureFrame) -> None:
         """Watch one tick for the pouring event."""
         if self.poured:
             return
-        bottle, cup = frame.objects["bottle"], frame.objects["cup"]
-        if not frame.is_holding("right", "bottle"):
-            return
-        tilt = tilt_deg(bottle.axis)
-        lateral = np.linalg.norm((bottle.top - cup.top)[:2])
-        if tilt >= self.pour_tilt_deg and lateral <= 0.5 * cup.extent[0] + 0.01 and bottle.top[2] > cup.top[2]:
+        if frame.is_holding("right", "bottle") and pouring(frame.objects["bottle"], frame.objects["cup"], self.pour_tilt_deg):
             self.poured = True
             self.poured_tick = frame.tick
 
