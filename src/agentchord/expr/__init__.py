@@ -32,6 +32,7 @@ from agentchord.expr.exceptions import (
     ExprNameError,
     ExprSyntaxError,
     ExprTypeError,
+    ExprValueError,
 )
 from agentchord.expr.library import ArgKind, Function, Param
 from agentchord.expr.templates import TEMPLATES, TemplateInfo
@@ -51,6 +52,7 @@ __all__ = [
     "ExprNameError",
     "ExprSyntaxError",
     "ExprTypeError",
+    "ExprValueError",
     "Function",
     "Param",
     "TemplateInfo",

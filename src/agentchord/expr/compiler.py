@@ -33,6 +33,7 @@ from agentchord.expr.exceptions import (
     ExprNameError,
     ExprSyntaxError,
     ExprTypeError,
+    ExprValueError,
 )
 from agentchord.expr.library import LIBRARY, ArgKind, Function, Value
 from agentchord.expr.templates import TEMPLATE_FUNCTIONS
@@ -281,7 +282,9 @@ def _recompile(source: str, vocabulary: Vocabulary, allow_vector: bool) -> Compi
     return compile_expr(source, vocabulary, allow_vector=allow_vector)
 
 
-def compile_expr(source: str, vocabulary: Vocabulary, *, allow_vector: bool = False) -> CompiledExpr:
+def compile_expr(
+    source: str, vocabulary: Vocabulary, *, allow_vector: bool = False, finite_constants: bool = False
+) -> CompiledExpr:
     """Compile a constraint/monitor expression.
 
     Args:
@@ -289,6 +292,9 @@ def compile_expr(source: str, vocabulary: Vocabulary, *, allow_vector: bool = Fa
         vocabulary: The object and arm names it may use.
         allow_vector: Accept a vector result (e.g. a target point for a
             solver); constraints and monitors must be scalars.
+        finite_constants: Refuse a constant part that is NaN or infinite
+            (``0/0``, ``1e400``): a monitor holding one is NaN or infinite on
+            every frame, so it never fires or always does. ``graph check`` sets it.
 
     Returns:
         The compiled expression.
@@ -300,13 +306,14 @@ def compile_expr(source: str, vocabulary: Vocabulary, *, allow_vector: bool = Fa
         ExprNameError: ``source`` names an unknown object, arm, feature or function.
         ExprTypeError: wrong argument count or kind, or a vector result when
             ``allow_vector`` is false.
+        ExprValueError: a constant part is not finite and ``finite_constants`` is set.
     """
     if not isinstance(source, str):
         raise ExprTypeError(f"an expression must be a string, got {type(source).__name__}", part=repr(source))
     if not isinstance(vocabulary, Vocabulary):
         raise TypeError(f"vocabulary must be a Vocabulary, got {type(vocabulary).__name__}")
     tree, text, shift = _parse(source)
-    compiler = _Compiler(source, text, shift, vocabulary)
+    compiler = _Compiler(source, text, shift, vocabulary, finite_constants)
     compiler.check_tree(tree)
     node = compiler.compile(tree.body)
     is_scalar = node.kind is _Kind.SCALAR
@@ -405,8 +412,11 @@ def _is_dunder(name: str | None) -> bool:
 class _Compiler:
     """Checks and compiles one parsed expression."""
 
-    def __init__(self, source: str, text: str, shift: int, vocabulary: Vocabulary) -> None:
+    def __init__(
+        self, source: str, text: str, shift: int, vocabulary: Vocabulary, finite_constants: bool = False
+    ) -> None:
         self.source = source
+        self.finite_constants = finite_constants
         self.text = text  # what was parsed: ast positions refer to it
         self.shift = shift  # column of text's first character in source
         self.vocabulary = vocabulary
@@ -487,7 +497,10 @@ class _Compiler:
         """Compile one node (recursion depth is bounded by :meth:`check_tree`)."""
         handler = _HANDLERS.get(type(node))
         if handler is not None:
-            return handler(self, node)
+            out = handler(self, node)
+            if self.finite_constants and out.is_const and out.kind in (_Kind.SCALAR, _Kind.VECTOR, _Kind.ANY):
+                self.check_finite(out)
+            return out
         template = _FORBIDDEN.get(type(node))
         if template is not None:
             part = self.segment(node)
@@ -496,6 +509,21 @@ class _Compiler:
                 self.fail(ExprForbiddenError, template.format(part=self.segment(node)), node, part)
             self.fail(ExprForbiddenError, template.format(part=part), node)
         self.fail(ExprForbiddenError, f"{type(node).__name__} {self.segment(node)!r} is not allowed", node)
+
+    def check_finite(self, out: _Node) -> None:
+        """Refuse a folded constant that is NaN or infinite."""
+        try:
+            values = np.asarray(out.const, dtype=float)
+        except (TypeError, ValueError):
+            return
+        if not np.all(np.isfinite(values)):
+            shown = np.array2string(values, precision=3) if values.ndim else f"{float(values):g}"
+            self.fail(
+                ExprValueError,
+                f"{_shorten(self.segment(out.ast_node))!r} is {shown}, not a finite number: the expression "
+                "would be NaN or infinite on every frame (a monitor that never or always fires)",
+                out.ast_node,
+            )
 
     def value(self, node: ast.AST, what: str) -> _Node:
         """Compile ``node`` and require a number (not an object or arm name)."""

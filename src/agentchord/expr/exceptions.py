@@ -69,5 +69,9 @@ class ExprTypeError(ExprError):
     """Wrong argument count or kind, or a non-scalar result, detected at compile time."""
 
 
+class ExprValueError(ExprError):
+    """A constant part of the source is NaN or infinite where finite numbers are required."""
+
+
 class ExprEvalError(ExprError):
     """A compiled expression could not be evaluated on a frame (missing object, ...)."""
