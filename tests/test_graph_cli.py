@@ -49,13 +49,13 @@ def test_check_valid_graph(runner: CliRunner) -> None:
     assert result.output == f"{POUR}: ok (7 nodes, 9 edges, 3 failure modes)\n"
 
 
-def test_check_reports_every_problem_and_exits_1(runner: CliRunner, tmp_path: Path) -> None:
+def test_check_reports_every_problem_and_exits_2(runner: CliRunner, tmp_path: Path) -> None:
     data = yaml.safe_load(POUR.read_text())
     data["edges"][0]["actions"]["right"]["fn"] = "grab"
     data["edges"][4]["actions"]["right"]["args"]["obj"] = "mug"
     bad = _write(tmp_path, data)
     result = runner.invoke(main, ["graph", "check", str(POUR), str(bad)])
-    assert result.exit_code == 1
+    assert result.exit_code == 2
     assert result.output.splitlines() == [
         f"{POUR}: ok (7 nodes, 9 edges, 3 failure modes)",
         f"{bad}: edges[0].actions.right.fn: unknown action 'grab' (did you mean 'grasp'?); actions are "
@@ -69,14 +69,14 @@ def test_check_reports_load_errors(runner: CliRunner, tmp_path: Path) -> None:
     data["edges"][1]["failures"][0]["window"] = 0
     bad = _write(tmp_path, data)
     result = runner.invoke(main, ["graph", "check", str(bad)])
-    assert result.exit_code == 1
+    assert result.exit_code == 2
     assert result.output == f"{bad}: edges[1].failures[0].window: Input should be greater than or equal to 1\n"
 
 
 def test_check_regressive_branch(runner: CliRunner, tmp_path: Path) -> None:
     path = _regressive(tmp_path)
     result = runner.invoke(main, ["graph", "check", str(path)])
-    assert result.exit_code == 1
+    assert result.exit_code == 2
     assert result.output == (
         f"{path}: edges[1].failures[0].recovery: regressive recovery branch (forward-moving principle): "
         "D(r_bottle_regrasped, goal)=730  >  D(v1, goal)=440\n"
@@ -93,16 +93,16 @@ def test_render(runner: CliRunner, tmp_path: Path, suffix: str) -> None:
 
 
 def test_render_unknown_format_fails_cleanly(runner: CliRunner, tmp_path: Path) -> None:
-    result = runner.invoke(main, ["graph", "render", str(POUR), "-o", str(tmp_path / "g.pdf")])
-    assert result.exit_code == 1
-    assert "unknown format '.pdf'" in result.output
+    result = runner.invoke(main, ["graph", "render", str(POUR), "-o", str(tmp_path / "g.xyz")])
+    assert result.exit_code == 2
+    assert "unsupported file type '.xyz'" in result.output
 
 
 def test_render_of_unloadable_file(runner: CliRunner, tmp_path: Path) -> None:
     bad = tmp_path / "g.yaml"
     bad.write_text("task: [\n")
     result = runner.invoke(main, ["graph", "render", str(bad), "-o", str(tmp_path / "g.dot")])
-    assert result.exit_code == 1
+    assert result.exit_code == 2
     assert result.output.startswith(f"{bad}: line 2, column 1: invalid YAML:")
 
 
@@ -134,5 +134,5 @@ def test_filter_of_graph_with_dangling_reference(runner: CliRunner, tmp_path: Pa
     data["edges"][1]["failures"][0]["recovery"] = "missing"
     path = _write(tmp_path, data)
     result = runner.invoke(main, ["graph", "filter", str(path)])
-    assert result.exit_code == 1
+    assert result.exit_code == 2
     assert "unknown edge 'missing'" in result.output and f"agentchord graph check {path}" in result.output

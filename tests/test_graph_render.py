@@ -103,5 +103,15 @@ def test_render_without_dot_says_how_to_install(
 
 
 def test_render_unknown_suffix(pour: TaskGraph, tmp_path: Path) -> None:
-    with pytest.raises(RenderError, match=r"unknown format '.pdf'; use .dot, .gv, .mmd, .svg, .png"):
-        render(pour, tmp_path / "g.pdf")
+    with pytest.raises(RenderError, match=r"unknown format '.jpg'; use .dot, .gv, .mmd, .svg, .png, .pdf"):
+        render(pour, tmp_path / "g.jpg")
+
+
+def test_render_refuses_a_graph_too_large_to_lay_out(pour: TaskGraph, tmp_path: Path, monkeypatch) -> None:
+    import sys
+
+    monkeypatch.setattr(sys.modules["agentchord.graph.render"], "MAX_LAYOUT_SIZE", 5)
+    with pytest.raises(RenderError, match="render to .dot or .mmd instead"):
+        render(pour, tmp_path / "g.svg")
+    assert not (tmp_path / "g.svg").exists()
+    render(pour, tmp_path / "g.dot")  # text formats have no limit

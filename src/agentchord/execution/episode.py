@@ -13,6 +13,7 @@ from agentchord.agents.rules.goals import GoalSpec
 from agentchord.execution.executor import EpisodeResult, Executor, ExecutorConfig
 from agentchord.execution.repair import Repairer
 from agentchord.execution.strategies import make_strategy
+from agentchord.graph.grounding import require_runnable
 from agentchord.graph.models import TaskGraph
 from agentchord.tasks import load_task_graph
 from agentchord.worlds.sim.disturbances import Disturbance, ProtocolDisturbances, RandomDisturbances
@@ -80,6 +81,7 @@ def run_episode(spec: EpisodeSpec, on_tick: Callable[[Executor], None] | None = 
     Raises:
         KeyError: Unknown task.
         ValueError: Unknown strategy or a probability outside [0, 1].
+        GraphNotRunnableError: The graph fails ``graph check`` or names objects the scene lacks.
     """
     if spec.task not in SIM_TASKS:
         raise KeyError(f"unknown task {spec.task!r} (tasks: {', '.join(SIM_TASKS)})")
@@ -104,6 +106,9 @@ def run_episode(spec: EpisodeSpec, on_tick: Callable[[Executor], None] | None = 
         tracker = task.success_tracker()
         if repairer is None and spec.repair:
             repairer = ReasonerRepairer(make_reasoner("rules"), task_regions(task))
+    # A graph that fails `graph check` or names objects this scene lacks is refused before the first tick.
+    source = "planned graph" if spec.planned else "graph" if spec.graph is not None else f"{spec.task} library graph"
+    require_runnable(graph, [*world.object_names, *world.cloth_point_names], spec.task, source)
     executor = Executor(
         graph=graph,
         world=world,

@@ -14,6 +14,8 @@ from typing import Any
 
 import numpy as np
 
+from agentchord.guard.outputs import atomic_write_text, finite_json
+
 
 def _plain(value: Any) -> Any:
     if isinstance(value, np.ndarray):
@@ -46,13 +48,13 @@ class Trace:
         return [e for e in self.events if e["event"] == event]
 
     def write(self, path: str | Path) -> Path:
-        """Write as JSON lines."""
-        path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with path.open("w") as stream:
-            for record in self.events:
-                stream.write(json.dumps(record, sort_keys=True) + "\n")
-        return path
+        """Write as JSON lines, atomically (a failed write leaves no half trace).
+
+        Raises:
+            OutputPathError: The file cannot be written.
+        """
+        text = "".join(finite_json(record, sort_keys=True) + "\n" for record in self.events)
+        return atomic_write_text(path, text)
 
     @staticmethod
     def read(path: str | Path) -> Trace:

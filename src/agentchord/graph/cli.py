@@ -1,4 +1,8 @@
-"""Command-line interface of the graph package: ``agentchord schema`` and ``agentchord graph ...``."""
+"""Command-line interface of the graph package: ``agentchord schema`` and ``agentchord graph ...``.
+
+Exit statuses as everywhere (:mod:`agentchord.cli_support`): 0 valid / written, 2 an
+unreadable or invalid file or an output that cannot be written.
+"""
 
 from __future__ import annotations
 
@@ -8,12 +12,16 @@ from pathlib import Path
 
 import click
 
+from agentchord.cli_support import EXIT_BAD_INPUT, BadInput, check_outputs
 from agentchord.graph.exceptions import GraphError, GraphFileError
-from agentchord.graph.loader import dump_graph, load_graph
+from agentchord.graph.loader import JSON_SUFFIXES, YAML_SUFFIXES, dump_graph, load_graph
 from agentchord.graph.models import TaskGraph
 from agentchord.graph.progress import forward_filter
 from agentchord.graph.render import FORMATS, render
-from agentchord.graph.validation import check_file
+from agentchord.graph.validation import check_graph
+from agentchord.guard.outputs import atomic_write_text
+
+GRAPH_SUFFIXES = YAML_SUFFIXES + JSON_SUFFIXES
 
 
 @click.command("schema")
@@ -37,30 +45,33 @@ def _load_or_exit(path: Path) -> TaskGraph:
     try:
         return load_graph(path)
     except GraphFileError as error:
-        click.echo(str(error))
-        sys.exit(1)
+        raise BadInput(str(error)) from None
 
 
 @graph_group.command("check")
 @click.argument("files", nargs=-1, required=True, type=click.Path(dir_okay=False, path_type=Path))
 def check_command(files: tuple[Path, ...]) -> None:
-    """Validate graph FILES: print one line per problem, exit 1 if any.
+    """Validate graph FILES: print one line per problem, exit 2 if any.
 
     A valid file prints ``FILE: ok (N nodes, M edges, K failure modes)``.
     """
     failed = False
     for path in files:
-        problems = check_file(path)
+        try:
+            graph = load_graph(path)  # read once: a large file costs seconds to parse
+        except GraphFileError as error:
+            problems = error.problems
+        else:
+            problems = [f"{path}: {problem}" for problem in check_graph(graph)]
         if problems:
             failed = True
             for line in problems:
                 click.echo(line)
             continue
-        graph = load_graph(path)
         click.echo(
             f"{path}: ok ({len(graph.nodes)} nodes, {len(graph.edges)} edges, {len(graph.failures())} failure modes)"
         )
-    sys.exit(1 if failed else 0)
+    sys.exit(EXIT_BAD_INPUT if failed else 0)
 
 
 @graph_group.command("render")
@@ -75,11 +86,12 @@ def check_command(files: tuple[Path, ...]) -> None:
 )
 def render_command(file: Path, output: Path) -> None:
     """Draw graph FILE: nominal edges blue, recovery edges pink."""
+    check_outputs(("-o", output, FORMATS))
     graph = _load_or_exit(file)
     try:
         render(graph, output)
     except GraphError as error:
-        raise click.ClickException(str(error)) from None
+        raise BadInput(str(error)) from None
     click.echo(f"wrote {output}")
 
 
@@ -94,11 +106,12 @@ def render_command(file: Path, output: Path) -> None:
 )
 def filter_command(file: Path, output: Path | None) -> None:
     """Apply the forward-moving filter (Eq. 8) to FILE: say which recovery branches it removes and why."""
+    check_outputs(("-o", output, GRAPH_SUFFIXES))
     graph = _load_or_exit(file)
     try:
         result = forward_filter(graph)
     except GraphError as error:
-        raise click.ClickException(f"{file}: {error} (run `agentchord graph check {file}`)") from None
+        raise BadInput(f"{file}: {error} (run `agentchord graph check {file}`)") from None
     for branch in result.removed:
         click.echo(
             f"{file}: remove {branch.failure} on {branch.edge} -> {branch.recovery_edge} "
@@ -112,10 +125,7 @@ def filter_command(file: Path, output: Path | None) -> None:
     if not result.removed:
         click.echo(f"{file}: nothing to remove ({len(result.kept)} recovery branches, all forward-moving)")
     if output is not None:
-        try:
-            dump_graph(result.graph, output)
-        except GraphFileError as error:
-            raise click.ClickException(str(error)) from None
+        dump_graph(result.graph, output)
         click.echo(f"wrote {output}")
 
 
@@ -154,6 +164,7 @@ def import_release_command(
     """
     from agentchord.graph.interop import FrameMap, ReleaseImportError, import_release  # noqa: PLC0415
 
+    check_outputs(("-o", output, GRAPH_SUFFIXES))
     try:
         frame_map = FrameMap.parse(frame)
     except ValueError as error:
@@ -164,21 +175,18 @@ def import_release_command(
     except ReleaseImportError as error:
         for line in error.problems:
             click.echo(line, err=True)
-        sys.exit(2)
+        sys.exit(EXIT_BAD_INPUT)
     if not quiet:
         for line in result.notes:
             click.echo(f"note: {line}")
-    try:
-        dump_graph(result.graph, output)
-    except GraphFileError as error:
-        raise click.ClickException(str(error)) from None
-    if output.suffix.lower() in (".yaml", ".yml"):
+    dump_graph(result.graph, output)
+    if output.suffix.lower() in YAML_SUFFIXES:
         header = [
             f"# Imported by `agentchord import-release` from {task_graph} and {recovery_spec}",
             f"# (frame {frame}); dropped or approximated:",
             *(f"#   {line}" for line in result.notes),
         ]
-        output.write_text("\n".join(header) + "\n" + output.read_text(encoding="utf-8"), encoding="utf-8")
+        atomic_write_text(output, "\n".join(header) + "\n" + output.read_text(encoding="utf-8"))
     graph = result.graph
     _warn_sim_objects(graph)
     click.echo(

@@ -9,6 +9,18 @@ from pathlib import Path
 class GraphError(Exception):
     """Base class for task-graph errors."""
 
+    def __reduce__(self) -> tuple[object, ...]:
+        # Subclasses take other arguments than the message: rebuild from the state, so
+        # that an error raised in a bench worker process reaches the parent intact.
+        return (_rebuild, (type(self), self.args, self.__dict__))
+
+
+def _rebuild(cls: type[GraphError], args: tuple, state: dict) -> GraphError:
+    error = cls.__new__(cls)
+    Exception.__init__(error, *args)
+    error.__dict__.update(state)
+    return error
+
 
 class GraphFileError(GraphError):
     """A graph file could not be read, parsed or validated.
@@ -22,6 +34,22 @@ class GraphFileError(GraphError):
         self.path = Path(path)
         self.problems = [f"{path}: {problem}" for problem in problems]
         super().__init__("\n".join(self.problems))
+
+
+class GraphNotRunnableError(GraphError):
+    """A graph about to run fails ``graph check`` or names objects its scene lacks.
+
+    Attributes:
+        source: Where the graph came from (a file, ``planned``, a task's library graph).
+        lines: One line per problem, ``where: what is wrong``.
+        problems: One line per problem, each ``SOURCE: where: what is wrong``.
+    """
+
+    def __init__(self, source: str, problems: Sequence[str]) -> None:
+        self.source = source
+        self.lines = list(problems)
+        self.problems = [f"{source}: {problem}" for problem in problems]
+        super().__init__("the graph cannot run:\n" + "\n".join(self.problems))
 
 
 class UnknownNodeError(GraphError, KeyError):

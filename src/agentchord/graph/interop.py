@@ -159,10 +159,14 @@ from typing import Any
 from pydantic import ValidationError
 
 from agentchord.actions.catalog import ACTIONS
+from agentchord.expr.names import name_problem
 from agentchord.graph.exceptions import GraphError
 from agentchord.graph.loader import format_loc
 from agentchord.graph.models import ActionCall, Edge, FailureMode, Node, TaskGraph
 from agentchord.graph.validation import check_graph
+from agentchord.guard.documents import check_shape, read_text
+from agentchord.guard.exceptions import DocumentError
+from agentchord.guard.numbers import describe, non_finite
 
 #: Release arm names -> ours.
 ARM_NAMES = {"left_arm": "left", "right_arm": "right"}
@@ -334,7 +338,12 @@ def import_release_data(
     """
     frame_map = FrameMap.parse(frame) if isinstance(frame, str) else frame
     importer = _Importer(graph_name, spec_name, frame_map, objects)
-    graph = importer.run(graph_data, spec_data, task, folder)
+    try:
+        graph = importer.run(graph_data, spec_data, task, folder)
+    except ValidationError as error:  # a value that passed the mapping but not our models
+        raise ReleaseImportError(
+            [f"{graph_name}: (imported graph) {format_loc(d['loc'])}: {d['msg']}" for d in error.errors()]
+        ) from None
     if importer.problems:
         raise ReleaseImportError(importer.problems)
     assert graph is not None
@@ -357,17 +366,31 @@ def _fmt(x: float) -> str:
 
 
 def _read_json(path: Path, problems: list[str]) -> Any:
+    # Bounded like every input (agentchord.guard): regular files, size, depth, finite numbers.
     try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as error:
+        text = read_text(path)
+    except (OSError, UnicodeDecodeError, DocumentError) as error:
         reason = error.strerror if isinstance(error, OSError) and error.strerror else str(error)
         problems.append(f"{path}: (file): cannot read the file: {reason}")
         return None
     try:
-        return json.loads(text)
+        data = json.loads(text)
+    except RecursionError:
+        problems.append(f"{path}: (file): the JSON is nested too deeply to read")
+        return None
     except json.JSONDecodeError as error:
         problems.append(f"{path}: (file): line {error.lineno}, column {error.colno}: invalid JSON: {error.msg}")
         return None
+    try:
+        check_shape(data)
+    except DocumentError as error:
+        problems.append(f"{path}: {error.where or '(file)'}: {error}")
+        return None
+    bad = [f"{path}: {where or '(top level)'}: {describe(number)}" for where, number in non_finite(data)]
+    if bad:
+        problems += bad
+        return None
+    return data
 
 
 def _slug(text: str) -> str:
@@ -465,7 +488,9 @@ class _Importer:
                 name = (new if sep else old).strip()
                 if sep:
                     self.renames[old.strip()] = name
-                if name and name not in self.declared:
+                if name and (problem := name_problem(name)) is not None:
+                    self.problems.append(f"--objects: {problem}")
+                elif name and name not in self.declared:
                     self.declared.append(name)
         self.used: dict[str, str] = {}  # object -> where first named
         self.grasp_modes: dict[tuple[str, str], str] = {}
@@ -1175,6 +1200,9 @@ class _Importer:
 
     def _object(self, name: str, file: str, path: str) -> str:
         ours = self.renames.get(name, name)
+        if ours not in self.used and (problem := name_problem(ours)) is not None:
+            hint = f" (rename it: --objects '{name}=NEW_NAME')" if isinstance(name, str) else ""
+            self.error(file, path, problem + hint)
         self.used.setdefault(ours, f"{file}: {path}")
         return ours
 

@@ -1,0 +1,166 @@
+"""Command-line plumbing: exit statuses, the top-level error handler, output checks, number options.
+
+Exit statuses of every ``agentchord`` command:
+
+====  ==========================================================================
+0     success (the task succeeded, the file is valid, the output was written)
+1     the task failed (``run``: the episode ended without success)
+2     bad input: a usage error, an unreadable or invalid file, an output path that
+      cannot be written, an instruction that cannot be planned
+3     internal error: anything unexpected; one line on stderr, the traceback in a
+      log file that the line names
+====  ==========================================================================
+"""
+
+from __future__ import annotations
+
+import datetime
+import math
+import os
+import sys
+import tempfile
+import traceback
+from collections.abc import Iterable
+from pathlib import Path
+from typing import Any
+
+import click
+
+from agentchord.guard.exceptions import InputError
+from agentchord.guard.outputs import check_output_path
+
+EXIT_OK = 0
+EXIT_TASK_FAILED = 1
+EXIT_BAD_INPUT = 2
+EXIT_INTERNAL = 3
+
+#: Where internal-error logs go; default ``$XDG_CACHE_HOME/agentchord`` (``~/.cache/agentchord``).
+ENV_LOG_DIR = "AGENTCHORD_LOG_DIR"
+
+
+class BadInput(click.ClickException):
+    """Bad input found by a command: its message, exit status 2."""
+
+    exit_code = EXIT_BAD_INPUT
+
+    def show(self, file: Any = None) -> None:
+        """Print the message as is (it already names the file, field and problem)."""
+        click.echo(self.format_message(), file=file or sys.stderr)
+
+
+class InternalError(click.ClickException):
+    """Anything unexpected: one line naming the log file with the details, exit status 3.
+
+    Attributes:
+        log: The log file holding the traceback, ``None`` if it could not be written.
+    """
+
+    exit_code = EXIT_INTERNAL
+
+    def __init__(self, error: BaseException, log: Path | None) -> None:
+        self.log = log
+        first = (str(error).strip().splitlines() or [""])[0][:200]
+        where = f"details in {log}" if log else "no log could be written"
+        super().__init__(f"internal error: {type(error).__name__}{': ' if first else ''}{first} ({where})")
+
+    def show(self, file: Any = None) -> None:
+        """One line on stderr."""
+        click.echo(f"agentchord: {self.format_message()}", file=file or sys.stderr)
+
+
+def _bad_input_types() -> tuple[type[BaseException], ...]:
+    # Imported late: the handler must not make every command import the agents.
+    from agentchord.agents.exceptions import ReasonerError  # noqa: PLC0415
+    from agentchord.graph.exceptions import GraphFileError, GraphNotRunnableError, RenderError  # noqa: PLC0415
+
+    return (InputError, GraphFileError, GraphNotRunnableError, RenderError, ReasonerError)
+
+
+class GuardedGroup(click.Group):
+    """A click group whose commands never end in a traceback.
+
+    Known bad input that a command did not catch becomes its message with exit status 2;
+    anything else becomes :class:`InternalError` (exit status 3), its traceback in a log file.
+    """
+
+    def invoke(self, ctx: click.Context) -> Any:
+        """Run the command, translating what escapes it."""
+        try:
+            return super().invoke(ctx)
+        except (click.exceptions.ClickException, click.exceptions.Exit, click.exceptions.Abort, SystemExit):
+            raise
+        except KeyboardInterrupt:
+            raise
+        except Exception as error:
+            if isinstance(error, _bad_input_types()):
+                raise BadInput(str(error)) from error
+            raise InternalError(error, write_error_log(error)) from error
+
+
+def log_dir() -> Path:
+    """The folder of internal-error logs (see :data:`ENV_LOG_DIR`)."""
+    configured = os.environ.get(ENV_LOG_DIR)
+    if configured:
+        return Path(configured)
+    cache = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(cache) / "agentchord"
+
+
+def write_error_log(error: BaseException) -> Path | None:
+    """Write the traceback of ``error``, the command line and the version to a new log file.
+
+    Returns:
+        The log file, or ``None`` when neither the log folder nor the temporary folder takes it.
+    """
+    from agentchord import __version__  # noqa: PLC0415
+
+    stamp = datetime.datetime.now().strftime("%Y%m%d-%H%M%S")
+    text = (
+        f"agentchord {__version__}, python {sys.version.split()[0]}\n"
+        f"command: {' '.join(sys.argv)}\n\n"
+        + "".join(traceback.format_exception(type(error), error, error.__traceback__))
+    )
+    for folder in (log_dir(), Path(tempfile.gettempdir())):
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+            path = folder / f"error-{stamp}-{os.getpid()}.log"
+            path.write_text(text, encoding="utf-8")
+            return path
+        except OSError:
+            continue
+    return None
+
+
+def check_outputs(*outputs: tuple[str, str | Path | None, Iterable[str]]) -> None:
+    """Check every output path before any work starts (missing folders are created).
+
+    Args:
+        outputs: ``(option, path or None, accepted suffixes)``; ``None`` paths are skipped,
+            an empty suffix list accepts any.
+
+    Raises:
+        BadInput: Every path that cannot be written, one line each.
+    """
+    problems = []
+    for option, path, suffixes in outputs:
+        if path is None:
+            continue
+        try:
+            check_output_path(path, suffixes, option)
+        except InputError as error:
+            problems.append(str(error))
+    if problems:
+        raise BadInput("\n".join(problems))
+
+
+class FiniteFloatRange(click.FloatRange):
+    """A float option within bounds that refuses NaN (``FloatRange`` lets NaN through: every comparison is false)."""
+
+    name = "finite float range"
+
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        """The number, or a usage error naming NaN."""
+        number = super().convert(value, param, ctx)
+        if isinstance(number, float) and math.isnan(number):
+            self.fail("NaN is not a number: give a finite value", param, ctx)
+        return number
