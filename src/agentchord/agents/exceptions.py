@@ -23,6 +23,8 @@ class ReasonerError(Exception):
         headline: The message without the list of problems.
         problems: One line per problem, the last ones seen.
         call: The record of the failed call, if one was made.
+        calls: Every call of the plan that failed, the failed one last (set by
+            :func:`~agentchord.agents.pipeline.plan_task`), so that the replies are kept.
     """
 
     def __init__(
@@ -37,8 +39,21 @@ class ReasonerError(Exception):
         self.headline = message
         self.problems = list(problems)
         self.call = call
+        self.calls: list[ReasonerCall] = [call] if call is not None else []
         lines = [message, *(f"  - {problem}" for problem in self.problems)]
         super().__init__("\n".join(lines))
+
+    def __reduce__(self) -> tuple[object, ...]:
+        # Subclasses take other arguments than the message: rebuild from the state, so
+        # that an error raised in a bench worker process reaches the parent intact.
+        return (_rebuild, (type(self), self.args, self.__dict__))
+
+
+def _rebuild(cls: type[ReasonerError], args: tuple, state: dict) -> ReasonerError:
+    error = cls.__new__(cls)
+    Exception.__init__(error, *args)
+    error.__dict__.update(state)
+    return error
 
 
 class ReasonerConfigError(ReasonerError):
@@ -96,6 +111,13 @@ class InstructionNotGroundedError(ReasonerError):
             "(`--goal goal.yaml`, see `agentchord schema goal`) or use an LLM (`--reasoner llm`).",
             agent="composer",
         )
+
+
+class InfeasibleGoalError(ReasonerError):
+    """A goal that no plan can achieve in the scene: the reasons (size, containment, a cycle) are the problems."""
+
+    def __init__(self, problems: Sequence[str]) -> None:
+        super().__init__("the goal cannot be achieved in this scene:", agent="composer", problems=problems)
 
 
 class PlanningError(ReasonerError):

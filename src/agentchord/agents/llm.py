@@ -11,11 +11,20 @@ back to the model for repair, at most ``max_repairs`` times. Transport failures
 back-off by its own loop (the client's retries are off). Every call is recorded
 as a :class:`~agentchord.agents.reasoner.ReasonerCall`.
 
+Nothing an endpoint does can hang a plan: each request has a wall-clock limit
+(``timeout_s``; the HTTP client's own timeout is per read, so a server that drips
+its reply byte by byte would never trip it), each agent call a total deadline
+(``deadline_s``: retries, back-off and repairs included), and a reply longer than
+``max_reply_chars`` is refused without being copied into the repair request.
+
 Configuration comes from the environment or from arguments::
 
     AGENTCHORD_LLM_BASE_URL=http://127.0.0.1:11434/v1  # Ollama; vLLM: http://HOST:8000/v1
     AGENTCHORD_LLM_MODEL=qwen2.5:14b
     AGENTCHORD_LLM_API_KEY=none                         # local servers accept any value
+    AGENTCHORD_LLM_TIMEOUT_S=120                        # optional: wall-clock limit of one request
+    AGENTCHORD_LLM_DEADLINE_S=600                       # optional: limit of one agent call, repairs included
+    AGENTCHORD_LLM_MAX_REPLY_CHARS=1000000              # optional: longest reply accepted
 
     reasoner = LlmReasoner()                            # or LlmReasoner(LlmConfig(...))
     graph = reasoner.compose(ComposeRequest(instruction=..., scene=...))
@@ -27,8 +36,10 @@ import copy
 import dataclasses
 import functools
 import json
+import math
 import os
 import re
+import threading
 import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
@@ -56,6 +67,8 @@ from agentchord.agents.reasoner import (
 )
 from agentchord.graph.loader import validation_messages
 from agentchord.graph.models import TaskGraph
+from agentchord.guard.documents import check_shape
+from agentchord.guard.exceptions import DocumentError
 
 ENV_BASE_URL = "AGENTCHORD_LLM_BASE_URL"
 ENV_MODEL = "AGENTCHORD_LLM_MODEL"
@@ -64,6 +77,11 @@ ENV_STRUCTURED_OUTPUT = "AGENTCHORD_LLM_STRUCTURED_OUTPUT"
 ENV_TIMEOUT = "AGENTCHORD_LLM_TIMEOUT_S"
 ENV_TEMPERATURE = "AGENTCHORD_LLM_TEMPERATURE"
 ENV_MAX_TOKENS = "AGENTCHORD_LLM_MAX_TOKENS"
+ENV_DEADLINE = "AGENTCHORD_LLM_DEADLINE_S"
+ENV_MAX_REPLY = "AGENTCHORD_LLM_MAX_REPLY_CHARS"
+
+#: How much of a refused over-long reply is kept in the record and the conversation.
+_REPLY_EXCERPT = 2000
 
 #: How the reply's JSON is asked for. ``json_schema``: ``response_format`` with the
 #: graph's JSON Schema (OpenAI, Gemini, vLLM, recent Ollama and llama.cpp);
@@ -87,6 +105,8 @@ _OPTIONAL: tuple[tuple[str, str, Callable[[str], Any]], ...] = (
     ("timeout_s", ENV_TIMEOUT, float),
     ("temperature", ENV_TEMPERATURE, float),
     ("max_tokens", ENV_MAX_TOKENS, int),
+    ("deadline_s", ENV_DEADLINE, float),
+    ("max_reply_chars", ENV_MAX_REPLY, int),
 )
 
 
@@ -103,7 +123,11 @@ class LlmConfig:
             (reasoning models accept only their default).
         max_tokens: Reply token limit (sent as ``max_tokens``); ``None`` sends none.
         seed: Sampling seed, for the servers that honour it.
-        timeout_s: Timeout of one HTTP request.
+        timeout_s: Wall-clock limit of one HTTP request, however the reply trickles in.
+        deadline_s: Wall-clock limit of one agent call: every request, retry,
+            back-off and repair turn together.
+        max_reply_chars: Longest reply accepted; a longer one is refused (and
+            only its start kept) so that it is not sent back in every repair.
         max_repairs: Repair turns after an invalid reply before giving up.
         max_retries: Transport retries of one request before giving up.
         backoff_base_s: First back-off delay; the n-th retry waits ``base * 2**n``.
@@ -119,6 +143,8 @@ class LlmConfig:
     max_tokens: int | None = None
     seed: int | None = None
     timeout_s: float = 120.0
+    deadline_s: float = 600.0
+    max_reply_chars: int = 1_000_000
     max_repairs: int = 3
     max_retries: int = 4
     backoff_base_s: float = 1.0
@@ -136,12 +162,14 @@ class LlmConfig:
                 f"structured_output: expected one of {', '.join(get_args(StructuredOutput))}, "
                 f"got {self.structured_output!r}"
             )
-        for name in ("timeout_s",):
-            if not getattr(self, name) > 0:
-                problems.append(f"{name}: expected a positive number, got {getattr(self, name)!r}")
+        for name in ("timeout_s", "deadline_s", "max_reply_chars"):
+            if not _finite_number(getattr(self, name)) or not getattr(self, name) > 0:
+                problems.append(f"{name}: expected a finite positive number, got {getattr(self, name)!r}")
         for name in ("max_repairs", "max_retries", "backoff_base_s", "backoff_max_s"):
-            if not getattr(self, name) >= 0:
-                problems.append(f"{name}: expected a number >= 0, got {getattr(self, name)!r}")
+            if not _finite_number(getattr(self, name)) or not getattr(self, name) >= 0:
+                problems.append(f"{name}: expected a finite number >= 0, got {getattr(self, name)!r}")
+        if self.temperature is not None and not (_finite_number(self.temperature) and 0 <= self.temperature <= 2):
+            problems.append(f"temperature: expected a number from 0 to 2 or None, got {self.temperature!r}")
         if self.max_tokens is not None and self.max_tokens < 1:
             problems.append(f"max_tokens: expected a positive integer or None, got {self.max_tokens!r}")
         if problems:
@@ -153,8 +181,8 @@ class LlmConfig:
 
         Reads ``AGENTCHORD_LLM_BASE_URL``, ``AGENTCHORD_LLM_MODEL``,
         ``AGENTCHORD_LLM_API_KEY`` (required), and ``AGENTCHORD_LLM_STRUCTURED_OUTPUT``,
-        ``AGENTCHORD_LLM_TIMEOUT_S``, ``AGENTCHORD_LLM_TEMPERATURE``,
-        ``AGENTCHORD_LLM_MAX_TOKENS`` (optional).
+        ``AGENTCHORD_LLM_TIMEOUT_S``, ``AGENTCHORD_LLM_DEADLINE_S``, ``AGENTCHORD_LLM_TEMPERATURE``,
+        ``AGENTCHORD_LLM_MAX_TOKENS``, ``AGENTCHORD_LLM_MAX_REPLY_CHARS`` (optional).
 
         Args:
             env: The environment (default ``os.environ``).
@@ -286,6 +314,7 @@ class LlmReasoner:
             {"role": "user", "content": request_message(request)},
         ]
         start = self._clock()
+        deadline = time.monotonic() + config.deadline_s
         try:
             problems: list[str] = []
             for turn in range(config.max_repairs + 1):
@@ -295,14 +324,17 @@ class LlmReasoner:
                 call.attempts.append(attempt)
                 begun = self._clock()
                 try:
-                    completion = self._complete(agent, messages, attempt)
+                    completion = self._complete(agent, messages, attempt, deadline)
                 finally:
                     attempt.latency_s = self._clock() - begun
-                refusal = _read_completion(completion, attempt)
+                refusal, unreadable = _read_completion(completion, attempt, config.max_reply_chars)
                 messages.append({"role": "assistant", "content": attempt.reply or ""})
-                graph, problems = parse_reply(
-                    attempt.reply, request, finish_reason=attempt.finish_reason, refusal=refusal
-                )
+                if unreadable:
+                    graph, problems = None, [unreadable]
+                else:
+                    graph, problems = parse_reply(
+                        attempt.reply, request, finish_reason=attempt.finish_reason, refusal=refusal
+                    )
                 attempt.problems = problems
                 if graph is not None and not problems:
                     call.reply = graph.model_dump(mode="json", exclude_defaults=True)
@@ -323,16 +355,35 @@ class LlmReasoner:
             call.messages = copy.deepcopy(messages)
             self.calls.append(call)
 
-    def _complete(self, agent: str, messages: list[dict[str, Any]], attempt: ReasonerAttempt) -> Any:
-        """One chat completion, with transport retries and the structured-output fallback."""
+    def _complete(
+        self, agent: str, messages: list[dict[str, Any]], attempt: ReasonerAttempt, deadline: float | None = None
+    ) -> Any:
+        """One chat completion, with transport retries and the structured-output fallback.
+
+        Each request is bounded by ``timeout_s`` of wall time and all of them by ``deadline``
+        (a ``time.monotonic()`` instant).
+        """
         config = self.config
+        if deadline is None:
+            deadline = time.monotonic() + config.deadline_s
         retries = 0
         while True:
             mode = self._modes[0]
             messages[0]["content"] = system_prompt(agent, mode)
+            left = deadline - time.monotonic()
+            if left <= 0:
+                raise ReasonerTransportError(
+                    f"{agent}: no valid reply from {config.base_url} within the deadline of "
+                    f"{config.deadline_s:g} s ({ENV_DEADLINE}):",
+                    problems=attempt.transport_errors or ["the deadline passed before a request could be sent"],
+                )
+            limit = min(config.timeout_s, left)
             try:
-                completion = self._client.chat.completions.create(
-                    model=config.model, messages=messages, timeout=config.timeout_s, **self._params(mode)
+                completion = _within(
+                    limit,
+                    lambda: self._client.chat.completions.create(
+                        model=config.model, messages=messages, timeout=limit, **self._params(mode)
+                    ),
                 )
             except openai.APIStatusError as error:
                 status = error.status_code
@@ -350,9 +401,9 @@ class LlmReasoner:
                 delay = _retry_after(error.response, config.backoff_max_s)
                 if delay is None:
                     delay = backoff_delay(retries, config.backoff_base_s, config.backoff_max_s)
-            except openai.APIConnectionError as error:  # also a timeout
-                if isinstance(error, openai.APITimeoutError):
-                    line = f"timed out after {config.timeout_s:g} s"
+            except (openai.APIConnectionError, _WallClockTimeout) as error:  # also a timeout
+                if isinstance(error, (openai.APITimeoutError, _WallClockTimeout)):
+                    line = f"timed out after {limit:g} s"
                 else:
                     cause = error.__cause__
                     line = f"connection error: {cause or error}"
@@ -375,6 +426,7 @@ class LlmReasoner:
                 return completion
             retries += 1
             attempt.retries = retries
+            delay = max(0.0, min(delay, deadline - time.monotonic()))  # never sleep past the deadline
             attempt.transport_errors.append(f"{line}; retry {retries}/{config.max_retries} in {delay:.3g} s")
             self._sleep(delay)
 
@@ -527,6 +579,10 @@ def parse_reply(
         return None, [problem]
     if not isinstance(data, dict):
         return None, [f"expected one JSON object (the task graph), got a JSON {_json_type(data)}"]
+    try:
+        check_shape(data)  # a validator must not recurse into a 10,000-level list
+    except DocumentError as error:
+        return None, [f"{error.where}: {error}" if error.where else str(error)]
     data = _fill_from_request(data, request)
     try:
         graph = TaskGraph.model_validate(data)
@@ -550,20 +606,22 @@ def extract_json(text: str) -> Any:
     text = _THINK.sub("", text).strip()
     try:
         return json.loads(text)
+    except RecursionError:
+        raise ValueError("the JSON is nested too deeply") from None
     except json.JSONDecodeError as error:
         first = error
     candidates = [m.group(1) for m in _FENCE.finditer(text)]
     for candidate in candidates:
         try:
             return json.loads(candidate)
-        except json.JSONDecodeError:
+        except (json.JSONDecodeError, RecursionError):
             continue
     start = text.find("{")
     if start >= 0:  # prose around the object, or trailing text after it
         try:
             value, _ = json.JSONDecoder().raw_decode(text, start)
             return value
-        except (json.JSONDecodeError, ValueError):
+        except (json.JSONDecodeError, ValueError, RecursionError):
             pass
     raise ValueError(f"line {first.lineno}, column {first.colno}: {first.msg}")
 
@@ -604,21 +662,85 @@ def _fill_from_request(data: dict[str, Any], request: AgentRequest) -> dict[str,
     return {**{k: v for k, v in defaults.items() if k not in data}, **data}
 
 
-def _read_completion(completion: Any, attempt: ReasonerAttempt) -> str | None:
-    """Copy text, finish reason and usage of a completion into the attempt; return any refusal."""
-    choices = getattr(completion, "choices", None) or []
-    refusal = None
-    if choices:
+def _read_completion(
+    completion: Any, attempt: ReasonerAttempt, max_chars: int = 1_000_000
+) -> tuple[str | None, str | None]:
+    """Copy text, finish reason and usage of a completion into the attempt.
+
+    Whatever the endpoint sent is taken defensively: a ``content`` that is not a string,
+    a reply over ``max_chars`` (kept only in part) and non-numeric usage are problems or
+    unknowns, never crashes.
+
+    Returns:
+        ``(refusal, problem)``: any refusal, and why the reply cannot be read (``None`` if it can).
+    """
+    choices = getattr(completion, "choices", None)
+    refusal = problem = None
+    if isinstance(choices, list) and choices:
         choice = choices[0]
         message = getattr(choice, "message", None)
-        attempt.reply = getattr(message, "content", None)
-        refusal = getattr(message, "refusal", None)
-        attempt.finish_reason = getattr(choice, "finish_reason", None)
+        content = getattr(message, "content", None)
+        raw_refusal = getattr(message, "refusal", None)
+        refusal = raw_refusal if isinstance(raw_refusal, str) else None
+        finish = getattr(choice, "finish_reason", None)
+        attempt.finish_reason = finish if isinstance(finish, str) else None
+        if content is not None and not isinstance(content, str):
+            problem = f"the reply's content is a JSON {_json_type(content)}; expected a string holding the task graph"
+        elif content is not None and len(content) > max_chars:
+            attempt.reply = f"{content[:_REPLY_EXCERPT]}... [cut: {len(content):,} characters in all]"
+            problem = (
+                f"the reply is {len(content):,} characters long, more than the limit of {max_chars:,} "
+                f"({ENV_MAX_REPLY}): reply with the task graph only, compactly"
+            )
+        else:
+            attempt.reply = content
     usage = getattr(completion, "usage", None)
     if usage is not None:
-        attempt.tokens_in = getattr(usage, "prompt_tokens", None)
-        attempt.tokens_out = getattr(usage, "completion_tokens", None)
-    return refusal
+        attempt.tokens_in = _token_count(getattr(usage, "prompt_tokens", None))
+        attempt.tokens_out = _token_count(getattr(usage, "completion_tokens", None))
+    return refusal, problem
+
+
+def _token_count(value: Any) -> int | None:
+    # Usage is informational: a count that is not a non-negative integer is unknown.
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return None
+    if isinstance(value, float) and not (math.isfinite(value) and value.is_integer()):
+        return None
+    return int(value) if 0 <= value < 2**53 else None
+
+
+def _finite_number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+class _WallClockTimeout(Exception):
+    """A request did not finish within its wall-clock limit."""
+
+
+def _within(seconds: float, request: Callable[[], Any]) -> Any:
+    """``request()``, or :class:`_WallClockTimeout` after ``seconds`` of wall time.
+
+    The HTTP client's timeout applies per read; a reply that trickles in a byte at a time
+    never trips it. The request runs in a daemon thread that is abandoned on timeout (it
+    ends with its connection and never keeps the process alive).
+    """
+    box: dict[str, Any] = {}
+
+    def run() -> None:
+        try:
+            box["value"] = request()
+        except BaseException as error:  # re-raised in the caller's thread
+            box["error"] = error
+
+    worker = threading.Thread(target=run, name="agentchord-llm-request", daemon=True)
+    worker.start()
+    worker.join(seconds)
+    if worker.is_alive():
+        raise _WallClockTimeout(f"no complete reply within {seconds:g} s")
+    if "error" in box:
+        raise box["error"]
+    return box["value"]
 
 
 # --- transport helpers -------------------------------------------------------------------
@@ -671,7 +793,7 @@ def _status_message(agent: str, config: LlmConfig, status: int, retries: int) ->
 
 
 def _json_type(value: Any) -> str:
-    return {list: "array", str: "string", bool: "boolean", int: "number", float: "number", type(None): "null"}.get(
+    return {dict: "object", list: "array", str: "string", bool: "boolean", int: "number", float: "number", type(None): "null"}.get(
         type(value), type(value).__name__
     )
 

@@ -69,8 +69,16 @@ def plan_task(instruction: str, scene: Scene, reasoner: Reasoner, task: str = ""
     Raises:
         ReasonerError: An agent could not produce a valid graph (the message says why).
     """
-    seconds: dict[str, float] = {}
     first = len(reasoner.calls)
+    try:
+        return _plan(instruction, scene, reasoner, task, first)
+    except ReasonerError as error:
+        error.calls = list(reasoner.calls[first:])  # the refused replies travel with the error
+        raise
+
+
+def _plan(instruction: str, scene: Scene, reasoner: Reasoner, task: str, first: int) -> PlanResult:
+    seconds: dict[str, float] = {}
     start = time.perf_counter()
     nominal = reasoner.compose(ComposeRequest(instruction=instruction, scene=scene, task=task))
     seconds["composer"] = time.perf_counter() - start

@@ -11,13 +11,20 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+from agentchord.expr.names import ObjectName
+from agentchord.guard.numbers import MAX_MAGNITUDE
 
 Arm = Literal["left", "right"]
+#: A table coordinate or offset (m): finite and within any workspace.
+Coordinate = Annotated[float, Field(allow_inf_nan=False, ge=-MAX_MAGNITUDE, le=MAX_MAGNITUDE)]
+#: A yaw (deg).
+Yaw = Annotated[float, Field(allow_inf_nan=False, ge=-360.0, le=360.0)]
 
 
 class _Goal(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
     def objects(self) -> list[str]:
         """Scene objects the predicate names."""
@@ -35,8 +42,8 @@ class Poured(_Goal):
     """
 
     kind: Literal["poured"] = "poured"
-    source: str
-    target: str
+    source: ObjectName
+    target: ObjectName
     arm: Arm | None = None
     hold_target: bool = False
 
@@ -62,12 +69,12 @@ class Placed(_Goal):
     """
 
     kind: Literal["placed"] = "placed"
-    obj: str
+    obj: ObjectName
     region: str | None = None
-    at: tuple[float, float] | None = None
-    relative_to: str | None = None
-    offset: tuple[float, float] = (0.0, 0.0)
-    yaw: float | None = None
+    at: tuple[Coordinate, Coordinate] | None = None
+    relative_to: ObjectName | None = None
+    offset: tuple[Coordinate, Coordinate] = (0.0, 0.0)
+    yaw: Yaw | None = None
     arm: Arm | None = None
 
     def objects(self) -> list[str]:
@@ -78,8 +85,8 @@ class Inside(_Goal):
     """``obj`` released inside ``container`` (a capsule in a tray, a block in a cup)."""
 
     kind: Literal["inside"] = "inside"
-    obj: str
-    container: str
+    obj: ObjectName
+    container: ObjectName
     arm: Arm | None = None
 
     def objects(self) -> list[str]:
@@ -90,8 +97,8 @@ class On(_Goal):
     """``obj`` released on top of ``support`` (a stack)."""
 
     kind: Literal["on_top_of"] = "on_top_of"  # not "on": YAML reads a bare on as true
-    obj: str
-    support: str
+    obj: ObjectName
+    support: ObjectName
     arm: Arm | None = None
 
     def objects(self) -> list[str]:
@@ -102,7 +109,7 @@ class HandedOver(_Goal):
     """``obj`` passed from ``giver`` to ``receiver`` (the receiver closes before the giver opens)."""
 
     kind: Literal["handed_over"] = "handed_over"
-    obj: str
+    obj: ObjectName
     giver: Arm = "left"
     receiver: Arm = "right"
 
@@ -118,7 +125,7 @@ class Folded(_Goal):
     """
 
     kind: Literal["folded"] = "folded"
-    cloth: str
+    cloth: ObjectName
 
     def objects(self) -> list[str]:
         return [f"{self.cloth}_{c}" for c in ("bl", "br", "tl", "tr")]
@@ -137,8 +144,16 @@ class GoalSpec(BaseModel):
 
     model_config = ConfigDict(extra="forbid")
 
-    goals: list[Goal] = Field(min_length=1)
+    goals: list[Goal] = Field(min_length=1, max_length=64)
     home: bool = True
+
+    @model_validator(mode="after")
+    def _coherent(self) -> GoalSpec:
+        # Contradictions that no scene can satisfy; what needs the scene (sizes, which
+        # objects are containers) is checked by agents.rules.feasibility.
+        if problems := static_problems(self):
+            raise ValueError("; ".join(problems))
+        return self
 
     def objects(self) -> list[str]:
         """Every object the goals name, first mention first."""
@@ -146,3 +161,47 @@ class GoalSpec(BaseModel):
         for goal in self.goals:
             names += [n for n in goal.objects() if n not in names]
         return names
+
+
+def _rests_on(goal: _Goal) -> tuple[str, str, str] | None:
+    # (object, what it ends up resting on or in, the relation in words)
+    if isinstance(goal, Inside):
+        return goal.obj, goal.container, "inside"
+    if isinstance(goal, On):
+        return goal.obj, goal.support, "on top of"
+    return None
+
+
+def static_problems(spec: GoalSpec) -> list[str]:
+    """Contradictions within a goal spec: an object in or on itself, or a cycle of stacking/containment.
+
+    Returns:
+        One line per problem, naming the goals (``goals[1]``); empty when coherent.
+    """
+    problems = []
+    edges: dict[str, tuple[str, int, str]] = {}
+    for index, goal in enumerate(spec.goals):
+        relation = _rests_on(goal)
+        if isinstance(goal, Poured) and goal.source == goal.target:
+            problems.append(f"goals[{index}]: {goal.source!r} cannot be poured into itself")
+        if isinstance(goal, Placed) and goal.relative_to == goal.obj:
+            problems.append(f"goals[{index}]: {goal.obj!r} cannot be placed relative to itself")
+        if relation is None:
+            continue
+        obj, under, words = relation
+        if obj == under:
+            problems.append(f"goals[{index}]: {obj!r} cannot be {words} itself")
+            continue
+        edges[obj] = (under, index, words)
+    reported: set[str] = set()
+    for start in edges:
+        chain, node = [start], edges[start][0]
+        while node in edges and node not in chain:
+            chain.append(node)
+            node = edges[node][0]
+        if node == start and not reported & set(chain):
+            reported |= set(chain)
+            steps = " ".join(f"{name} {edges[name][2]}" for name in chain) + f" {start}"
+            indices = ", ".join(f"goals[{edges[name][1]}]" for name in chain)
+            problems.append(f"{indices}: a cycle: {steps}; nothing can rest on or in what rests on or in it")
+    return problems

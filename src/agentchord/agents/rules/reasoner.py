@@ -13,7 +13,9 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 
-from agentchord.agents.exceptions import InvalidReplyError, ReasonerError
+from pydantic import ValidationError
+
+from agentchord.agents.exceptions import InfeasibleGoalError, InvalidReplyError, ReasonerError
 from agentchord.agents.reasoner import (
     AgentRequest,
     ArrangeRequest,
@@ -26,6 +28,7 @@ from agentchord.agents.reasoner import (
 from agentchord.agents.rules.arranger import Arranger
 from agentchord.agents.rules.composer import compose
 from agentchord.agents.rules.conductor import Conductor
+from agentchord.agents.rules.feasibility import goal_problems
 from agentchord.agents.rules.goals import GoalSpec
 from agentchord.agents.rules.instructions import ground_instruction
 from agentchord.graph.models import TaskGraph
@@ -56,7 +59,12 @@ class RulesReasoner:
         """The nominal graph (raises :class:`InstructionNotGroundedError` or :class:`PlanningError`)."""
 
         def answer() -> TaskGraph:
-            goal = self.goal or ground_instruction(request.instruction, request.scene)
+            try:
+                goal = self.goal or ground_instruction(request.instruction, request.scene)
+            except ValidationError as error:  # the words make a contradictory goal (a stack cycle)
+                raise InfeasibleGoalError([d["msg"].removeprefix("Value error, ") for d in error.errors()]) from None
+            if problems := goal_problems(goal, request.scene):
+                raise InfeasibleGoalError(problems)
             self.last_goal = goal
             return compose(goal, request.scene, request.task, request.instruction).graph
 

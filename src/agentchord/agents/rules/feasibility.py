@@ -1,0 +1,53 @@
+"""Whether a goal spec makes physical sense in a scene, before any planning.
+
+The STRIPS planner reasons over symbols: it would happily plan "put the cup into the red
+block" or "put the tray into the capsule". These checks refuse such goals with the reason:
+the receiving object is not a container, or the object does not fit through its opening;
+a stack or a containment that closes a cycle (also refused by the goal spec itself); a
+goal naming an object the scene does not have.
+"""
+
+from __future__ import annotations
+
+from agentchord.agents.reasoner import Scene, SceneObject
+from agentchord.agents.rules import knowledge as kb
+from agentchord.agents.rules.goals import GoalSpec, Inside, On, Poured, static_problems
+
+#: Fraction of the container's smaller horizontal size an object's smaller horizontal size may fill.
+FIT_FRACTION = 0.95
+
+
+def goal_problems(goal: GoalSpec, scene: Scene) -> list[str]:
+    """Every reason ``goal`` cannot be achieved in ``scene``; empty when it is sound.
+
+    Args:
+        goal: The goal spec (from a file or read from an instruction).
+        scene: The first observation.
+    """
+    objects = {obj.name: obj for obj in scene.objects}
+    cloth = set(kb.cloth_names(objects))
+    problems = list(static_problems(goal))
+    for index, item in enumerate(goal.goals):
+        where = f"goals[{index}]"
+        missing = [n for n in item.objects() if n not in objects and n.rsplit("_", 1)[0] not in cloth]
+        if missing and objects:
+            problems.append(f"{where}: the scene has no {', '.join(map(repr, missing))} (it has {', '.join(objects)})")
+            continue
+        if isinstance(item, Inside) and item.obj in objects and item.container in objects:
+            problems += _fit(where, objects[item.obj], objects[item.container], "put into")
+        elif isinstance(item, Poured) and item.target in objects and not kb.is_container(objects[item.target]):
+            problems.append(f"{where}: {item.target!r} is not a container: nothing can be poured into it")
+    return problems
+
+
+def _fit(where: str, obj: SceneObject, container: SceneObject, verb: str) -> list[str]:
+    if not kb.is_container(container):
+        return [f"{where}: {container.name!r} is not a container: nothing can be {verb} it"]
+    inner = min(container.extent[0], container.extent[1]) * FIT_FRACTION
+    size = min(obj.extent[0], obj.extent[1])
+    if size >= inner:
+        return [
+            f"{where}: {obj.name!r} ({size * 100:.1f} cm across) does not fit into {container.name!r} "
+            f"({inner * 100:.1f} cm inside)"
+        ]
+    return []
