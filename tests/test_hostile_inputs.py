@@ -155,8 +155,10 @@ def test_p_nan_is_refused(command):
         ({"kind": "placed", "obj": "red_block", "at": [float("nan"), 0.1]}, "goals[0].at[0]: NaN is not a number"),
         ({"kind": "placed", "obj": "red_block", "yaw": float("inf")}, "goals[0].yaw: infinity is not allowed"),
         ({"kind": "placed", "obj": "red_block", "relative_to": "cup", "offset": [1e9, 0]}, "goals[0].offset[0]: "),
+        ({"kind": "placed", "obj": "red_block", "at": [900.0, 0.4]}, "goals[0].at[0]: Input should be less than or equal to 2"),
+        ({"kind": "placed", "obj": "red_block", "yaw": 359}, "goals[0].yaw: Input should be less than or equal to 180"),
     ],
-    ids=["at nan", "yaw inf", "offset huge"],
+    ids=["at nan", "yaw inf", "offset huge", "at off the table", "yaw past 180"],
 )
 def test_a_goal_with_non_finite_numbers_is_refused(tmp_path, goal, message):
     path = write(tmp_path, {"goals": [goal]}, "goal.yaml")
@@ -623,8 +625,13 @@ def test_nonsense_instructions_are_refused_with_the_reason(tmp_path, task, instr
         ([{"kind": "inside", "obj": "cup", "container": "cup"}], "'cup' cannot be inside itself"),
         ([{"kind": "inside", "obj": "red_block", "container": "blue_block"}], "'blue_block' is not a container"),
         ([{"kind": "inside", "obj": "red_block", "container": "mug"}], "the scene has no 'mug'"),
+        ([{"kind": "placed", "obj": "red_block", "region": "nowhere"}], "the scene has no region 'nowhere'"),
+        ([{"kind": "poured", "source": "red_block", "target": "cup"}], "'red_block' is not a vessel to pour from"),
+        ([{"kind": "handed_over", "obj": "cup", "giver": "left", "receiver": "left"}], "cannot hand 'cup' over to itself"),
+        ([{"kind": "placed", "obj": "red_block", "at": [0.1, 0.4], "relative_to": "cup"}], "one way only"),
     ],
-    ids=["cycle", "inside itself", "into a block", "unknown object"],
+    ids=["cycle", "inside itself", "into a block", "unknown object", "unknown region", "pour from a block",
+         "hand over to itself", "two places at once"],
 )
 def test_nonsense_goal_specs_are_refused(tmp_path, goals, message):
     path = write(tmp_path, {"goals": goals}, "goal.yaml")

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from agentchord.agents.reasoner import Scene, SceneObject
 from agentchord.agents.rules import knowledge as kb
-from agentchord.agents.rules.goals import GoalSpec, Inside, On, Poured, static_problems
+from agentchord.agents.rules.goals import GoalSpec, Inside, Placed, Poured, static_problems
 
 #: Fraction of the container's smaller horizontal size an object's smaller horizontal size may fill.
 FIT_FRACTION = 0.95
@@ -35,8 +35,16 @@ def goal_problems(goal: GoalSpec, scene: Scene) -> list[str]:
             continue
         if isinstance(item, Inside) and item.obj in objects and item.container in objects:
             problems += _fit(where, objects[item.obj], objects[item.container], "put into")
-        elif isinstance(item, Poured) and item.target in objects and not kb.is_container(objects[item.target]):
-            problems.append(f"{where}: {item.target!r} is not a container: nothing can be poured into it")
+        elif isinstance(item, Poured) and item.source in objects and item.target in objects:
+            if not kb.is_pourable(objects[item.source]):
+                problems.append(f"{where}: {item.source!r} is not a vessel to pour from")
+            if not kb.is_container(objects[item.target]):
+                problems.append(f"{where}: {item.target!r} is not a container: nothing can be poured into it")
+        elif isinstance(item, Placed) and item.region is not None:
+            regions = [r.name for r in scene.regions]
+            if item.region not in regions:
+                known = ", ".join(regions) or "none"
+                problems.append(f"{where}: the scene has no region {item.region!r} (regions: {known})")
     return problems
 
 

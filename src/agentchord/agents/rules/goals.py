@@ -14,13 +14,14 @@ from typing import Annotated, Literal
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from agentchord.expr.names import ObjectName
-from agentchord.guard.numbers import MAX_MAGNITUDE
 
 Arm = Literal["left", "right"]
-#: A table coordinate or offset (m): finite and within any workspace.
-Coordinate = Annotated[float, Field(allow_inf_nan=False, ge=-MAX_MAGNITUDE, le=MAX_MAGNITUDE)]
-#: A yaw (deg).
-Yaw = Annotated[float, Field(allow_inf_nan=False, ge=-360.0, le=360.0)]
+#: A table position (m): finite, and on a table two arms can reach (generously).
+Coordinate = Annotated[float, Field(allow_inf_nan=False, ge=-2.0, le=2.0)]
+#: An offset from an anchor object (m).
+Offset = Annotated[float, Field(allow_inf_nan=False, ge=-1.0, le=1.0)]
+#: A yaw (deg), as the actions take it.
+Yaw = Annotated[float, Field(allow_inf_nan=False, ge=-180.0, le=180.0)]
 
 
 class _Goal(BaseModel):
@@ -73,7 +74,7 @@ class Placed(_Goal):
     region: str | None = None
     at: tuple[Coordinate, Coordinate] | None = None
     relative_to: ObjectName | None = None
-    offset: tuple[Coordinate, Coordinate] = (0.0, 0.0)
+    offset: tuple[Offset, Offset] = (0.0, 0.0)
     yaw: Yaw | None = None
     arm: Arm | None = None
 
@@ -186,6 +187,10 @@ def static_problems(spec: GoalSpec) -> list[str]:
             problems.append(f"goals[{index}]: {goal.source!r} cannot be poured into itself")
         if isinstance(goal, Placed) and goal.relative_to == goal.obj:
             problems.append(f"goals[{index}]: {goal.obj!r} cannot be placed relative to itself")
+        if isinstance(goal, Placed) and sum(x is not None for x in (goal.region, goal.at, goal.relative_to)) > 1:
+            problems.append(f"goals[{index}]: say where {goal.obj!r} goes one way only: region, at or relative_to")
+        if isinstance(goal, HandedOver) and goal.giver == goal.receiver:
+            problems.append(f"goals[{index}]: the {goal.giver} arm cannot hand {goal.obj!r} over to itself")
         if relation is None:
             continue
         obj, under, words = relation
