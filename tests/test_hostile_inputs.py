@@ -599,6 +599,23 @@ def test_an_unknown_task_is_exit_2():
     invoke(["run", "no_such_task"], 2, "unknown task")
 
 
+@pytest.mark.parametrize(
+    "args",
+    [["run", "single_arm_pour_water", "--seed", "-1"],
+     ["plan", "x", "--task", "blocks_and_cup", "-o", "never.yaml", "--seed", "-5"],
+     ["demo", "--seed", "-3"]],
+    ids=["run", "plan", "demo"],
+)
+def test_a_negative_seed_is_exit_2(args):
+    invoke(args, 2, "'--seed'")
+
+
+def test_an_unknown_camera_is_refused_before_the_episode(tmp_path):
+    invoke(["run", "single_arm_pour_water", "--video", tmp_path / "v.mp4", "--camera", "nosuch"], 2,
+           "no camera 'nosuch' in the single_arm_pour_water scene (cameras: front")
+    assert not (tmp_path / "v.mp4").exists()
+
+
 # --- 8. nonsense goals -----------------------------------------------------------------------
 
 
