@@ -107,7 +107,7 @@ class InstructionNotGroundedError(ReasonerError):
         self.instruction = instruction
         self.reason = reason
         super().__init__(
-            f"cannot ground the instruction {instruction!r}: {reason}. Give the goal as a goal spec "
+            f"cannot ground the instruction {_shorten(instruction)!r}: {_shorten(reason, 300)}. Give the goal as a goal spec "
             "(`--goal goal.yaml`, see `agentchord schema goal`) or use an LLM (`--reasoner llm`).",
             agent="composer",
         )
@@ -118,6 +118,11 @@ class InfeasibleGoalError(ReasonerError):
 
     def __init__(self, problems: Sequence[str]) -> None:
         super().__init__("the goal cannot be achieved in this scene:", agent="composer", problems=problems)
+
+
+def _shorten(text: str, limit: int = 200) -> str:
+    # An instruction can be any length; the message quotes enough of it to recognise it.
+    return text if len(text) <= limit else f"{text[:limit]}... ({len(text):,} characters)"
 
 
 class PlanningError(ReasonerError):
