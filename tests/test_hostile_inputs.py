@@ -589,6 +589,16 @@ def test_an_unexpected_error_is_one_line_and_a_log(tmp_path, monkeypatch):
     assert "Traceback" in log.read_text() and "ZeroDivisionError: a bug" in log.read_text()
 
 
+def test_an_interrupt_is_not_a_task_failure(monkeypatch):
+    import agentchord.graph.cli as graph_cli
+
+    def interrupted(graph):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(graph_cli, "check_graph", interrupted)
+    invoke(["graph", "check", POUR], 130, "agentchord: interrupted")
+
+
 @pytest.mark.parametrize("command", [["graph", "check"], ["graph", "render"], ["graph", "filter"]])
 def test_an_unreadable_file_is_exit_2(tmp_path, command):
     extra = ["-o", tmp_path / "g.dot"] if command[-1] == "render" else []

@@ -9,6 +9,7 @@ Exit statuses of every ``agentchord`` command:
       cannot be written, an instruction that cannot be planned
 3     internal error: anything unexpected; one line on stderr, the traceback in a
       log file that the line names
+130   interrupted (Ctrl-C)
 ====  ==========================================================================
 """
 
@@ -33,6 +34,7 @@ EXIT_OK = 0
 EXIT_TASK_FAILED = 1
 EXIT_BAD_INPUT = 2
 EXIT_INTERNAL = 3
+EXIT_INTERRUPTED = 130  # the shell's convention for Ctrl-C (128 + SIGINT)
 
 #: Where internal-error logs go; default ``$XDG_CACHE_HOME/agentchord`` (``~/.cache/agentchord``).
 ENV_LOG_DIR = "AGENTCHORD_LOG_DIR"
@@ -90,7 +92,9 @@ class GuardedGroup(click.Group):
         except (click.exceptions.ClickException, click.exceptions.Exit, click.exceptions.Abort, SystemExit):
             raise
         except KeyboardInterrupt:
-            raise
+            # click would say "Aborted!" and exit 1, which means "the task failed".
+            click.echo("agentchord: interrupted", err=True)
+            raise click.exceptions.Exit(EXIT_INTERRUPTED) from None
         except Exception as error:
             if isinstance(error, _bad_input_types()):
                 raise BadInput(str(error)) from error
