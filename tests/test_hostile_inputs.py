@@ -272,6 +272,14 @@ def test_run_refuses_a_graph_for_another_scene(tmp_path):
            f"{path}: objects[0]: the single_arm_pour_water scene has no object 'jug' (it has bottle, cup)")
 
 
+def test_graph_check_with_a_task_checks_the_scene(tmp_path):
+    path = write(tmp_path, yaml.safe_dump(pour(), sort_keys=False).replace("bottle", "jug"))
+    invoke(["graph", "check", path, "--task", "single_arm_pour_water"], 2,
+           f"{path}: objects[0]: the single_arm_pour_water scene has no object 'jug'")
+    invoke(["graph", "check", POUR, "--task", "single_arm_pour_water"], 0)
+    invoke(["graph", "check", POUR, "--task", "nowhere"], 2, "unknown task 'nowhere'")
+
+
 def test_run_refuses_a_towel_graph_on_the_blocks_scene():
     from agentchord.tasks import load_task_graph
 

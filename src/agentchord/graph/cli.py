@@ -14,6 +14,7 @@ import click
 
 from agentchord.cli_support import EXIT_BAD_INPUT, BadInput, check_outputs
 from agentchord.graph.exceptions import GraphError, GraphFileError
+from agentchord.graph.grounding import check_scene
 from agentchord.graph.loader import JSON_SUFFIXES, YAML_SUFFIXES, dump_graph, load_graph
 from agentchord.graph.models import TaskGraph
 from agentchord.graph.progress import forward_filter
@@ -50,11 +51,14 @@ def _load_or_exit(path: Path) -> TaskGraph:
 
 @graph_group.command("check")
 @click.argument("files", nargs=-1, required=True, type=click.Path(dir_okay=False, path_type=Path))
-def check_command(files: tuple[Path, ...]) -> None:
+@click.option("--task", "task", default=None, help="Also check the graph's objects against this simulated task's scene.")
+def check_command(files: tuple[Path, ...], task: str | None) -> None:
     """Validate graph FILES: print one line per problem, exit 2 if any.
 
-    A valid file prints ``FILE: ok (N nodes, M edges, K failure modes)``.
+    A valid file prints ``FILE: ok (N nodes, M edges, K failure modes)``. With ``--task``,
+    each graph must also name only objects of that task's scene (as ``run`` requires).
     """
+    scene = _scene_objects(task) if task is not None else None
     failed = False
     for path in files:
         try:
@@ -62,7 +66,8 @@ def check_command(files: tuple[Path, ...]) -> None:
         except GraphFileError as error:
             problems = error.problems
         else:
-            problems = [f"{path}: {problem}" for problem in check_graph(graph)]
+            found = check_graph(graph) + (check_scene(graph, scene, task) if scene is not None else [])
+            problems = [f"{path}: {problem}" for problem in found]
         if problems:
             failed = True
             for line in problems:
@@ -72,6 +77,19 @@ def check_command(files: tuple[Path, ...]) -> None:
             f"{path}: ok ({len(graph.nodes)} nodes, {len(graph.edges)} edges, {len(graph.failures())} failure modes)"
         )
     sys.exit(EXIT_BAD_INPUT if failed else 0)
+
+
+def _scene_objects(task: str) -> list[str]:
+    """The names the feature frame of ``task``'s scene holds (objects, cloth points)."""
+    import numpy as np  # noqa: PLC0415
+
+    from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: PLC0415
+    from agentchord.worlds.sim.world import SimWorld  # noqa: PLC0415
+
+    if task not in SIM_TASKS:
+        raise click.BadParameter(f"unknown task {task!r} (tasks: {', '.join(SIM_TASKS)})", param_hint="--task")
+    world = SimWorld(SIM_TASKS[task].sample_scene(np.random.default_rng(0)))
+    return [*world.object_names, *world.cloth_point_names]
 
 
 @graph_group.command("render")
