@@ -11,7 +11,7 @@ from __future__ import annotations
 import keyword
 from typing import Annotated
 
-from pydantic import AfterValidator
+from pydantic import AfterValidator, Field
 
 from agentchord.expr.compiler import CALLABLES
 from agentchord.features.frame import ARMS
@@ -56,5 +56,10 @@ def check_object_name(name: str) -> str:
     return name
 
 
-#: A ``str`` field holding an object name, checked by :func:`check_object_name`.
-ObjectName = Annotated[str, AfterValidator(check_object_name)]
+#: A ``str`` field holding an object name, checked by :func:`check_object_name`; its JSON Schema
+#: carries the pattern, so that structured output (an LLM's reply) follows it too.
+ObjectName = Annotated[
+    str,
+    AfterValidator(check_object_name),
+    Field(json_schema_extra={"pattern": "^[A-Za-z_][A-Za-z0-9_]*$", "maxLength": MAX_NAME_LENGTH}),
+]
