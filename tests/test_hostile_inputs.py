@@ -384,6 +384,17 @@ def test_one_failing_output_does_not_lose_the_others(tmp_path):
     assert good.read_text() == "{}"
 
 
+def test_writing_to_a_device_or_through_a_symlink_keeps_them(tmp_path):
+    atomic_write_text("/dev/null", "discarded")
+    assert Path("/dev/null").is_char_device()
+    target = tmp_path / "real.json"
+    link = tmp_path / "link.json"
+    link.symlink_to(target)
+    check_output_path(link)
+    atomic_write_text(link, "{}")
+    assert link.is_symlink() and target.read_text() == "{}"
+
+
 def test_check_output_path_leaves_nothing_behind(tmp_path):
     path = check_output_path(tmp_path / "new" / "x.json", (".json",), "--json")
     assert path.parent.is_dir() and os.listdir(path.parent) == []

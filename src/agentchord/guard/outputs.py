@@ -47,7 +47,9 @@ def check_output_path(path: str | Path, suffixes: Iterable[str] = (), option: st
         raise OutputPathError(given, "it is a directory; give a file name", option)
     if path.exists() and not os.access(path, os.W_OK):
         raise OutputPathError(given, "the file exists and is not writable", option)
-    folder = path.parent
+    if path.exists() and not path.is_file():
+        return path  # a device or FIFO (/dev/null, /dev/stdout): written in place, nothing to probe
+    folder = Path(os.path.realpath(path)).parent  # a symlink's target is what gets written
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as error:
@@ -67,12 +69,21 @@ def atomic_write_bytes(path: str | Path, data: bytes) -> Path:
     Raises:
         OutputPathError: The folder cannot be written or the disk is full.
     """
-    path = Path(path)
+    given = Path(path)
+    if given.exists() and not given.is_file():
+        # /dev/null, /dev/stdout, a FIFO: renaming over them would replace the device itself.
+        try:
+            with open(given, "wb") as stream:
+                stream.write(data)
+        except OSError as error:
+            raise OutputPathError(str(given), _reason(error)) from None
+        return given
+    path = Path(os.path.realpath(given))  # through a symlink to its target, the link kept
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     except OSError as error:
-        raise OutputPathError(str(path), _reason(error)) from None
+        raise OutputPathError(str(given), _reason(error)) from None
     try:
         with os.fdopen(fd, "wb") as stream:
             stream.write(data)
@@ -87,8 +98,8 @@ def atomic_write_bytes(path: str | Path, data: bytes) -> Path:
     except OSError as error:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
-        raise OutputPathError(str(path), _reason(error)) from None
-    return path
+        raise OutputPathError(str(given), _reason(error)) from None
+    return given
 
 
 def atomic_write_text(path: str | Path, text: str) -> Path:
