@@ -89,3 +89,39 @@ def test_cup_shifted_while_the_bottle_approaches_or_pours_is_followed(action, ed
     switch = result.trace.of("recovery_switch")[0]
     assert (switch["failure"], switch["edge"], switch["to"]) == ("cup_shifted", edge, entry)
     assert result.trace.of("disturbance")[0]["kind"] == "shift"
+
+
+# --- feasibility, arm binding and unrecoverable objects (the real-world protocol) ---------------
+
+def test_a_pulled_object_out_of_the_busy_arms_reach_is_taken_by_the_other_arm():
+    from agentchord.worlds.sim.disturbances import ScriptedDisturbance
+
+    pull = ScriptedDisturbance("move_to_obj", "pull", after=15, seed=2, spot=(-0.3, 0.8), lying=False)
+    result = run_episode(EpisodeSpec("single_arm_pour_water", seed=2, disturbance=pull))
+    bound = result.trace.of("recovery_bound")[0]
+    assert bound["edge"] == "e2_r_bottle_dropped_via_left"
+    assert "out of the right arm's reach" in bound["refused"][0]["reason"]
+    assert result.success, result.reason
+
+
+def test_an_object_off_the_table_ends_the_episode_as_unrecoverable_at_once():
+    from agentchord.worlds.sim.disturbances import ScriptedDisturbance
+
+    pull = ScriptedDisturbance("move_to_obj", "pull", after=15, seed=1, spot=(0.0, 1.2), lying=False)
+    result = run_episode(EpisodeSpec("single_arm_pour_water", seed=1, disturbance=pull))
+    assert not result.success and result.unrecoverable and result.summary()["unrecoverable"]
+    assert result.reason.startswith("unrecoverable: ") and "bottle" in result.reason
+    pulled = result.trace.of("disturbance")[0]["tick"]
+    assert result.steps - pulled < 150  # the hand's carry and the rest check, not the 4000-tick budget
+
+
+def test_a_perturbed_grasp_re_approaches_the_object_where_it_is_now():
+    from agentchord.worlds.sim.disturbances import ScriptedDisturbance
+
+    push = ScriptedDisturbance("grasp", "perturb", after=40, seed=3)
+    result = run_episode(EpisodeSpec("single_arm_pour_water", seed=2, disturbance=push))
+    assert result.trace.of("disturbance")[0]["kind"] == "perturb"
+    detected = result.trace.of("failure_detected")
+    assert detected and detected[0]["failure"] == "bottle_shifted"
+    assert result.trace.of("recovery_switch")[0]["to"] == "e1_r_bottle_dropped"
+    assert result.success, result.reason

@@ -67,3 +67,21 @@ def test_protocol_injects_one_or_two_disturbances_identically_for_both_strategie
     firsts = [run_episode(EpisodeSpec(TASK, strategy=s, seed=1, protocol=True, disturb=KINDS)).trace.of("disturbance")[:1]
               for s in ("agentchord", "agentchord-bt")]
     assert firsts[0] == firsts[1] and firsts[0]
+
+
+def test_presets_name_the_papers_protocols():
+    from agentchord.worlds.sim.disturbances import PRESETS
+
+    assert PRESETS["real"] == ("perturb", "pull") and PRESETS["stress"] == KINDS
+
+
+@pytest.mark.parametrize("kind,low,high", [("pull", 0.04, 0.30), ("perturb", 0.01, 0.08)])
+def test_landings_stay_in_the_stated_ranges(kind, low, high):
+    from agentchord.bench.landing import landing
+
+    landings = [x for x in (landing(kind, seed) for seed in range(3)) if x is not None]
+    assert len(landings) >= 2
+    for x in landings:
+        assert not x.off_table
+        assert low <= x.moved <= high, (x.seed, x.moved)
+        assert any(x.reachable.values())

@@ -1,7 +1,8 @@
 """The ``agentchord`` command line.
 
-Exit statuses: 0 success, 1 task failure (``run``) or invalid graph
-(``graph check``), 2 bad input (click's usage errors, unreadable files).
+Exit statuses (:mod:`agentchord.cli_support`): 0 success, 1 the task failed (``run``),
+2 bad input (usage errors, unreadable or invalid files, unwritable output paths),
+3 internal error (one line, the traceback in a log file it names).
 """
 
 from __future__ import annotations
@@ -15,12 +16,24 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
 from agentchord import __version__
+from agentchord.cli_support import BadInput, FiniteFloatRange, GuardedGroup, check_outputs
 from agentchord.graph.cli import graph_group, import_release_command, schema_command
+from agentchord.guard.outputs import atomic_write_text, finite_json
 
 STRATEGY_NAMES = ("agentchord", "agentchord-bt")
 REASONER_NAMES = ("rules", "llm")
 PERCEPTION_NAMES = ("oracle", "rgbd")
 DISTURB_HELP = "Disturbance kinds, comma-separated: drop, pull, perturb, shift, knock."
+PROTOCOL_NAMES = ("real", "stress", "custom")
+PROTOCOL_HELP = ("1-2 disturbances at random moments of each trial (ignores --p): 'real' = perturb + pull (the paper's "
+                 "real-world protocol, Table II), 'stress' = all five kinds; bare --protocol (= custom) uses --disturb.")
+
+
+def _protocol_kinds(protocol: str | None, disturb: tuple[str, ...]) -> tuple[str, ...]:
+    """The disturbance kinds a protocol preset stands for (``custom`` and no protocol: ``--disturb``)."""
+    from agentchord.worlds.sim.disturbances import PRESETS  # noqa: PLC0415
+
+    return PRESETS.get(protocol or "", disturb)
 
 
 def _kinds(ctx, param, value: str) -> tuple[str, ...]:
@@ -39,7 +52,7 @@ def _task_name(task: str, param_hint: str) -> None:
         raise click.BadParameter(f"unknown task {task!r} (tasks: {', '.join(SIM_TASKS)})", param_hint=param_hint)
 
 
-@click.group()
+@click.group(cls=GuardedGroup)
 @click.version_option(__version__, prog_name="agentchord")
 def main() -> None:
     """AgentChord: recovery-augmented task graphs for robot manipulation."""
@@ -87,7 +100,7 @@ def _load_graph_option(graph_path: str | None):
 @main.command()
 @click.argument("instruction", required=False)
 @click.option("--task", required=True, help="Simulated task whose seeded scene is the first observation.")
-@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the scene.")
+@click.option("--seed", type=click.IntRange(0), default=0, show_default=True, help="Seed of the scene.")
 @click.option("--goal", "goal_path", type=click.Path(exists=True, dir_okay=False), help="A goal spec (YAML/JSON) instead of reading INSTRUCTION.")
 @click.option("--reasoner", type=click.Choice(REASONER_NAMES), default="rules", show_default=True)
 @click.option("--perception", type=click.Choice(PERCEPTION_NAMES), default="oracle", show_default=True)
@@ -110,6 +123,7 @@ def plan(instruction, task, seed, goal_path, reasoner, perception, output, rende
     from agentchord.worlds.sim.world import SimWorld  # noqa: PLC0415
 
     _task_name(task, "--task")
+    _check_plan_outputs(output, render_path, trace_path)
     goal = _load_goal_option(goal_path)
     if not instruction and goal is None:
         raise click.UsageError("give an INSTRUCTION or --goal")
@@ -120,7 +134,7 @@ def plan(instruction, task, seed, goal_path, reasoner, perception, output, rende
         agent = make_reasoner(reasoner, goal=goal, watch_visibility=perception == "rgbd")
         result = plan_task(instruction or "", scene, agent, task=task)
     except ReasonerError as exc:
-        raise click.UsageError(str(exc)) from exc
+        raise click.UsageError(str(exc) + _failed_calls_trace(exc, trace_path)) from exc
     console = Console()
     graph = result.graph
     dump_graph(graph, output)
@@ -146,11 +160,12 @@ def plan(instruction, task, seed, goal_path, reasoner, perception, output, rende
 @main.command()
 @click.argument("task")
 @click.option("--strategy", type=click.Choice(STRATEGY_NAMES), default="agentchord", show_default=True)
-@click.option("--p", "p", type=click.FloatRange(0.0, 1.0), default=0.0, show_default=True, help="Disturbance probability per atomic action.")
+@click.option("--p", "p", type=FiniteFloatRange(0.0, 1.0), default=0.0, show_default=True, help="Disturbance probability per atomic action.")
 @click.option("--disturb", default="drop", show_default=True, callback=_kinds, help=DISTURB_HELP)
-@click.option("--protocol", is_flag=True, help="The paper's real-world protocol: 1-2 disturbances at random moments (ignores --p).")
+@click.option("--protocol", type=click.Choice(PROTOCOL_NAMES), is_flag=False, flag_value="custom", default=None,
+              help=PROTOCOL_HELP)
 @click.option("--perception", type=click.Choice(PERCEPTION_NAMES), default="oracle", show_default=True)
-@click.option("--seed", type=int, default=0, show_default=True)
+@click.option("--seed", type=click.IntRange(0), default=0, show_default=True)
 @click.option("--graph", "graph_path", type=click.Path(exists=True, dir_okay=False), help="Graph file (default: the task library's).")
 @click.option("--instruction", help="Plan the graph from this instruction on the episode's first observation.")
 @click.option("--goal", "goal_path", type=click.Path(exists=True, dir_okay=False), help="Plan from a goal spec file (YAML/JSON) instead.")
@@ -169,6 +184,8 @@ def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, inst
     from agentchord.execution.episode import EpisodeSpec  # noqa: PLC0415
 
     _task_name(task, "TASK")
+    check_outputs(("--trace", trace_path, ()), ("--json", json_path, ()), ("--video", video_path, (".mp4",)))
+    _check_camera(task, camera, video_path)
     graph = _load_graph_option(graph_path)
     goal = _load_goal_option(goal_path)
     if graph is not None and (instruction or goal):
@@ -197,31 +214,107 @@ def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, inst
         caption = f"{task}  node {executor.node}  edge {program.edge_id if program else '-'} ({program.kind if program else ''})"
         video.capture(caption)
 
-    spec = EpisodeSpec(task=task, strategy=strategy, p=p, seed=seed, graph=graph, disturb=disturb, protocol=protocol,
+    disturb = _protocol_kinds(protocol, disturb)
+    spec = EpisodeSpec(task=task, strategy=strategy, p=p, seed=seed, graph=graph, disturb=disturb, protocol=protocol is not None,
                        perception=perception, instruction=instruction, goal=goal, reasoner=reasoner, repair=repair)
-    result = _run_or_explain(spec, on_tick)
+    result = _run_or_explain(spec, on_tick, trace_path, graph_path)
     _print_episode(console, result)
-    if trace_path:
-        result.trace.write(trace_path)
-        console.print(f"trace: {trace_path}")
-    if json_path:
-        Path(json_path).parent.mkdir(parents=True, exist_ok=True)
-        Path(json_path).write_text(json.dumps(result.summary(), indent=2) + "\n")
-        console.print(f"summary: {json_path}")
-    if video_path and "video" in recorder:
-        console.print(f"video: {recorder['video'].write()}")
+    _write_outputs(console, [
+        ("trace", trace_path, lambda: result.trace.write(trace_path)),
+        ("summary", json_path, lambda: atomic_write_text(json_path, finite_json(result.summary(), indent=2) + "\n")),
+        ("video", video_path if "video" in recorder else None, lambda: _write_video(recorder["video"], video_path)),
+    ])
     sys.exit(0 if result.success else 1)
 
 
-def _run_or_explain(spec, on_tick=None):
-    """Run an episode; a reasoner that cannot plan is bad input (exit 2), not a crash."""
+def _run_or_explain(spec, on_tick=None, trace_path=None, graph_path=None):
+    """Run an episode; a reasoner that cannot plan, or a graph that cannot run here, is bad input (exit 2)."""
     from agentchord.agents.exceptions import ReasonerError  # noqa: PLC0415
     from agentchord.execution.episode import run_episode  # noqa: PLC0415
+    from agentchord.graph.exceptions import GraphNotRunnableError  # noqa: PLC0415
 
     try:
         return run_episode(spec, on_tick=on_tick)
     except ReasonerError as exc:
-        raise click.UsageError(str(exc)) from exc
+        raise click.UsageError(str(exc) + _failed_calls_trace(exc, trace_path)) from exc
+    except GraphNotRunnableError as exc:
+        source = graph_path or exc.source
+        raise BadInput("the graph cannot run:\n" + "\n".join(f"{source}: {line}" for line in exc.lines)) from exc
+
+
+def _check_camera(task: str, camera: str, video_path) -> None:
+    """Refuse an unknown --camera before the episode, not when its first frame is drawn."""
+    if video_path is None:
+        return
+    import mujoco  # noqa: PLC0415
+    import numpy as np  # noqa: PLC0415
+
+    from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: PLC0415
+    from agentchord.worlds.sim.world import SimWorld  # noqa: PLC0415
+
+    model = SimWorld(SIM_TASKS[task].sample_scene(np.random.default_rng(0))).model
+    cameras = [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_CAMERA, i) for i in range(model.ncam)]
+    if camera not in cameras:
+        raise click.BadParameter(f"no camera {camera!r} in the {task} scene (cameras: {', '.join(cameras)})",
+                                 param_hint="--camera")
+
+
+def _check_plan_outputs(output, render_path, trace_path) -> None:
+    from agentchord.graph.loader import JSON_SUFFIXES, YAML_SUFFIXES  # noqa: PLC0415
+    from agentchord.graph.render import FORMATS  # noqa: PLC0415
+
+    check_outputs(("-o", output, YAML_SUFFIXES + JSON_SUFFIXES), ("--render", render_path, FORMATS), ("--trace", trace_path, ()))
+
+
+def _failed_calls_trace(error, trace_path) -> str:
+    """Write the agents' calls of a failed plan (the replies that were refused) to the trace; say where."""
+    from agentchord.execution.trace import Trace  # noqa: PLC0415
+
+    calls = list(getattr(error, "calls", None) or ([error.call] if getattr(error, "call", None) else []))
+    if not trace_path or not calls:
+        return ""
+    trace = Trace()
+    for call in calls:
+        trace.add(0, "reasoner_call", **call.to_trace_event())
+    try:
+        return f"\n(the agents' calls, refused replies included: {trace.write(trace_path)})"
+    except OSError as exc:
+        return f"\n(the agents' calls could not be written to {trace_path}: {exc})"
+
+
+def _write_video(video, path) -> Path:
+    """Encode the video beside ``path`` and rename it over ``path``: never half an MP4."""
+    import os  # noqa: PLC0415
+    import tempfile  # noqa: PLC0415
+
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".mp4", dir=path.parent)  # the encoder needs .mp4
+    os.close(fd)
+    try:
+        video.path = Path(tmp)
+        video.write()
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # mkstemp's file is private; a video is not
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+    return path
+
+
+def _write_outputs(console: Console, outputs) -> None:
+    """Write each output (label, path, writer); one that fails does not stop the others. Exit 2 if any failed."""
+    failed = []
+    for label, path, write in outputs:
+        if not path:
+            continue
+        try:
+            console.print(f"{label}: {write()}")
+        except Exception as exc:  # noqa: BLE001 - whatever the writer raised, the other outputs still get written
+            failed.append(f"cannot write {label} {path}: {exc}")
+    if failed:
+        raise BadInput("\n".join(failed))
 
 
 def _load_goal_option(goal_path: str | None):
@@ -273,9 +366,11 @@ def _print_episode(console: Console, result) -> None:
 @main.command()
 @click.option("--task", default="single_arm_pour_water", show_default=True)
 @click.option("--trials", type=click.IntRange(1, 10000), default=20, show_default=True)
-@click.option("--p", "p", type=click.FloatRange(0.0, 1.0), default=0.1, show_default=True)
+@click.option("--seed", "first_seed", type=click.IntRange(0, 2**31), default=0, show_default=True, help="Seeds run from here: --seed N --trials T runs seeds N .. N+T-1.")
+@click.option("--p", "p", type=FiniteFloatRange(0.0, 1.0), default=0.1, show_default=True)
 @click.option("--disturb", default="drop", show_default=True, callback=_kinds, help=DISTURB_HELP)
-@click.option("--protocol", is_flag=True, help="The paper's real-world protocol: 1-2 disturbances at random moments (ignores --p).")
+@click.option("--protocol", type=click.Choice(PROTOCOL_NAMES), is_flag=False, flag_value="custom", default=None,
+              help=PROTOCOL_HELP)
 @click.option("--perception", type=click.Choice(PERCEPTION_NAMES), default="oracle", show_default=True)
 @click.option("--strategies", default=",".join(STRATEGY_NAMES), show_default=True, help="Comma-separated strategies to compare.")
 @click.option("--workers", type=click.IntRange(1, 64), default=None, help="Worker processes (default: one per core).")
@@ -283,7 +378,7 @@ def _print_episode(console: Console, result) -> None:
 @click.option("--instruction", help="Plan each episode's graph from this instruction (implies --planned).")
 @click.option("--reasoner", type=click.Choice(REASONER_NAMES), default="rules", show_default=True)
 @click.option("--json", "json_path", type=click.Path(dir_okay=False), help="Write the aggregates as JSON.")
-def demo(task, trials, p, disturb, protocol, perception, strategies, workers, planned, instruction, reasoner, json_path) -> None:
+def demo(task, trials, first_seed, p, disturb, protocol, perception, strategies, workers, planned, instruction, reasoner, json_path) -> None:
     """Seeded episodes of each strategy under random drops, then a table per strategy."""
     from agentchord.bench.report import aggregate, paired_steps, print_tables  # noqa: PLC0415
     from agentchord.bench.runner import run_many  # noqa: PLC0415
@@ -293,8 +388,10 @@ def demo(task, trials, p, disturb, protocol, perception, strategies, workers, pl
     if unknown or not names:
         raise click.BadParameter(f"unknown strategy {unknown} (choose from {', '.join(STRATEGY_NAMES)})", param_hint="--strategies")
     _task_name(task, "--task")
+    check_outputs(("--json", json_path, ()))
     console = Console()
-    schedule = "1-2 disturbances per trial (real-world protocol)" if protocol else f"probability p = {p} per atomic action"
+    disturb = _protocol_kinds(protocol, disturb)
+    schedule = f"1-2 disturbances per trial ({protocol} protocol)" if protocol else f"probability p = {p} per atomic action"
     console.print(f"[bold]{task}[/bold]: {trials} seeded episodes per strategy; disturbances {', '.join(disturb)}, "
                   f"{schedule}; perception {perception}")
     if planned and instruction is None:
@@ -303,9 +400,9 @@ def demo(task, trials, p, disturb, protocol, perception, strategies, workers, pl
         instruction = load_task_graph(task).instruction
     if instruction:
         console.print(f"graphs planned per episode by the {reasoner} reasoner from: {instruction!r}")
-    specs = [EpisodeSpec(task=task, strategy=name, p=p, seed=seed, disturb=disturb, protocol=protocol, perception=perception,
-                         instruction=instruction, reasoner=reasoner)
-             for name in names for seed in range(trials)]
+    specs = [EpisodeSpec(task=task, strategy=name, p=p, seed=seed, disturb=disturb, protocol=protocol is not None,
+                         perception=perception, instruction=instruction, reasoner=reasoner)
+             for name in names for seed in range(first_seed, first_seed + trials)]
     summaries: dict[str, list[dict]] = {name: [] for name in names}
     with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(), console=console) as bar:
         job = bar.add_task("episodes", total=len(specs))
@@ -318,10 +415,9 @@ def demo(task, trials, p, disturb, protocol, perception, strategies, workers, pl
     paired = paired_steps(summaries)
     print_tables(results, console, paired)
     if json_path:
-        payload = {"task": task, "p": p, "trials": trials, "disturb": list(disturb), "protocol": protocol,
+        payload = {"task": task, "p": p, "trials": trials, "first_seed": first_seed, "disturb": list(disturb), "protocol": protocol,
                    "perception": perception, "instruction": instruction, "reasoner": reasoner if instruction else None, "strategies": results, "paired_steps": paired}
-        Path(json_path).parent.mkdir(parents=True, exist_ok=True)
-        Path(json_path).write_text(json.dumps(payload, indent=2) + "\n")
+        atomic_write_text(json_path, finite_json(payload, indent=2) + "\n")
         console.print(f"aggregates: {json_path}")
 
 

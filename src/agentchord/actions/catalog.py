@@ -83,6 +83,11 @@ class PlaceArgs(_Args):
         False,
         description="If obj is not held but already stands upright on the table, only open and retreat (finish an interrupted synchronous place).",
     )
+    within_reach: Literal["left", "right"] | None = Field(
+        None,
+        description="Set obj down at the nearest free spot this (other) arm reaches, chosen when the action runs: "
+        "a hand-off in an arm-switching recovery; target and relative_to are then ignored.",
+    )
 
 
 class MoveToTargetArgs(_Args):

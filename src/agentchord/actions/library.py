@@ -27,11 +27,16 @@ from agentchord.actions.motion import (
     wait_for_rest,
 )
 from agentchord.features.frame import tilt_deg
+from agentchord.solvers.exceptions import NoHandoffSpotError
+from agentchord.solvers.handoff import handoff_spot
+from agentchord.solvers.ik import PoseTarget
 from agentchord.solvers.obstacles import held_spheres, scene_spheres
 from agentchord.worlds.sim.scene import ARM_JOINTS, ARM_PREFIX, FINGER_GAP_OFFSET, FINGER_RANGE, HOME_Q
 
 #: Tilt (deg) beyond which an object counts as fallen for a side grasp.
 UPRIGHT_TOLERANCE_DEG = 25.0
+#: A closed grasp whose grasp point is farther than this (m) from where the tool aimed is off-centre.
+OFF_CENTRE_TOLERANCE = 0.025
 
 
 class GraspMissed(ActionFailed):
@@ -127,20 +132,49 @@ class Grasp(ArmAction):
                 if attempt == self.ATTEMPTS - 1:
                     raise
 
-    def _attempt(self, robot: RobotController) -> Iterator[None]:
+    def _mode(self, robot: RobotController) -> str:
+        """How the object is taken now: ``top``, ``side`` (upright), ``fallen`` (lying) or ``leaning``."""
         feats = robot.frame.objects[self.args.obj]
-        if feats.pos[2] < -0.02:
-            raise ActionFailed(f"{self.args.obj} fell off the table")
         tilt = tilt_deg(feats.axis)
         height = float(np.linalg.norm(feats.top - feats.bottom))
         mode = self.args.mode
         if mode == "auto":
             mode = "side" if height >= self.SIDE_MIN_HEIGHT else "top"
         if mode == "top":
+            return "top"
+        if tilt <= UPRIGHT_TOLERANCE_DEG:
+            return "side"
+        return "fallen" if tilt >= self.FALLEN_DEG else "leaning"
+
+    def target_poses(self, robot: RobotController) -> list[PoseTarget]:
+        """The tool poses this grasp would go to from the current frame: above/before the object, then at it.
+
+        Feasibility checks (reach, IK) use them before the arm moves.
+        """
+        mode = self._mode(robot)
+        if mode == "top":
+            rotation, point = self._top_frame(robot)
+            pre = point + np.array([0.0, 0.0, self.args.pre_grasp_dis])
+        elif mode == "fallen":
+            rotation, point = self._fallen_frame(robot)
+            pre = point + np.array([0.0, 0.0, self.args.pre_grasp_dis])
+        else:
+            point = self._side_point(robot)
+            rotation = self._side_rotation(robot, point)
+            pre = point - self.args.pre_grasp_dis * rotation[:, 0]
+        return [pose_from_matrix(pre, rotation), pose_from_matrix(point, rotation)]
+
+    def _attempt(self, robot: RobotController) -> Iterator[None]:
+        feats = robot.frame.objects[self.args.obj]
+        if feats.pos[2] < -0.02:
+            raise ActionFailed(f"{self.args.obj} fell off the table")
+        mode = self._mode(robot)
+        tilt = tilt_deg(feats.axis)
+        if mode == "top":
             yield from self._top_grasp(robot)
-        elif tilt <= UPRIGHT_TOLERANCE_DEG:
+        elif mode == "side":
             yield from self._side_grasp(robot)
-        elif tilt >= self.FALLEN_DEG:
+        elif mode == "fallen":
             yield from self._fallen_grasp(robot)
             if self.args.reseat:
                 yield from self._reseat(robot)
@@ -199,18 +233,27 @@ class Grasp(ArmAction):
 
     def _close_and_check(self, robot: RobotController) -> Iterator[None]:
         yield from settle(robot, self.arm, max_ticks=30, required=0.015)
+        aimed = robot.commanded_pose(self.arm).pos.copy()
         yield from grip(robot, self.arm, 1.0)
         if not robot.frame.is_holding(self.arm, self.args.obj):
             raise GraspMissed(f"fingers closed but {self.args.obj} is not held")
+        # Pushed while the fingers closed, it is held off-centre (a pour or a place would then miss):
+        # where the grasp point is now, seen from where the tool aimed, says so.
+        off = float(np.linalg.norm(self.target_poses(robot)[-1].pos - aimed))
+        if off > OFF_CENTRE_TOLERANCE:
+            raise GraspMissed(f"{self.args.obj} is held {100 * off:.1f} cm off the grasp point")
+
+    def _side_rotation(self, robot: RobotController, point: np.ndarray) -> np.ndarray:
+        """The side-grasp tool frame: approach from the arm's base, or at the yaw asked for."""
+        if self.args.yaw is None:
+            return grasp_frame(point - robot.world.arm_base(self.arm))
+        yaw = np.radians(self.args.yaw)
+        return grasp_frame(np.array([np.cos(yaw), np.sin(yaw), 0.0]))
 
     def _side_grasp(self, robot: RobotController) -> Iterator[None]:
         arm = self.arm
         point = self._side_point(robot)
-        if self.args.yaw is None:
-            rotation = grasp_frame(point - robot.world.arm_base(arm))
-        else:
-            yaw = np.radians(self.args.yaw)
-            rotation = grasp_frame(np.array([np.cos(yaw), np.sin(yaw), 0.0]))
+        rotation = self._side_rotation(robot, point)
         pre = point - self.args.pre_grasp_dis * rotation[:, 0]
         if np.linalg.norm(robot.commanded_pose(arm).pos[:2] - pre[:2]) > 0.05:
             yield from self._clear_from_below(robot, pre[2] + 0.08)
@@ -281,17 +324,22 @@ class Grasp(ArmAction):
         lift = robot.commanded_pose(arm).pos + np.array([0.0, 0.0, lift_by])
         yield from move_to(robot, arm, pose_from_matrix(lift, rotation), speed=0.15)
 
-    def _fallen_grasp(self, robot: RobotController) -> Iterator[None]:
-        arm = self.arm
+    def _fallen_frame(self, robot: RobotController) -> tuple[np.ndarray, np.ndarray]:
+        """Tool rotation (approach down, fingers across the lying object's axis) and grasp point."""
         feats = robot.frame.objects[self.args.obj]
         top_dir = np.array([feats.axis[0], feats.axis[1], 0.0])
-        top_dir /= np.linalg.norm(top_dir)
-        # Tool frame for a top-down grasp: approach down, fingers across the object's axis.
+        top_dir /= max(np.linalg.norm(top_dir), 1e-9)
         down = np.array([0.0, 0.0, -1.0])
         rotation = np.column_stack([down, np.cross(top_dir, down), top_dir])
         radius = 0.5 * float(feats.extent[0])
         # The finger tips reach ~4 cm past the tool centre: stay high enough to miss the table.
-        point = np.r_[feats.pos[:2], max(feats.pos[2] + 0.35 * radius, self.FINGERTIP_REACH + 0.006)]
+        return rotation, np.r_[feats.pos[:2], max(feats.pos[2] + 0.35 * radius, self.FINGERTIP_REACH + 0.006)]
+
+    def _fallen_grasp(self, robot: RobotController) -> Iterator[None]:
+        arm = self.arm
+        feats = robot.frame.objects[self.args.obj]
+        rotation, point = self._fallen_frame(robot)
+        top_dir = rotation[:, 2]
         yield from self._clear_from_below(robot, point[2] + self.args.pre_grasp_dis + 0.05)
         yield from move_to(robot, arm, pose_from_matrix(point + np.array([0, 0, self.args.pre_grasp_dis]), rotation))
         # A top-down tool often flips the forearm roll: let the IK converge before descending.
@@ -397,7 +445,7 @@ class Place(ArmAction):
                     break  # finger contact flickered for a tick (a tray shifting in two grips): go on
             else:
                 raise ActionFailed(f"{self.args.obj} is not held: nothing to place")
-        if self.args.relative_to is not None:
+        if self.args.relative_to is not None and self.args.within_reach is None:
             # A pushed reference may still be sliding: aim at where it stops.
             yield from wait_for_rest(robot, self.args.relative_to)
         obj = robot.frame.objects[self.args.obj]
@@ -407,6 +455,11 @@ class Place(ArmAction):
         target = None if self.args.target is None else np.asarray(self.args.target, dtype=float)
         if target is not None and self.args.relative_to is not None:
             target = target + robot.frame.objects[self.args.relative_to].pos[:2]
+        if self.args.within_reach is not None:
+            try:
+                target = handoff_spot(robot.frame, self.args.obj, arm, self.args.within_reach)
+            except NoHandoffSpotError as error:
+                raise ActionFailed(str(error)) from None
         if self.args.yaw is not None:
             # Turn the tool about the vertical so the object's long axis ends at the asked yaw
             # (either direction), keeping the object's centre where it goes.
@@ -419,7 +472,7 @@ class Place(ArmAction):
             # Put the object's centre, not the tool, over the target.
             above[:2] += target - obj.pos[:2]
         above[2] = max(above[2], tool.pos[2])
-        if self.args.relative_to is not None:
+        if self.args.relative_to is not None and self.args.within_reach is None:
             # Carry the object over the reference's rim (into a cup, onto a block), not through it.
             host_top = robot.frame.objects[self.args.relative_to].top[2]
             above[2] = max(above[2], tool.pos[2] + host_top + RIM_CLEARANCE - obj.bottom[2])

@@ -44,8 +44,22 @@ def aggregate(summaries: list[dict]) -> dict:
         "reaction_latency_ticks_mean": round(mean(latencies), 2) if latencies else None,
         "reaction_latency_ticks_max": max(latencies) if latencies else None,
         "mean_wall_s": round(mean(s["wall_s"] for s in summaries), 3) if n else 0.0,
+        # Counted as failures in the success rate, and separately: objects beyond every arm's reach.
+        "unrecoverable": sum(bool(s.get("unrecoverable")) for s in summaries),
+        "disturbances": _disturbance_totals(summaries),
         "failures": sorted({s["reason"] for s in summaries if not s["success"]}),
     }
+
+
+def _disturbance_totals(summaries: list[dict]) -> dict[str, list[int]]:
+    """Per disturbance kind, [injected, detected, recovered] summed over the episodes."""
+    totals: dict[str, list[int]] = {}
+    for summary in summaries:
+        for kind, counts in summary.get("disturbances", {}).items():
+            row = totals.setdefault(kind, [0, 0, 0])
+            for k, count in enumerate(counts):
+                row[k] += count
+    return dict(sorted(totals.items()))
 
 
 def paired_steps(by_strategy: dict[str, list[dict]]) -> dict | None:
@@ -81,6 +95,10 @@ def strategy_table(name: str, stats: dict) -> Table:
     done = stats["mean_steps_success_with_drop"]
     table.add_row("mean steps, successful episodes with a drop", "-" if done is None else f"{done:.0f}")
     table.add_row("drops injected / detected / recovered", f"{stats['drops_injected']} / {stats['drops_detected']} / {stats['drops_recovered']}")
+    for kind, (injected, detected, recovered) in stats.get("disturbances", {}).items():
+        if kind != "drop":
+            table.add_row(f"{kind}: injected / detected / recovered", f"{injected} / {detected} / {recovered}")
+    table.add_row("unrecoverable episodes (counted as failures)", str(stats.get("unrecoverable", 0)))
     lat_mean, lat_max = stats["reaction_latency_ticks_mean"], stats["reaction_latency_ticks_max"]
     table.add_row("reaction latency mean / max (ticks)", "-" if lat_mean is None else f"{lat_mean:.1f} / {lat_max}")
     table.add_row("mean wall time per episode (s)", f"{stats['mean_wall_s']:.2f}")

@@ -25,6 +25,7 @@ from agentchord.actions.controller import RobotController
 from agentchord.agents.exceptions import ReasonerError
 from agentchord.agents.reasoner import UnanticipatedFailure
 from agentchord.execution.edge_program import EdgeProgram
+from agentchord.execution.feasibility import FeasibilityChecker, first_grasps, off_table
 from agentchord.execution.repair import RepairRejectedError, Repairer, validate_repair
 from agentchord.execution.strategies import RecoveryStrategy
 from agentchord.execution.trace import Trace
@@ -53,6 +54,38 @@ class ExecutorConfig:
     tick_limit: int = 4000
     failure_budget: int = 3
     max_repairs: int = 2
+    #: Ticks an object must stay off the table before the episode ends as unrecoverable.
+    off_table_ticks: int = 5
+    #: Ticks a recovery waits for the objects it grasps to come to rest before binding its arm.
+    bind_wait_ticks: int = 100
+
+
+#: Prefix of the reason of an episode that ended because no arm can take an object any more.
+UNRECOVERABLE = "unrecoverable"
+#: Object speed (m/s) under which it counts as at rest, and for how many ticks in a row.
+REST_SPEED = 0.03
+REST_TICKS = 10
+#: Height (m) under which an object's lower axis end must be to count as resting on the table.
+RESTING_HEIGHT = 0.05
+
+
+@dataclass
+class Binding:
+    """A recovery waiting to bind its arm: the candidates (entry edge, then its alternatives).
+
+    Attributes:
+        candidates: Programs to try in order.
+        objects: What their first grasps take: bound once these are at rest.
+        since: Tick the recovery began.
+        previous: Object positions at the last tick (for their speed).
+        still: Ticks in a row every object has been at rest.
+    """
+
+    candidates: list[EdgeProgram]
+    objects: list[str]
+    since: int
+    previous: dict[str, np.ndarray] = field(default_factory=dict)
+    still: int = 0
 
 
 @dataclass
@@ -80,6 +113,11 @@ class EpisodeResult:
     disturbances: dict[str, list[int]]
     trace: Trace = field(repr=False)
 
+    @property
+    def unrecoverable(self) -> bool:
+        """Whether it ended because an object was beyond every arm (off the table, out of reach)."""
+        return self.reason.startswith(UNRECOVERABLE)
+
     def summary(self) -> dict:
         """The JSON summary of ``agentchord run --json``."""
         return {
@@ -96,6 +134,7 @@ class EpisodeResult:
             "drops_recovered": self.drops_recovered,
             "reaction_latency_ticks": self.reaction_latency_ticks,
             "disturbances": self.disturbances,
+            "unrecoverable": self.unrecoverable,
             "path": self.path,
         }
 
@@ -143,12 +182,15 @@ class Executor:
         self.robot = RobotController(world)
         self.extractor = make_extractor(perception, world, lambda arm: self.robot.targets[arm].grip_closed_settled)
         self.robot.frame = self.extractor.frame
+        self.feasibility = FeasibilityChecker(self.robot)
         self._compile(filtered.graph)
         # Per reached nominal node: the robot's keyframe (arm joints and grips), for backtracking.
         self.keyframes: dict[str, dict[str, tuple[np.ndarray, float]]] = {}
         self.visited_nominal: list[str] = []
         self.path: list[str] = []
         self.program: EdgeProgram | None = None
+        self.binding: Binding | None = None
+        self._off_table_since: dict[str, int] = {}
         self.armed: EdgeMonitors | None = None
         self.recovering_from: str | None = None
         self.fire_counts: dict[tuple[str, str], int] = {}
@@ -243,26 +285,96 @@ class Executor:
                 self.trace.add(event.tick, "disturbance", kind=event.kind, arm=event.arm, obj=event.obj, action=event.action)
         if self.world.tick >= self.config.tick_limit:
             return False, f"tick limit {self.config.tick_limit} reached at {self._where()}"
+        lost = self._lost_objects(frame)
+        if lost is not None:
+            return False, lost
+        if self.binding is not None:
+            outcome = self._bind(frame)
+            if outcome is not None:
+                return outcome
+            if self.binding is not None:  # still waiting: the arms hold their poses
+                self.robot.step()
+                if self.on_tick is not None:
+                    self.on_tick(self)
+                return None
         if self.armed is not None:
             detection = self.armed.evaluate(frame)
             if detection is not None:
                 outcome = self._on_failure(detection)
                 if outcome is not None:
                     return outcome
-        status = self.program.update(self.robot)
-        if status == Status.FAILURE:
-            return False, f"{self._where()}: {self.program.failure_reason}"
-        if status == Status.SUCCESS:
-            outcome = self._on_program_done()
-            if outcome is not None:
-                return outcome
+        if self.program is not None:
+            status = self.program.update(self.robot)
+            if status == Status.FAILURE:
+                return False, f"{self._where()}: {self.program.failure_reason}"
+            if status == Status.SUCCESS:
+                outcome = self._on_program_done()
+                if outcome is not None:
+                    return outcome
         self.robot.step()
         if self.on_tick is not None:
             self.on_tick(self)
         return None
 
     def _where(self) -> str:
+        if self.binding is not None:
+            return f"recovery {self.binding.candidates[0].edge_id} (binding its arm)"
         return f"edge {self.program.edge_id}" if self.program else f"node {self.node}"
+
+    def _lost_objects(self, frame: FeatureFrame) -> str | None:
+        """The unrecoverable reason once a graph object has been off the table for a few ticks."""
+        lost = off_table(frame, self.graph.objects)
+        self._off_table_since = {name: self._off_table_since.get(name, self.world.tick) for name in lost}
+        for name, since in self._off_table_since.items():
+            if self.world.tick - since >= self.config.off_table_ticks:
+                z = frame.objects[name].pos[2]
+                self.trace.add(self.world.tick, "unrecoverable", obj=name, reason="off the table")
+                return f"{UNRECOVERABLE}: {name} fell off the table (z = {z:.2f} m, table top at 0) at {self._where()}"
+        return None
+
+    # ------------------------------------------------------- binding
+    def _begin_recovery(self, candidates: list[EdgeProgram]) -> tuple[bool, str] | None:
+        """Start a recovery: at once when it grasps nothing, else after binding its arm."""
+        objects = sorted({g.args.obj for c in candidates for g in first_grasps(c)})
+        if not objects:
+            self._start(candidates[0])
+            return None
+        # The arms hold still while what was dropped or taken comes to rest; then the arm is bound.
+        self.program, self.armed = None, None
+        self.binding = Binding(candidates, objects, self.world.tick)
+        return None
+
+    def _bind(self, frame: FeatureFrame) -> tuple[bool, str] | None:
+        """One tick of a binding recovery: wait for rest, then start the first feasible candidate."""
+        binding = self.binding
+        speeds = [np.linalg.norm(frame.objects[o].pos - binding.previous[o]) * CONTROL_HZ
+                  for o in binding.objects if o in binding.previous]
+        binding.previous = {o: frame.objects[o].pos.copy() for o in binding.objects}
+        # At rest on the table: still, and low (a hand pausing mid-air is not a resting place).
+        low = all(min(frame.objects[o].bottom[2], frame.objects[o].top[2]) < RESTING_HEIGHT for o in binding.objects)
+        at_rest = len(speeds) == len(binding.objects) and max(speeds) < REST_SPEED and low
+        binding.still = binding.still + 1 if at_rest else 0
+        waited = self.world.tick - binding.since
+        if binding.still < REST_TICKS and waited < self.config.bind_wait_ticks:
+            return None
+        self.binding = None
+        refused = []
+        for candidate in binding.candidates:
+            problems = self.feasibility.check_program(candidate)
+            if not problems:
+                self.trace.add(self.world.tick, "recovery_bound", edge=candidate.edge_id, waited_ticks=waited,
+                               refused=refused, arms=sorted({a.arm for step in candidate.steps for a in step}))
+                self._start(candidate)
+                return None
+            refused.append({"edge": candidate.edge_id, "reason": "; ".join(p.reason for p in problems)})
+        summary = "; ".join(f"{r['edge']}: {r['reason']}" for r in refused)
+        for obj in binding.objects:
+            beyond = self.feasibility.unreachable(obj)
+            if beyond:
+                self.trace.add(self.world.tick, "unrecoverable", obj=obj, reason="; ".join(c.reason for c in beyond))
+                return False, (f"{UNRECOVERABLE}: no arm can take {obj} at {self.feasibility.where(obj)} "
+                               f"({'; '.join(c.reason for c in beyond)})")
+        return False, f"no feasible recovery for {', '.join(binding.objects)} at {self.feasibility.where(binding.objects[0])}: {summary}"
 
     # ------------------------------------------------------- transitions
     def _arrive(self, node_id: str) -> tuple[bool, str] | None:
@@ -287,7 +399,15 @@ class Executor:
         next_edge = self.strategy.next_edge(self, node_id)
         if next_edge is None:
             return False, f"no edge leaves node {node_id} toward the goal"
-        self._start(EdgeProgram.from_edge(self.graph.edge(next_edge)))
+        program = EdgeProgram.from_edge(self.graph.edge(next_edge))
+        for grasp in first_grasps(program):
+            # Before the arm moves: an object beyond every arm ends the episode now, not after budgets.
+            beyond = self.feasibility.unreachable(grasp.args.obj, confirm_ik=False)
+            if beyond:
+                self.trace.add(self.world.tick, "unrecoverable", obj=grasp.args.obj, reason="; ".join(c.reason for c in beyond))
+                return False, (f"{UNRECOVERABLE}: no arm can take {grasp.args.obj} at {self.feasibility.where(grasp.args.obj)} "
+                               f"({'; '.join(c.reason for c in beyond)})")
+        self._start(program)
         return None
 
     def _start(self, program: EdgeProgram) -> None:
@@ -339,15 +459,16 @@ class Executor:
             return False, f"failure budget exhausted: {detection.failure.name} on {detection.edge_id} fired {self.fire_counts[key]} times"
         if self.program is not None:  # None after an online repair: the failed edge had ended
             self.program.terminate(Status.INVALID)
+            self.program = None
         failed_nominal = self.recovering_from or detection.edge_id
-        program = self.strategy.recover(self, detection)
-        if program is None:
+        candidates = self.strategy.recover(self, detection)
+        if not candidates:
             return False, f"no recovery for {detection.failure.name} on {detection.edge_id}"
         self.recovering_from = failed_nominal
         self.trace.add(self.world.tick, "recovery_switch", failure=detection.failure.name, edge=detection.edge_id,
-                       to=program.edge_id, strategy=self.strategy.name, latency_ticks=self.world.tick - detection.onset_tick)
-        self._start(program)
-        return None
+                       to=candidates[0].edge_id, alternatives=[c.edge_id for c in candidates[1:]],
+                       strategy=self.strategy.name, latency_ticks=self.world.tick - detection.onset_tick)
+        return self._begin_recovery(candidates)
 
     def _repair(self, program: EdgeProgram) -> Detection | None:
         """Online repair of an unanticipated failure at the end of ``program``.

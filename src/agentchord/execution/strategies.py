@@ -26,19 +26,26 @@ class RecoveryStrategy:
         """The nominal edge to run from a nominal node."""
         return executor.nominal_next.get(node_id)
 
-    def recover(self, executor: Executor, detection: Detection) -> EdgeProgram | None:
-        """The program to switch to when ``detection`` fired (None: give up)."""
+    def recover(self, executor: Executor, detection: Detection) -> list[EdgeProgram]:
+        """The programs to switch to when ``detection`` fired, in order of preference (empty: give up).
+
+        The executor runs the first whose grasps are feasible once the objects are at rest.
+        """
         raise NotImplementedError
 
 
 class AgentChordStrategy(RecoveryStrategy):
-    """Switch to the pre-compiled forward-moving recovery edge (Eq. 13): no re-planning."""
+    """Switch to the pre-compiled forward-moving recovery edge (Eq. 13): no re-planning.
+
+    The entry edge and its alternatives (another arm's way there) are all candidates;
+    the executor binds the first the arms can make.
+    """
 
     name = "agentchord"
 
-    def recover(self, executor: Executor, detection: Detection) -> EdgeProgram | None:
-        entry = executor.recovery_map.entry(detection.edge_id, detection.failure.name)
-        return None if entry is None else EdgeProgram.from_edge(entry)
+    def recover(self, executor: Executor, detection: Detection) -> list[EdgeProgram]:
+        candidates = executor.recovery_map.candidates(detection.edge_id, detection.failure.name)
+        return [EdgeProgram.from_edge(edge) for edge in candidates]
 
 
 class BacktrackStrategy(RecoveryStrategy):
@@ -50,13 +57,13 @@ class BacktrackStrategy(RecoveryStrategy):
 
     name = "agentchord-bt"
 
-    def recover(self, executor: Executor, detection: Detection) -> EdgeProgram | None:
+    def recover(self, executor: Executor, detection: Detection) -> list[EdgeProgram]:
         for node_id in reversed(executor.visited_nominal):
             if executor.constraints_hold(node_id):
                 keyframe = executor.keyframes[node_id]
                 actions = [ReturnToKeyframe(arm, q, grip) for arm, (q, grip) in keyframe.items()]
-                return EdgeProgram(f"backtrack_to_{node_id}", node_id, [actions], kind="backtrack")
-        return None
+                return [EdgeProgram(f"backtrack_to_{node_id}", node_id, [actions], kind="backtrack")]
+        return []
 
 
 STRATEGIES: dict[str, type[RecoveryStrategy]] = {s.name: s for s in (AgentChordStrategy, BacktrackStrategy)}

@@ -13,7 +13,9 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, SerializerFunctionWrapHandler, field_serializer, field_validator
 
+from agentchord.expr.names import ObjectName
 from agentchord.graph.exceptions import UnknownEdgeError, UnknownNodeError
+from agentchord.guard.numbers import MAX_MAGNITUDE, check_finite
 
 Kind = Literal["nominal", "recovery"]
 
@@ -32,6 +34,12 @@ class ActionCall(_Model):
 
     fn: str
     args: dict[str, Any] = Field(default_factory=dict)
+
+    @field_validator("args")
+    @classmethod
+    def _finite_args(cls, args: dict[str, Any]) -> dict[str, Any]:
+        # NaN passes every range check; it must not reach a solver (guard.numbers says why).
+        return check_finite(args, MAX_MAGNITUDE)
 
 
 #: One step of an edge: arm name -> call, ``None`` for an idle arm. Both arms
@@ -99,6 +107,11 @@ class Edge(_Model):
         failures: Anticipated failure modes, each mapped to a recovery entry edge.
         cost: Expected execution cost in control ticks; ``None`` means the sum
             over steps of the catalogue's ``expected_ticks`` (slowest arm per step).
+        alternative_to: For a recovery entry edge's alternative: the id of that
+            entry edge. Same source and target, another way there (typically the
+            other arm). When a failure fires, the executor waits for the objects to
+            come to rest, then binds the first of ``[entry, *alternatives]`` (file
+            order) whose grasps the arms can make (reach model, confirmed by the IK).
     """
 
     id: str
@@ -109,6 +122,7 @@ class Edge(_Model):
     path_constraints: list[str] = Field(default_factory=list)
     failures: list[FailureMode] = Field(default_factory=list)
     cost: float | None = Field(None, ge=0.0, allow_inf_nan=False)
+    alternative_to: str | None = None
 
     @field_validator("actions", mode="before", json_schema_input_type=Step | list[Step])
     @classmethod
@@ -158,7 +172,7 @@ class TaskGraph(_Model):
     instruction: str = ""
     start: str
     goal: str
-    objects: list[str] = Field(default_factory=list)
+    objects: list[ObjectName] = Field(default_factory=list)
     nodes: list[Node]
     edges: list[Edge]
 
@@ -203,6 +217,10 @@ class TaskGraph(_Model):
     def failures(self) -> list[tuple[Edge, FailureMode]]:
         """Every ``(edge, failure mode)`` pair, in file order."""
         return [(edge, failure) for edge in self.edges for failure in edge.failures]
+
+    def alternatives(self, entry_id: str) -> list[Edge]:
+        """The alternatives of a recovery entry edge, in file order."""
+        return [e for e in self.edges if e.alternative_to == entry_id]
 
     def failure_entries(self) -> dict[tuple[str, str], str]:
         """The recovery map (Eq. 13): ``(edge id, failure name) -> recovery entry edge id``."""

@@ -175,8 +175,9 @@ def recovery_branches(graph: TaskGraph, distances: dict[str, float] | None = Non
     if distances is None:
         distances = cost_to_go(graph)
     branches = []
+    by_id = {e.id: e for e in graph.edges}  # one index, not a scan per branch (large graphs)
     for edge, failure in graph.failures():
-        entry = graph.edge(failure.recovery)
+        entry = by_id.get(failure.recovery) or graph.edge(failure.recovery)
         branches.append(
             RecoveryBranch(
                 failure=failure.name,
@@ -209,6 +210,9 @@ def recovery_reach(graph: TaskGraph, entries: Iterable[str]) -> tuple[set[str], 
     edges = {edge_id for edge_id in entries if edge_id in known}
     nodes: set[str] = set()
     frontier = [known[edge_id].target for edge_id in edges]
+    leaving: dict[str, list] = {}  # one index, not a scan per node (large graphs)
+    for edge in graph.edges:
+        leaving.setdefault(edge.source, []).append(edge)
     while frontier:
         node = frontier.pop()
         if node in nodes:
@@ -216,10 +220,17 @@ def recovery_reach(graph: TaskGraph, entries: Iterable[str]) -> tuple[set[str], 
         nodes.add(node)
         if node not in recovery_nodes:
             continue
-        for edge in graph.out_edges(node):
+        for edge in leaving.get(node, []):
             edges.add(edge.id)
             frontier.append(edge.target)
     return edges, nodes
+
+
+def with_alternatives(graph: TaskGraph, entries: Iterable[str]) -> list[str]:
+    """Recovery entry edge ids followed by the ids of their alternatives (``Edge.alternative_to``)."""
+    entries = list(entries)
+    wanted = set(entries)
+    return entries + [edge.id for edge in graph.edges if edge.alternative_to in wanted]
 
 
 def forward_filter(graph: TaskGraph) -> FilterResult:
@@ -248,8 +259,9 @@ def forward_filter(graph: TaskGraph) -> FilterResult:
     for edge in filtered.edges:
         edge.failures = [f for f in edge.failures if (edge.id, f.name) not in dropped]
 
-    before_edges, before_nodes = recovery_reach(graph, (b.recovery_edge for b in branches))
-    after_edges, after_nodes = recovery_reach(filtered, (b.recovery_edge for b in kept))
+    # An alternative (another arm's way along an entry edge) stands or falls with its entry edge.
+    before_edges, before_nodes = recovery_reach(graph, with_alternatives(graph, (b.recovery_edge for b in branches)))
+    after_edges, after_nodes = recovery_reach(filtered, with_alternatives(filtered, (b.recovery_edge for b in kept)))
     # Only what a removed branch made unreachable goes; nominal nodes always stay.
     gone_edges = {e.id for e in graph.recovery_edges() if e.id in before_edges - after_edges}
     gone_nodes = {n.id for n in graph.recovery_nodes() if n.id in before_nodes - after_nodes}

@@ -23,7 +23,7 @@ from agentchord.graph._hints import did_you_mean
 from agentchord.graph.exceptions import GraphFileError, UnknownActionError
 from agentchord.graph.loader import format_loc, load_graph
 from agentchord.graph.models import ActionCall, Edge, TaskGraph
-from agentchord.graph.progress import cost_to_go, recovery_branches, recovery_reach
+from agentchord.graph.progress import cost_to_go, recovery_branches, recovery_reach, with_alternatives
 
 
 @dataclass(frozen=True)
@@ -116,6 +116,8 @@ def _check_references(graph: TaskGraph) -> list[Problem]:
         for field, node_id in (("start", graph.start), ("goal", graph.goal))
         if node_id not in nodes
     ]
+    if graph.start == graph.goal:  # an episode would end before its first tick
+        problems.append(Problem("goal", f"the goal is the start node {graph.start!r}: the graph has nothing to do"))
     for i, edge in enumerate(graph.edges):
         for field in ("source", "target"):
             node_id = getattr(edge, field)
@@ -154,6 +156,33 @@ def _check_entries(graph: TaskGraph) -> list[Problem]:
                         f"{edge.source!r} (the source of edge {edge.id!r})",
                     )
                 )
+    return problems + _check_alternatives(graph)
+
+
+def _check_alternatives(graph: TaskGraph) -> list[Problem]:
+    """An alternative is another way along a recovery entry edge: same ends, a recovery edge itself."""
+    edges = {e.id: e for e in graph.edges}
+    entries = {failure.recovery for _, failure in graph.failures()}
+    problems = []
+    for i, edge in enumerate(graph.edges):
+        if edge.alternative_to is None:
+            continue
+        path = f"edges[{i}].alternative_to"
+        entry = edges.get(edge.alternative_to)
+        if entry is None:
+            problems.append(Problem(path, _unknown("edge", edge.alternative_to, edges)))
+            continue
+        if not edge.is_recovery:
+            problems.append(Problem(f"edges[{i}].kind", "an alternative of a recovery entry edge needs kind: recovery"))
+        if entry.id not in entries:
+            problems.append(Problem(path, f"edge {entry.id!r} is no failure mode's recovery entry edge"))
+        if entry.alternative_to is not None:
+            problems.append(Problem(path, f"edge {entry.id!r} is itself an alternative (of {entry.alternative_to!r})"))
+        if (edge.source, edge.target) != (entry.source, entry.target):
+            problems.append(
+                Problem(path, f"an alternative goes where its entry edge goes: {entry.id!r} is {entry.source} -> "
+                              f"{entry.target}, this edge {edge.source} -> {edge.target}")
+            )
     return problems
 
 
@@ -213,11 +242,16 @@ def _check_expressions(graph: TaskGraph) -> list[Problem]:
         sources += [(f"edges[{i}].path_constraints[{k}]", c) for k, c in enumerate(edge.path_constraints)]
         sources += [(f"edges[{i}].failures[{j}].monitor", f.monitor) for j, f in enumerate(edge.failures)]
     problems = []
+    verdicts: dict[str, str | None] = {}  # the same monitor recurs on many edges: compile it once
     for path, source in sources:
-        try:
-            compile_expr(source, vocabulary)
-        except ExprError as error:
-            problems.append(Problem(path, str(error)))
+        if source not in verdicts:
+            try:
+                compile_expr(source, vocabulary, finite_constants=True)
+                verdicts[source] = None
+            except ExprError as error:
+                verdicts[source] = str(error)
+        if verdicts[source] is not None:
+            problems.append(Problem(path, verdicts[source]))
     return problems
 
 
@@ -231,7 +265,7 @@ def _check_structure(graph: TaskGraph) -> list[Problem]:
         )
 
     entries = {f.recovery for _, f in graph.failures()}
-    reached_edges, reached_nodes = recovery_reach(graph, entries)
+    reached_edges, reached_nodes = recovery_reach(graph, with_alternatives(graph, entries))
     augmented = nx.DiGraph((e.source, e.target) for e in graph.edges)
     augmented.add_node(graph.goal)
     to_goal = nx.ancestors(augmented, graph.goal) | {graph.goal}

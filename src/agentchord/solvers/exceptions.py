@@ -52,3 +52,20 @@ class PathNotReachedError(SolverError):
     def __reduce__(self) -> tuple[Any, ...]:
         # The bench runner ships errors between processes: keep the attached result.
         return (type(self), (str(self), self.path))
+
+
+class NoHandoffSpotError(SolverError):
+    """No spot on the table is reachable by both arms and clear of the other objects.
+
+    Attributes:
+        obj: The object to set down.
+        placer: The arm that would set it down.
+        taker: The arm that would take it.
+    """
+
+    def __init__(self, obj: str, placer: str, taker: str) -> None:
+        self.obj, self.placer, self.taker = obj, placer, taker
+        super().__init__(f"no free spot on the table where the {placer} arm can set {obj} down for the {taker} arm")
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (type(self), (self.obj, self.placer, self.taker))

@@ -1,14 +1,20 @@
 """Seeded disturbances: the paper's random drop and its real-world disturbance kinds.
 
-Kinds (all physical: forces and gripper faults, never teleports):
+Kinds, each modelled on what a person (or a gripper fault) does to the scene; all
+are physical (forces and gripper faults, never teleports). docs/disturbances.md
+states the models and the landing statistics ``benchmarks/bench_disturbances.py``
+measures.
 
-- ``drop``: the held object falls: the gripper is forced open for a moment.
-- ``pull``: the held object is taken out of the gripper during motion: the
-  gripper is forced open and the object is shoved away from the hand.
-- ``perturb``: the object being grasped is pushed before the fingers close.
+- ``drop``: the held object falls from where it is held: the gripper is forced
+  open for a moment.
+- ``pull``: a person takes the held object out of the gripper during motion and
+  sets it down on the table, upright or (a tall object) on its side, at a seeded
+  spot 6-25 cm from where it was taken (a person's hand: ``hand.PersonHand``).
+- ``perturb``: the object being grasped is pushed a few centimetres (2-5 cm)
+  before the fingers close.
 - ``shift``: a target the action refers to (the cup the bottle approaches;
   for an action without an object, the free object nearest the tool) slides
-  to a new place.
+  5-8 cm.
 - ``knock``: an object nobody holds is knocked over (a push high on it).
 
 Two schedules. :class:`RandomDisturbances` draws once per atomic action
@@ -17,6 +23,8 @@ simulated protocol, a stream that two strategies with the same seed consume
 identically for their n-th action. :class:`ProtocolDisturbances` is the
 paper's real-world protocol: one or two disturbances at random moments of
 each trial. Scripted variants inject one chosen disturbance, for tests.
+Presets (:data:`PRESETS`): ``real`` = perturb + pull (the paper's Table II),
+``stress`` = every kind (its Fig. 4 style stress test).
 """
 
 from __future__ import annotations
@@ -25,17 +33,38 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from agentchord.features.frame import FeatureFrame
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.worlds.sim.hand import set_down_path
+from agentchord.worlds.sim.world import CONTROL_HZ, SimWorld
 
 if TYPE_CHECKING:
     from agentchord.actions.base import ArmAction
 
 #: Every disturbance kind, in a fixed order (the order seeded choices index into).
 KINDS = ("drop", "pull", "perturb", "shift", "knock")
+#: Protocol presets: the paper's real-world protocol (Table II) and the all-kinds stress test.
+PRESETS: dict[str, tuple[str, ...]] = {"real": ("perturb", "pull"), "stress": KINDS}
 #: How long a gripper fault forces the fingers open (ticks at 50 Hz).
 FAULT_TICKS = 12
+#: A person sets a pulled object down this far (m, horizontal) from where they took it ...
+SET_DOWN_DISTANCE = (0.06, 0.25)
+#: ... inside this part of the table (x range, y range; m): in front of the robot, off its bases ...
+SET_DOWN_AREA = ((-0.32, 0.32), (0.28, 0.85))
+#: ... at least this far (m, horizontal) from either arm's base, and this far clear of other objects;
+#: within the robot's workspace: this far (m, horizontal) from at least one arm's shoulder (the
+#: experimenter tests recovery, not reach: an object put beyond the arms is a different experiment).
+SET_DOWN_BASE_CLEARANCE = 0.30
+SET_DOWN_WORKSPACE = (0.36, 0.62)
+SET_DOWN_OBJECT_CLEARANCE = 0.03
+#: Share of tall objects (a bottle) a person sets down on their side rather than upright.
+LYING_SHARE = 0.3
+#: A perturbation pushes the object being grasped this far (m), a shift this far.
+PERTURB_DISTANCE = (0.02, 0.05)
+SHIFT_DISTANCE = (0.05, 0.08)
+#: Ticks a push lasts.
+PUSH_TICKS = 5
 
 
 @dataclass
@@ -67,10 +96,78 @@ def _free_objects(frame: FeatureFrame, world: SimWorld) -> list[str]:
     return sorted(name for name in world.object_names if name not in held)
 
 
-def _slide(world: SimWorld, obj: str, direction: np.ndarray, ticks: int = 6) -> None:
-    # Overcome sliding friction plus 6 m/s^2 for 0.12 s: the object slides ~5-8 cm.
+def _slide(world: SimWorld, obj: str, direction: np.ndarray, distance: float) -> None:
+    """Push ``obj`` along ``direction`` so that it slides about ``distance`` (m) on the table.
+
+    A net acceleration a for T s beyond sliding friction, then friction stops it:
+    distance = a T^2 / 2 + (a T)^2 / (2 mu g); solved for a. A cylinder lying on its
+    side is pushed along its axis (pushed across it, it would roll away, not slide).
+    """
     spec = world.object_spec(obj)
-    world.push(obj, spec.mass * (spec.friction * 9.81 + 6.0) * direction, ticks=ticks)
+    axis = world.object_pose(obj)[1][:, 2]
+    if spec.shape == "cylinder" and abs(axis[2]) < 0.5:
+        along = np.array([axis[0], axis[1], 0.0]) / max(np.linalg.norm(axis[:2]), 1e-9)
+        direction = along if float(np.dot(along, direction)) >= 0.0 else -along
+    seconds = PUSH_TICKS / CONTROL_HZ
+    mu_g = max(spec.friction, 0.1) * 9.81
+    # a^2 T^2 / (2 mu g) + a T^2 / 2 - distance = 0
+    qa, qb = seconds**2 / (2.0 * mu_g), 0.5 * seconds**2
+    accel = (-qb + np.sqrt(qb * qb + 4.0 * qa * distance)) / (2.0 * qa)
+    world.push(obj, spec.mass * (mu_g + accel) * direction, ticks=PUSH_TICKS)
+
+
+def _footprint(spec) -> float:
+    """Radius (m) of the circle an upright object covers on the table."""
+    return float(spec.size[0]) if spec.shape == "cylinder" else float(np.hypot(spec.size[0], spec.size[1]))
+
+
+def _set_down_spot(world: SimWorld, frame: FeatureFrame, obj: str, rng: np.random.Generator) -> np.ndarray:
+    """A spot on the table where a person sets ``obj`` down: near where they took it, clear of things."""
+    here = frame.objects[obj].pos[:2]
+    spec = world.object_spec(obj)
+    bases = [world.arm_base(arm)[:2] for arm in ("left", "right")]
+    others = [(frame.objects[n].pos[:2], _footprint(world.object_spec(n))) for n in world.object_names if n != obj]
+    radius = 0.5 * spec.height if spec.shape == "cylinder" else _footprint(spec)  # it may be set down lying
+    (x_lo, x_hi), (y_lo, y_hi) = SET_DOWN_AREA
+    candidate = np.clip(here, [x_lo, y_lo], [x_hi, y_hi])
+    for _ in range(40):
+        angle, distance = rng.uniform(0.0, 2.0 * np.pi), rng.uniform(*SET_DOWN_DISTANCE)
+        candidate = here + distance * np.array([np.cos(angle), np.sin(angle)])
+        if not (x_lo <= candidate[0] <= x_hi and y_lo <= candidate[1] <= y_hi):
+            continue
+        reach = [float(np.linalg.norm(candidate - b)) for b in bases]
+        if min(reach) < SET_DOWN_BASE_CLEARANCE:
+            continue
+        if not any(SET_DOWN_WORKSPACE[0] <= r <= SET_DOWN_WORKSPACE[1] for r in reach):
+            continue
+        if all(np.linalg.norm(candidate - pos) >= radius + r + SET_DOWN_OBJECT_CLEARANCE for pos, r in others):
+            return candidate
+    return np.clip(candidate, [x_lo, y_lo], [x_hi, y_hi])
+
+
+def _take_and_set_down(world: SimWorld, frame: FeatureFrame, obj: str, arm: str, rng: np.random.Generator,
+                       spot: np.ndarray | None = None, lying: bool | None = None) -> None:
+    """A person's hand takes ``obj`` out of ``arm``'s open gripper and sets it down on the table.
+
+    ``spot`` and ``lying`` override the seeded draw (scripted disturbances).
+    """
+    spec = world.object_spec(obj)
+    pos, matrix = world.object_pose(obj)
+    tool = world.tcp_pose(arm)[1]
+    approach = tool[:, 0]
+    # Out of a side grasp beyond the finger tips; out of a top grasp along the gap between the pads.
+    out = tool[:, 2] if abs(approach[2]) > 0.7 else approach
+    out = np.array([out[0], out[1], 0.0]) / max(np.linalg.norm(out[:2]), 1e-6)
+    drawn = _set_down_spot(world, frame, obj, rng)
+    spot = drawn if spot is None else np.asarray(spot, dtype=float)
+    yaw = Rotation.from_euler("z", rng.uniform(-np.pi, np.pi))
+    tall = spec.shape == "cylinder" and spec.height > 2.0 * spec.width
+    on_side = rng.random() < LYING_SHARE
+    if tall and (on_side if lying is None else lying):
+        rest, height = yaw * Rotation.from_euler("y", 90.0, degrees=True), 0.5 * spec.width
+    else:
+        rest, height = yaw, 0.5 * spec.height
+    world.hand_carry(obj, set_down_path(pos, Rotation.from_matrix(matrix), out, spot, height, rest))
 
 
 def _horizontal(rng: np.random.Generator) -> np.ndarray:
@@ -80,7 +177,8 @@ def _horizontal(rng: np.random.Generator) -> np.ndarray:
 
 def inject(kind: str, world: SimWorld, frame: FeatureFrame, rng: np.random.Generator,
            arm: str = "", action: ArmAction | None = None,
-           direction: tuple[float, float, float] | None = None) -> DisturbanceEvent | None:
+           direction: tuple[float, float, float] | None = None,
+           spot: tuple[float, float] | None = None, lying: bool | None = None) -> DisturbanceEvent | None:
     """Apply one disturbance of ``kind`` now, if it applies to the current state.
 
     Args:
@@ -91,6 +189,8 @@ def inject(kind: str, world: SimWorld, frame: FeatureFrame, rng: np.random.Gener
         arm: The arm whose action is running (drop, pull, perturb, shift).
         action: The running atomic action (its ``obj`` argument is the target).
         direction: Horizontal direction of a push or knock (None: drawn from ``rng``).
+        spot: Where a pull sets the object down (None: drawn from ``rng``).
+        lying: Whether a pull sets a tall object down on its side (None: drawn).
 
     Returns:
         The event, or None when the kind does not apply now (nothing held to
@@ -110,17 +210,18 @@ def inject(kind: str, world: SimWorld, frame: FeatureFrame, rng: np.random.Gener
         # Only a closed grip can lose its object: an opening gripper is releasing anyway.
         if not held or world.commands[arm].grip < 0.5:
             return None
+        obj = held[0]
+        rigid = obj in world.object_names
+        if kind == "pull" and (not rigid or world.hand_busy or any(a != arm for a, o in frame.holding if o == obj)):
+            return None  # a person takes a rigid object out of one hand (not a cloth, not a tray in two)
         world.inject_gripper_fault(arm, FAULT_TICKS)
-        if kind == "pull" and held[0] in world.object_names:
-            # Taken out of the hand: shoved away from the gripper, outward and down.
-            away = world.tcp_pose(arm)[1][:, 0]
-            away = np.array([away[0], away[1], 0.0]) / max(np.linalg.norm(away[:2]), 1e-6)
-            _slide(world, held[0], away)
-        return DisturbanceEvent(world.tick, kind, held[0], arm, name)
+        if kind == "pull":
+            _take_and_set_down(world, frame, obj, arm, rng, spot, lying)
+        return DisturbanceEvent(world.tick, kind, obj, arm, name)
     if kind == "perturb":
         if name != "grasp" or target not in world.object_names or frame.is_holding(arm, target):
             return None
-        _slide(world, target, push_dir)
+        _slide(world, target, push_dir, float(rng.uniform(*PERTURB_DISTANCE)))
         return DisturbanceEvent(world.tick, kind, target, arm, name)
     if kind == "shift":
         free = _free_objects(frame, world)
@@ -130,7 +231,7 @@ def inject(kind: str, world: SimWorld, frame: FeatureFrame, rng: np.random.Gener
             target = min(free, key=lambda n: float(np.linalg.norm(frame.objects[n].pos[:2] - tool[:2])))
         if target is None or name == "grasp" or target not in free:
             return None
-        _slide(world, target, push_dir)
+        _slide(world, target, push_dir, float(rng.uniform(*SHIFT_DISTANCE)))
         return DisturbanceEvent(world.tick, kind, target, arm, name)
     if kind == "knock":
         upright = [n for n in _free_objects(frame, world) if frame.objects[n].axis[2] > 0.9]
@@ -292,6 +393,8 @@ class ScriptedDisturbance:
     after: int = 20
     seed: int = 0
     direction: tuple[float, float, float] | None = None
+    spot: tuple[float, float] | None = None
+    lying: bool | None = None
     events: list[DisturbanceEvent] = field(default_factory=list)
 
     def __post_init__(self) -> None:
@@ -319,7 +422,7 @@ class ScriptedDisturbance:
             return None
         arm, _, action = self._due
         self._due = None
-        event = inject(self.kind, world, frame, self._rng, arm, action, self.direction)
+        event = inject(self.kind, world, frame, self._rng, arm, action, self.direction, self.spot, self.lying)
         if event is not None:
             self.events.append(event)
         return event

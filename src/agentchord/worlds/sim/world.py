@@ -12,6 +12,7 @@ import mujoco
 import numpy as np
 
 from agentchord.worlds.sim.exceptions import UnknownObjectError
+from agentchord.worlds.sim.hand import PersonHand, Waypoint
 from agentchord.worlds.sim.scene import (
     ARM_JOINTS,
     ARM_PREFIX,
@@ -74,6 +75,7 @@ class SimWorld:
         self._object_spec = {o.name: o for o in scene.objects}
         self._fault_until: dict[str, int] = {}
         self._push_until: dict[int, int] = {}
+        self._hands: list[PersonHand] = []
         self.commands: dict[str, ArmCommand] = {}
         self._contacts: set[tuple[int, int]] = set()
         # A cloth (flex): named points (its corners) -> (vertex, diagonal neighbour inside), and
@@ -116,13 +118,14 @@ class SimWorld:
         self._fault_until[arm] = self.tick + ticks
 
     def push(self, obj: str, force: np.ndarray, ticks: int) -> None:
-        """Slide an object: a force (N, world frame) applied at its base for ``ticks`` ticks.
+        """Slide an object: a force (N, world frame) applied at table height for ``ticks`` ticks.
 
-        Applied at the base, not the centre, so a tall cup slides instead of tipping over.
+        Applied where the object meets the table, not at its centre, so a tall cup slides
+        instead of tipping over (upright or lying, whatever its orientation).
         """
-        spec = self.object_spec(obj)
+        self.object_spec(obj)
         body = self._object_body[obj]
-        base = np.array([0.0, 0.0, -0.5 * spec.height])
+        base = np.array([0.0, 0.0, -max(float(self.data.xpos[body][2]), 0.0)])
         self.data.xfrc_applied[body, :3] = force
         self.data.xfrc_applied[body, 3:] = np.cross(base, force)
         self._push_until[body] = self.tick + ticks
@@ -139,6 +142,18 @@ class SimWorld:
         self.data.xfrc_applied[body, :3] = force
         self.data.xfrc_applied[body, 3:] = np.cross(top, force)
         self._push_until[body] = self.tick + ticks
+
+    def hand_carry(self, obj: str, waypoints: list[Waypoint]) -> PersonHand:
+        """A person's hand takes ``obj`` and carries it along ``waypoints``, then lets go (see ``hand``)."""
+        self.object_spec(obj)
+        hand = PersonHand(self.model, self.data, self._object_body[obj], waypoints)
+        self._hands.append(hand)
+        return hand
+
+    @property
+    def hand_busy(self) -> bool:
+        """Whether a person's hand is still carrying an object."""
+        return bool(self._hands)
 
     def gripper_faulted(self, arm: str) -> bool:
         """Whether a gripper fault is forcing ``arm`` open now."""
@@ -159,7 +174,10 @@ class SimWorld:
         """Advance one control tick (``substeps`` physics steps)."""
         self._apply_commands()
         for _ in range(self.substeps):
+            for hand in self._hands:
+                hand.apply(self.model.opt.timestep)
             mujoco.mj_step(self.model, self.data)
+        self._hands = [hand for hand in self._hands if not hand.done]
         self.tick += 1
         for body, until in list(self._push_until.items()):
             if self.tick >= until:

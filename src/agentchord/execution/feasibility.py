@@ -1,0 +1,172 @@
+"""Feasibility before motion: can the arms make the grasps an edge starts with?
+
+Checked when a recovery edge is bound (and when a nominal edge that grasps starts),
+before the robot moves: the object must still be on the table, the arm's hand free,
+and the grasp's tool poses inside the arm's reach shell (``solvers.reach``) and
+confirmed by the IK. An object no arm can take any more is unrecoverable: the
+episode ends at once with the reason, rather than slowly after budgets run out.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from agentchord.actions.controller import RobotController
+from agentchord.actions.library import POINT_EXTENT, Grasp
+from agentchord.actions.catalog import GraspArgs
+from agentchord.execution.edge_program import EdgeProgram
+from agentchord.features.frame import ARMS, FeatureFrame
+from agentchord.solvers.ik import BimanualIK, PoseTarget
+from agentchord.solvers.reach import REACH
+from agentchord.worlds.sim.scene import HOME_Q
+
+#: An object whose centre is this far below the table top (m) has left the table.
+OFF_TABLE_Z = -0.05
+#: Reach slack (m) below which the reach model alone rules a pose out; above it the IK decides.
+REACH_SLACK_FLOOR = -0.12
+#: IK iterations from each start, and the position residual (m) under which a pose counts as reached.
+IK_ITERATIONS = 150
+IK_TOLERANCE = 0.01
+
+
+@dataclass(frozen=True)
+class GraspCheck:
+    """Whether one arm can make one grasp now.
+
+    Attributes:
+        arm: The arm.
+        obj: The object.
+        reason: Why not; empty when it can.
+    """
+
+    arm: str
+    obj: str
+    reason: str = ""
+
+    @property
+    def feasible(self) -> bool:
+        """Whether the grasp can be made."""
+        return not self.reason
+
+
+def off_table(frame: FeatureFrame, objects: list[str]) -> list[str]:
+    """The rigid objects among ``objects`` that have left the table (on the floor, falling)."""
+    lost = []
+    for name in objects:
+        feats = frame.objects.get(name)
+        if feats is not None and float(np.max(feats.extent)) >= POINT_EXTENT and feats.pos[2] < OFF_TABLE_Z:
+            lost.append(name)
+    return lost
+
+
+def others_move_first(program: EdgeProgram, grasp: Grasp) -> bool:
+    """Whether another arm acts in a step before ``grasp``'s (it may be moving out of the way)."""
+    for step in program.steps:
+        if grasp in step:
+            return False
+        if any(action.arm != grasp.arm for action in step):
+            return True
+    return False
+
+
+def first_grasps(program: EdgeProgram) -> list[Grasp]:
+    """The grasps made from the state at the program's start: each arm's first action, on an
+    object no earlier step of the program has handled (a hand-off sets it down for a later grasp)."""
+    seen: set[str] = set()
+    handled: set[str] = set()
+    grasps = []
+    for step in program.steps:
+        for action in step:
+            obj = getattr(action.args, "obj", None)
+            if action.arm not in seen and isinstance(action, Grasp) and obj not in handled:
+                grasps.append(action)
+            seen.add(action.arm)
+        handled |= {getattr(action.args, "obj", None) for action in step} - {None}
+    return grasps
+
+
+class FeasibilityChecker:
+    """Checks grasps against both arms' reach and the IK, on the robot's current state.
+
+    Args:
+        robot: The robot (its frame and commanded configuration).
+    """
+
+    def __init__(self, robot: RobotController) -> None:
+        self.robot = robot
+        self._ik: dict[bool, BimanualIK] = {}
+
+    def _ik_reaches(self, arm: str, poses: list[PoseTarget], avoid_other_arm: bool = True) -> bool:
+        """Whether the IK reaches every pose (from the current configuration, else from home).
+
+        Args:
+            arm: The arm.
+            poses: The poses, in order.
+            avoid_other_arm: Keep clear of the other arm where it is now (unless it moves away first).
+        """
+        if avoid_other_arm not in self._ik:
+            # Scratch solvers: the live one keeps the robot's warm start untouched.
+            self._ik[avoid_other_arm] = BimanualIK(iterations=IK_ITERATIONS, avoid_arm_collisions=avoid_other_arm)
+        ik = self._ik[avoid_other_arm]
+        current = self.robot.ik.configuration.q.copy()
+        for start in ("current", "home"):
+            ik.reset(current)
+            if start == "home":
+                ik.set_arm_q(arm, HOME_Q)
+            if all(self._solve(ik, arm, pose) for pose in poses):
+                return True
+        return False
+
+    @staticmethod
+    def _solve(ik: BimanualIK, arm: str, pose: PoseTarget) -> bool:
+        ik.solve({arm: pose})
+        return ik.residual(arm, pose) < IK_TOLERANCE
+
+    def check_grasp(self, grasp: Grasp, *, hand_free: bool = True, confirm_ik: bool = True,
+                    avoid_other_arm: bool = True) -> GraspCheck:
+        """Whether ``grasp`` (bound to its arm) can be made from the current state.
+
+        Args:
+            grasp: The grasp, bound to its arm.
+            hand_free: Also require the arm to hold nothing else.
+            confirm_ik: Confirm a pose the reach model accepts with the IK (~10-50 ms).
+            avoid_other_arm: The IK keeps clear of the other arm where it is now.
+        """
+        arm, obj = grasp.arm, grasp.args.obj
+        frame = self.robot.frame
+        if off_table(frame, [obj]):
+            return GraspCheck(arm, obj, f"{obj} has left the table (z = {frame.objects[obj].pos[2]:.2f} m)")
+        busy = sorted(o for a, o in frame.holding if a == arm and o != obj)
+        if hand_free and busy:
+            return GraspCheck(arm, obj, f"the {arm} arm holds {', '.join(busy)}")
+        try:
+            poses = grasp.target_poses(self.robot)
+        except (ValueError, FloatingPointError) as error:
+            return GraspCheck(arm, obj, f"no grasp pose for {obj}: {error}")
+        slack = min(float(REACH[arm].slack(pose.pos)) for pose in poses)
+        if slack < REACH_SLACK_FLOOR:
+            return GraspCheck(arm, obj, f"{obj} is out of the {arm} arm's reach ({100 * -slack:.0f} cm beyond its shell)")
+        if confirm_ik and not self._ik_reaches(arm, poses, avoid_other_arm):
+            return GraspCheck(arm, obj, f"the IK finds no {arm}-arm grasp of {obj} where it lies")
+        return GraspCheck(arm, obj)
+
+    def check_program(self, program: EdgeProgram) -> list[GraspCheck]:
+        """The infeasible first grasps of ``program`` (empty: it can start)."""
+        checks = (self.check_grasp(g, avoid_other_arm=not others_move_first(program, g)) for g in first_grasps(program))
+        return [check for check in checks if not check.feasible]
+
+    def unreachable(self, obj: str, *, confirm_ik: bool = True) -> list[GraspCheck]:
+        """Why no arm can take ``obj`` (off the table, beyond both shells); empty when some arm can.
+
+        A busy hand does not count: an object a busy arm could reach is not beyond recovery.
+        """
+        checks = [self.check_grasp(Grasp(arm, GraspArgs(obj=obj)), hand_free=False, confirm_ik=confirm_ik, avoid_other_arm=False)
+                  for arm in ARMS]
+        return [] if any(c.feasible for c in checks) else checks
+
+    def where(self, obj: str) -> str:
+        """Where an object is, for messages: ``(x, y, z) m``."""
+        x, y, z = self.robot.frame.objects[obj].pos
+        return f"({x:.2f}, {y:.2f}, {z:.2f}) m"

@@ -1,0 +1,68 @@
+"""Where to set an object down so that the other arm can take it (an arm-switching recovery).
+
+A recovery that the busy arm cannot reach is one the other arm can: it picks the
+object up and sets it down where both arms reach, then the busy arm takes it. The
+spot is chosen when the recovery runs, from the latest feature frame: inside both
+arms' reach shells with a margin, clear of the other objects and of the receiving
+arm's tool, and as near to where the object is as possible (a short carry).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from agentchord.features.frame import FeatureFrame
+from agentchord.solvers.exceptions import NoHandoffSpotError
+from agentchord.solvers.reach import REACH
+
+#: Candidate spots: a grid over the table area in front of the robot (x range, y range, step; m).
+SPOT_GRID = ((-0.30, 0.30), (0.30, 0.75), 0.02)
+#: Reach slack (m) a spot needs for the arm that will take the object and the arm that sets it down.
+TAKER_MARGIN = 0.05
+PLACER_MARGIN = 0.03
+#: Clearance (m) between the object's footprint and other objects' footprints, and from the taker's tool.
+OBJECT_CLEARANCE = 0.04
+TOOL_CLEARANCE = 0.12
+#: Lowest tool height (m) a side grasp is checked at.
+MIN_GRASP_HEIGHT = 0.06
+
+
+def _footprint(frame: FeatureFrame, name: str) -> float:
+    """Radius (m) of the table area an object covers, from its features."""
+    feats = frame.objects[name]
+    return 0.5 * float(np.hypot(*np.sort(feats.extent)[-2:])) if feats.extent[2] < 0.5 * max(feats.extent[:2]) \
+        else 0.5 * float(max(feats.extent[0], feats.extent[1]))
+
+
+def handoff_spot(frame: FeatureFrame, obj: str, placer: str, taker: str) -> np.ndarray:
+    """The table spot (x, y) where ``placer`` sets ``obj`` down for ``taker``.
+
+    Args:
+        frame: The latest features (object poses, the taker's tool).
+        obj: The object being handed over (held upright by ``placer``).
+        placer: The arm that sets it down.
+        taker: The arm that will grasp it there.
+
+    Raises:
+        NoHandoffSpotError: No grid spot is reachable by both arms and clear of everything.
+    """
+    feats = frame.objects[obj]
+    height = float(max(feats.extent))
+    grasp_z = max(0.5 * height, MIN_GRASP_HEIGHT)
+    (x_lo, x_hi), (y_lo, y_hi), step = SPOT_GRID
+    xs, ys = np.meshgrid(np.arange(x_lo, x_hi + 1e-9, step), np.arange(y_lo, y_hi + 1e-9, step))
+    spots = np.column_stack([xs.ravel(), ys.ravel()])
+    points = np.column_stack([spots, np.full(len(spots), grasp_z)])
+    ok = (REACH[taker].slack(points) >= TAKER_MARGIN) & (REACH[placer].slack(points) >= PLACER_MARGIN)
+    radius = 0.5 * float(min(feats.extent[0], feats.extent[1])) if height == feats.extent[2] else 0.5 * height
+    for name in frame.objects:
+        other = frame.objects[name]
+        if name == obj or float(np.max(other.extent)) < 0.01:  # itself, or a point feature (a cloth corner)
+            continue
+        gap = np.linalg.norm(spots - other.pos[:2], axis=1)
+        ok &= gap >= radius + _footprint(frame, name) + OBJECT_CLEARANCE
+    ok &= np.linalg.norm(spots - frame.arms[taker].ee[:2], axis=1) >= TOOL_CLEARANCE
+    if not ok.any():
+        raise NoHandoffSpotError(obj, placer, taker)
+    candidates = spots[ok]
+    return candidates[int(np.argmin(np.linalg.norm(candidates - feats.pos[:2], axis=1)))]

@@ -1,0 +1,61 @@
+"""Feasibility before motion: first grasps, off-table objects, reach and IK checks."""
+
+import numpy as np
+
+from agentchord.actions.catalog import GraspArgs
+from agentchord.actions.controller import RobotController
+from agentchord.actions.library import Grasp
+from agentchord.execution.edge_program import EdgeProgram
+from agentchord.execution.feasibility import FeasibilityChecker, first_grasps, off_table
+from agentchord.features.extractors import make_extractor
+from agentchord.tasks import load_task_graph
+from agentchord.worlds.sim.tasks import SIM_TASKS
+from agentchord.worlds.sim.world import SimWorld
+
+
+def _robot() -> RobotController:
+    world = SimWorld(SIM_TASKS["single_arm_pour_water"].sample_scene(np.random.default_rng([1, 0x5CE7E])))
+    robot = RobotController(world)
+    robot.frame = make_extractor("oracle", world, lambda arm: False).update()
+    return robot
+
+
+def _move(robot: RobotController, obj: str, xyz) -> None:
+    feats = robot.frame.objects[obj]
+    shift = np.asarray(xyz, dtype=float) - feats.pos
+    for name in ("pos", "top", "bottom"):
+        setattr(feats, name, getattr(feats, name) + shift)
+
+
+def test_an_alternative_checks_the_hand_off_grasp_not_the_grasp_after_it():
+    graph = load_task_graph("single_arm_pour_water")
+    alt = next(e for e in graph.edges if e.alternative_to == "e2_r_bottle_dropped")
+    grasps = first_grasps(EdgeProgram.from_edge(alt))
+    assert [(g.arm, g.args.obj) for g in grasps] == [("left", "bottle")]
+
+
+def test_an_object_below_the_table_top_is_off_the_table():
+    robot = _robot()
+    assert off_table(robot.frame, ["bottle", "cup"]) == []
+    _move(robot, "bottle", (0.0, 1.2, -0.6))
+    assert off_table(robot.frame, ["bottle", "cup"]) == ["bottle"]
+    assert FeasibilityChecker(robot).unreachable("bottle")
+
+
+def test_the_arm_near_the_object_can_take_it_and_an_object_beyond_both_shells_is_unreachable():
+    robot = _robot()
+    checker = FeasibilityChecker(robot)
+    assert checker.check_grasp(Grasp("right", GraspArgs(obj="bottle"))).feasible  # where the scene put it
+    _move(robot, "bottle", (-0.3, 0.8, robot.frame.objects["bottle"].pos[2]))
+    right = checker.check_grasp(Grasp("right", GraspArgs(obj="bottle")))
+    assert not right.feasible and "right arm" in right.reason
+    assert checker.check_grasp(Grasp("left", GraspArgs(obj="bottle"))).feasible
+    _move(robot, "bottle", (0.0, 1.3, robot.frame.objects["bottle"].pos[2]))
+    assert len(checker.unreachable("bottle")) == 2
+
+
+def test_a_busy_hand_cannot_take_another_object():
+    robot = _robot()
+    robot.frame.holding = {("left", "cup")}
+    check = FeasibilityChecker(robot).check_grasp(Grasp("left", GraspArgs(obj="bottle")))
+    assert not check.feasible and "holds cup" in check.reason
