@@ -115,3 +115,12 @@ def test_render_refuses_a_graph_too_large_to_lay_out(pour: TaskGraph, tmp_path: 
         render(pour, tmp_path / "g.svg")
     assert not (tmp_path / "g.svg").exists()
     render(pour, tmp_path / "g.dot")  # text formats have no limit
+
+
+def test_an_arm_switching_alternative_is_drawn_dotted_and_says_what_it_replaces():
+    from agentchord.graph.render import to_dot
+    from agentchord.tasks import load_task_graph
+
+    dot = to_dot(load_task_graph("single_arm_pour_water"))
+    line = next(line for line in dot.splitlines() if "e2_r_bottle_dropped_via_left\\n" in line)
+    assert 'style="dotted"' in line and "instead of e2_r_bottle_dropped when its arm cannot reach" in line

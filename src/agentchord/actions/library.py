@@ -35,6 +35,8 @@ from agentchord.worlds.sim.scene import ARM_JOINTS, ARM_PREFIX, FINGER_GAP_OFFSE
 
 #: Tilt (deg) beyond which an object counts as fallen for a side grasp.
 UPRIGHT_TOLERANCE_DEG = 25.0
+#: An object that moved more than this (m) while the tool approached it is looked at again.
+MOVED_DURING_APPROACH = 0.01
 #: A closed grasp whose grasp point is farther than this (m) from where the tool aimed is off-centre.
 OFF_CENTRE_TOLERANCE = 0.025
 
@@ -110,6 +112,8 @@ class Grasp(ArmAction):
 
     #: Tilt (deg) beyond which the object is treated as lying on its side.
     FALLEN_DEG = 60.0
+    #: Tilt (deg) beyond which an object leaning on something is grasped like a fallen one.
+    LEANING_AS_FALLEN_DEG = 40.0
     #: Tries before a grasp that closes on nothing fails.
     ATTEMPTS = 2
     #: Objects shorter than this (m) are grasped from above in ``auto`` mode.
@@ -144,7 +148,8 @@ class Grasp(ArmAction):
             return "top"
         if tilt <= UPRIGHT_TOLERANCE_DEG:
             return "side"
-        return "fallen" if tilt >= self.FALLEN_DEG else "leaning"
+        # Leaning far against something (pushed into another object), it is taken as if it lay there.
+        return "fallen" if tilt >= self.LEANING_AS_FALLEN_DEG else "leaning"
 
     def target_poses(self, robot: RobotController) -> list[PoseTarget]:
         """The tool poses this grasp would go to from the current frame: above/before the object, then at it.
@@ -166,6 +171,8 @@ class Grasp(ArmAction):
 
     def _attempt(self, robot: RobotController) -> Iterator[None]:
         feats = robot.frame.objects[self.args.obj]
+        self._seen_at = feats.pos.copy()
+        self._taken_as = self._mode(robot)
         if feats.pos[2] < -0.02:
             raise ActionFailed(f"{self.args.obj} fell off the table")
         mode = self._mode(robot)
@@ -232,14 +239,22 @@ class Grasp(ArmAction):
             yield from move_to(robot, self.arm, pose_from_matrix(np.r_[start[:2], height], robot.rotation(self.arm)))
 
     def _close_and_check(self, robot: RobotController) -> Iterator[None]:
-        yield from settle(robot, self.arm, max_ticks=30, required=0.015)
+        try:
+            yield from settle(robot, self.arm, max_ticks=30, required=0.015)
+        except ActionFailed:
+            # Pushed during the approach, it may now lie where this approach cannot end: look again.
+            moved = float(np.linalg.norm(robot.frame.objects[self.args.obj].pos - self._seen_at))
+            if moved > MOVED_DURING_APPROACH:
+                raise GraspMissed(f"{self.args.obj} moved {100 * moved:.1f} cm during the approach") from None
+            raise
         aimed = robot.commanded_pose(self.arm).pos.copy()
         yield from grip(robot, self.arm, 1.0)
         if not robot.frame.is_holding(self.arm, self.args.obj):
             raise GraspMissed(f"fingers closed but {self.args.obj} is not held")
         # Pushed while the fingers closed, it is held off-centre (a pour or a place would then miss):
         # where the grasp point is now, seen from where the tool aimed, says so.
-        off = float(np.linalg.norm(self.target_poses(robot)[-1].pos - aimed))
+        # (Not for a fallen or leaning object: the closing fingers turn it, which is the point.)
+        off = float(np.linalg.norm(self.target_poses(robot)[-1].pos - aimed)) if self._taken_as in ("side", "top") else 0.0
         if off > OFF_CENTRE_TOLERANCE:
             raise GraspMissed(f"{self.args.obj} is held {100 * off:.1f} cm off the grasp point")
 

@@ -190,6 +190,8 @@ class Executor:
         self.path: list[str] = []
         self.program: EdgeProgram | None = None
         self.binding: Binding | None = None
+        # Candidates after the bound recovery, tried if it fails outright; cleared when another edge starts.
+        self._fallbacks: list[EdgeProgram] = []
         self._off_table_since: dict[str, int] = {}
         self.armed: EdgeMonitors | None = None
         self.recovering_from: str | None = None
@@ -243,13 +245,10 @@ class Executor:
         """Execute until the goal, a failure or a budget ends the episode."""
         wall0 = time.perf_counter()
         self.trace.add(self.world.tick, "episode_start", task=self.graph.task, strategy=self.strategy.name, start=self.graph.start)
-        self._arrive(self.graph.start)
-        success, reason = False, ""
-        while True:
+        outcome = self._arrive(self.graph.start)
+        while outcome is None:
             outcome = self._tick()
-            if outcome is not None:
-                success, reason = outcome
-                break
+        success, reason = outcome
         injected = self.disturbance.events if self.disturbance is not None else []
         result = EpisodeResult(
             success=success,
@@ -306,6 +305,13 @@ class Executor:
         if self.program is not None:
             status = self.program.update(self.robot)
             if status == Status.FAILURE:
+                if self._fallbacks:
+                    # The bound recovery could not be carried out (a grasp out of reach after all):
+                    # the next candidate is bound from where the robot is now.
+                    self.trace.add(self.world.tick, "recovery_failed", edge=self.program.edge_id, reason=self.program.failure_reason)
+                    fallbacks, self._fallbacks = self._fallbacks, []
+                    self.program = None
+                    return self._begin_recovery(fallbacks)
                 return False, f"{self._where()}: {self.program.failure_reason}"
             if status == Status.SUCCESS:
                 outcome = self._on_program_done()
@@ -359,12 +365,13 @@ class Executor:
             return None
         self.binding = None
         refused = []
-        for candidate in binding.candidates:
+        for k, candidate in enumerate(binding.candidates):
             problems = self.feasibility.check_program(candidate)
             if not problems:
                 self.trace.add(self.world.tick, "recovery_bound", edge=candidate.edge_id, waited_ticks=waited,
                                refused=refused, arms=sorted({a.arm for step in candidate.steps for a in step}))
                 self._start(candidate)
+                self._fallbacks = [EdgeProgram.from_edge(self.graph.edge(c.edge_id)) for c in binding.candidates[k + 1:]]
                 return None
             refused.append({"edge": candidate.edge_id, "reason": "; ".join(p.reason for p in problems)})
         summary = "; ".join(f"{r['edge']}: {r['reason']}" for r in refused)
@@ -412,6 +419,7 @@ class Executor:
 
     def _start(self, program: EdgeProgram) -> None:
         """Start an edge program from the robot's current state."""
+        self._fallbacks = []
         self.program = program
         program.on_action_start = self._action_started
         program.on_action_end = self._action_ended

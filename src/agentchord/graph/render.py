@@ -4,7 +4,8 @@ Colours follow the paper's Fig. 3: nominal edges blue, recovery edges pink.
 Recovery nodes are outlined pink, the start node is bold and the goal doubly
 outlined. A recovery entry edge is dashed and labelled with the failure modes
 that fire it (``when mode on edge``); a nominal edge lists its failure
-modes with their entry edges (``! mode -> entry``).
+modes with their entry edges (``! mode -> entry``). An arm-switching alternative of an
+entry edge is dotted and says which entry it stands in for.
 """
 
 from __future__ import annotations
@@ -54,6 +55,8 @@ def _edge_lines(edge: Edge, triggers: list[tuple[Edge, FailureMode]]) -> list[st
     lines = [edge.id, edge_summary(edge)]
     lines += [f"! {f.name} -> {f.recovery}" for f in edge.failures]
     lines += [_trigger(f, e) for e, f in triggers]
+    if edge.alternative_to is not None:
+        lines.append(f"instead of {edge.alternative_to} when its arm cannot reach")
     return lines
 
 
@@ -102,6 +105,8 @@ def to_dot(graph: TaskGraph) -> str:
         ]
         if edge.id in triggers:
             attrs.append('style="dashed"')
+        elif edge.alternative_to is not None:
+            attrs.append('style="dotted"')
         out.append(f"  {_dot_quote(edge.source)} -> {_dot_quote(edge.target)} [{', '.join(attrs)}];")
     out.append("}")
     return "\n".join(out) + "\n"

@@ -44,6 +44,9 @@ def _single_arm_grasp(step: Step) -> tuple[str, ActionCall] | None:
 def arm_switch_alternative(entry: Edge, rigid: Iterable[str]) -> Edge | None:
     """The other arm's way along a recovery entry edge, or None when the rule does not apply.
 
+    It applies when the entry starts with one arm grasping a rigid object and the other arm's
+    hand is free during the entry (none of its monitors watches what the other arm holds).
+
     Args:
         entry: A recovery entry edge.
         rigid: Objects that can be picked up and set down (not a cloth's corner).
@@ -56,6 +59,8 @@ def arm_switch_alternative(entry: Edge, rigid: Iterable[str]) -> Edge | None:
     if obj not in set(rigid):
         return None
     other = _other(arm)
+    if any(f"holding({other}," in failure.monitor for failure in entry.failures):
+        return None  # the entry watches what the other arm holds: that hand is not free
     args = {key: grasp.args[key] for key in PORTABLE_GRASP_ARGS if key in grasp.args}
     # The other arm already went home in the hand-off: drop its "back" from the entry's first step.
     rest_first = {a: c for a, c in entry.steps[0].items() if a != other}
@@ -72,7 +77,9 @@ def arm_switch_alternative(entry: Edge, rigid: Iterable[str]) -> Edge | None:
         kind="recovery",
         alternative_to=entry.id,
         actions=[*hand_off, rest_first, *entry.steps[1:]],
-        failures=[failure.model_copy(deep=True) for failure in entry.failures],
+        # Only monitors gated by the first arm's grasp-done signal: they wait for its own grasp. An
+        # ungated one (the object drifting) would fire while the other arm carries the object.
+        failures=[failure.model_copy(deep=True) for failure in entry.failures if f"{arm}.closed *" in failure.monitor],
     )
 
 

@@ -12,7 +12,8 @@ motions since the last grasp, what each arm's pose is relative to). For each nom
   with a free arm while the busy arm parks, then ``e`` again;
 - an object released inside or on another one can fall out when that one is carried (Eq. 19):
   ``re-place`` it and take the carried one again;
-- with RGB-D perception, a tracked object can be lost from view (Eq. 18): ``re-observe``.
+- with RGB-D perception, a tracked object can be lost from view (Eq. 18): ``re-observe``;
+- a regrasp the busy arm cannot reach gets the other arm's alternative (``arm_switch``).
 
 Every recovery edge leaves the failure context ``s`` and merges at ``t`` (or, for a broken
 relation, at ``s``): nothing regresses, and the forward-moving filter (Eq. 8) checks it.
@@ -28,6 +29,7 @@ from dataclasses import dataclass, field
 
 from agentchord.agents.reasoner import Scene, SceneObject, UnanticipatedFailure
 from agentchord.agents.rules import knowledge as kb
+from agentchord.agents.rules.arm_switch import add_arm_switch_alternatives
 from agentchord.features.frame import tilt_deg
 from agentchord.graph.models import ActionCall, Edge, FailureMode, Step, TaskGraph
 from agentchord.graph.progress import forward_filter, nominal_path
@@ -181,7 +183,9 @@ class Arranger:
                 if recovery is not None:
                     out.edges.append(recovery)
         self._monitor_recoveries(out)
-        return forward_filter(out).graph
+        # A recovery the busy arm cannot reach is one the other arm can: its alternatives.
+        rigid = [name for name in self.objects if not kb.is_cloth_corner(name)]
+        return forward_filter(add_arm_switch_alternatives(out, rigid)).graph
 
     def accounts(self, graph: TaskGraph) -> dict[str, Account]:
         """The account at the source of every nominal edge, along the nominal path."""

@@ -20,9 +20,12 @@ from scipy.spatial.transform import Rotation, Slerp
 #: PD gains of the hand on the object's position (1/s^2, 1/s) and orientation: ~4 Hz, damped.
 POS_KP, POS_KD = 600.0, 50.0
 ROT_KP, ROT_KD = 300.0, 35.0
-#: Largest force (N) and torque (N m) the hand applies.
+#: Largest force (N) and torque (N m) the hand applies, and the largest linear (m/s^2, beyond
+#: gravity) and angular (rad/s^2) accelerations it may give a light object (a fork must not fly).
 MAX_FORCE = 25.0
 MAX_TORQUE = 1.5
+MAX_ACCEL = 30.0
+MAX_ANGULAR_ACCEL = 150.0
 #: Seconds of each phase: out of the fingers, carried over the spot, lowered, held still before letting go.
 OUT_S, CARRY_S, LOWER_S, HOLD_S = 0.3, 0.9, 0.3, 0.3
 #: Height (m) the object's resting pose is carried above before it is lowered, and released above.
@@ -97,8 +100,10 @@ class PersonHand:
         rot = Rotation.from_matrix(self.data.xmat[self.body].reshape(3, 3))
         err = (rot_ref * rot.inv()).as_rotvec()
         torque = self.inertia * (ROT_KP * err - ROT_KD * omega)
-        wrench[:3] = force * min(1.0, MAX_FORCE / max(np.linalg.norm(force), 1e-9))
-        wrench[3:] = torque * min(1.0, MAX_TORQUE / max(np.linalg.norm(torque), 1e-9))
+        max_force = min(MAX_FORCE, self.mass * (MAX_ACCEL + 9.81))
+        max_torque = min(MAX_TORQUE, self.inertia * MAX_ANGULAR_ACCEL)
+        wrench[:3] = force * min(1.0, max_force / max(np.linalg.norm(force), 1e-9))
+        wrench[3:] = torque * min(1.0, max_torque / max(np.linalg.norm(torque), 1e-9))
         self._t += dt
 
 
