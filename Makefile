@@ -39,6 +39,7 @@ test-all: install
 	$(BIN)/pytest -n 2
 
 bench: install
+	$(BIN)/python benchmarks/bench_disturbances.py
 	$(BIN)/python benchmarks/bench_episode.py
 	$(BIN)/python benchmarks/bench_monitors.py
 	$(BIN)/python benchmarks/bench_recovery_cost.py
