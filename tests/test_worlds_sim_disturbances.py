@@ -75,8 +75,14 @@ def test_presets_name_the_papers_protocols():
     assert PRESETS["real"] == ("perturb", "pull") and PRESETS["stress"] == KINDS
 
 
-@pytest.mark.parametrize("kind,low,high", [("pull", 0.04, 0.30), ("perturb", 0.01, 0.08)])
-def test_landings_stay_in_the_stated_ranges(kind, low, high):
+@pytest.mark.parametrize("kind,low,high,upright", [
+    ("pull", 0.04, 0.30, None),      # set down 6-25 cm away, upright or on its side
+    ("perturb", 0.01, 0.08, None),   # pushed 2-5 cm
+    ("shift", 0.03, 0.12, True),     # slid 5-8 cm, still standing
+    ("drop", 0.0, 0.25, None),       # falls from where it was held
+    ("knock", 0.0, 0.20, False),     # tipped over where it stood
+])
+def test_landings_stay_in_the_stated_ranges(kind, low, high, upright):
     from agentchord.bench.landing import landing
 
     landings = [x for x in (landing(kind, seed) for seed in range(3)) if x is not None]
@@ -85,3 +91,5 @@ def test_landings_stay_in_the_stated_ranges(kind, low, high):
         assert not x.off_table
         assert low <= x.moved <= high, (x.seed, x.moved)
         assert any(x.reachable.values())
+        if upright is not None:
+            assert x.upright is upright

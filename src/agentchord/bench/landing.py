@@ -85,7 +85,9 @@ def landing(kind: str, seed: int) -> Landing | None:
                 moved=float(np.linalg.norm(frame.objects[obj].pos[:2] - seen["start"][1][:2])),
                 upright=tilt_deg(frame.objects[obj].axis) < UPRIGHT_DEG,
                 off_table=bool(off_table(frame, [obj])),
-                reachable={arm: checker.check_grasp(Grasp(arm, GraspArgs(obj=obj)), hand_free=False).feasible for arm in ARMS},
+                # Reach alone: the other arm's pose and what the hands hold are not the object's doing.
+                reachable={arm: checker.check_grasp(Grasp(arm, GraspArgs(obj=obj)), hand_free=False,
+                                                    avoid_other_arm=False).feasible for arm in ARMS},
             )
 
     disturbance = ScriptedDisturbance(action, kind, after=after, seed=seed)

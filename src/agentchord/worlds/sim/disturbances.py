@@ -212,11 +212,13 @@ def inject(kind: str, world: SimWorld, frame: FeatureFrame, rng: np.random.Gener
             return None
         obj = held[0]
         rigid = obj in world.object_names
-        if kind == "pull" and (not rigid or world.hand_busy or any(a != arm for a, o in frame.holding if o == obj)):
-            return None  # a person takes a rigid object out of one hand (not a cloth, not a tray in two)
+        two_handed = any(a != arm for a, o in frame.holding if o == obj)
+        if kind == "pull" and rigid and (world.hand_busy or two_handed):
+            return None  # a person takes a rigid object out of one hand (not a tray held in two)
         world.inject_gripper_fault(arm, FAULT_TICKS)
-        if kind == "pull":
+        if kind == "pull" and rigid:
             _take_and_set_down(world, frame, obj, arm, rng, spot, lying)
+        # A cloth's corner pulled out of the fingers just falls back onto the table.
         return DisturbanceEvent(world.tick, kind, obj, arm, name)
     if kind == "perturb":
         if name != "grasp" or target not in world.object_names or frame.is_holding(arm, target):
