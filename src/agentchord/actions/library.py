@@ -115,7 +115,7 @@ class Grasp(ArmAction):
     #: Tilt (deg) beyond which an object leaning on something is grasped like a fallen one.
     LEANING_AS_FALLEN_DEG = 40.0
     #: Tries before a grasp that closes on nothing fails.
-    ATTEMPTS = 2
+    ATTEMPTS = 3
     #: Objects shorter than this (m) are grasped from above in ``auto`` mode.
     SIDE_MIN_HEIGHT = 0.08
     #: The finger tips reach this far past the tool centre (m): keep them off the table.
@@ -137,7 +137,7 @@ class Grasp(ArmAction):
                     raise
 
     def _mode(self, robot: RobotController) -> str:
-        """How the object is taken now: ``top``, ``side`` (upright), ``fallen`` (lying) or ``leaning``."""
+        """How the object is taken now: ``top``, ``side`` (upright or leaning a little) or ``fallen`` (lying)."""
         feats = robot.frame.objects[self.args.obj]
         tilt = tilt_deg(feats.axis)
         height = float(np.linalg.norm(feats.top - feats.bottom))
@@ -146,10 +146,9 @@ class Grasp(ArmAction):
             mode = "side" if height >= self.SIDE_MIN_HEIGHT else "top"
         if mode == "top":
             return "top"
-        if tilt <= UPRIGHT_TOLERANCE_DEG:
-            return "side"
-        # Leaning far against something (pushed into another object), it is taken as if it lay there.
-        return "fallen" if tilt >= self.LEANING_AS_FALLEN_DEG else "leaning"
+        # Leaning on something (pushed into another object): a little, the closing fingers stand it
+        # up; far, it is taken as if it lay there.
+        return "side" if tilt < self.LEANING_AS_FALLEN_DEG else "fallen"
 
     def target_poses(self, robot: RobotController) -> list[PoseTarget]:
         """The tool poses this grasp would go to from the current frame: above/before the object, then at it.
@@ -173,10 +172,10 @@ class Grasp(ArmAction):
         feats = robot.frame.objects[self.args.obj]
         self._seen_at = feats.pos.copy()
         self._taken_as = self._mode(robot)
+        self._upright_at_start = tilt_deg(feats.axis) <= UPRIGHT_TOLERANCE_DEG
         if feats.pos[2] < -0.02:
             raise ActionFailed(f"{self.args.obj} fell off the table")
         mode = self._mode(robot)
-        tilt = tilt_deg(feats.axis)
         if mode == "top":
             yield from self._top_grasp(robot)
         elif mode == "side":
@@ -185,8 +184,6 @@ class Grasp(ArmAction):
             yield from self._fallen_grasp(robot)
             if self.args.reseat:
                 yield from self._reseat(robot)
-        else:
-            raise ActionFailed(f"{self.args.obj} is leaning (tilt {tilt:.0f} deg): neither upright nor lying")
 
     def _reseat(self, robot: RobotController) -> Iterator[None]:
         """Put an object just set upright in hand down on the table, go home, side-grasp it again.
@@ -254,7 +251,9 @@ class Grasp(ArmAction):
         # Pushed while the fingers closed, it is held off-centre (a pour or a place would then miss):
         # where the grasp point is now, seen from where the tool aimed, says so.
         # (Not for a fallen or leaning object: the closing fingers turn it, which is the point.)
-        off = float(np.linalg.norm(self.target_poses(robot)[-1].pos - aimed)) if self._taken_as in ("side", "top") else 0.0
+        upright = tilt_deg(robot.frame.objects[self.args.obj].axis) <= UPRIGHT_TOLERANCE_DEG
+        off = float(np.linalg.norm(self.target_poses(robot)[-1].pos - aimed)) if self._taken_as == "top" or (
+            self._taken_as == "side" and upright and self._upright_at_start) else 0.0
         if off > OFF_CENTRE_TOLERANCE:
             raise GraspMissed(f"{self.args.obj} is held {100 * off:.1f} cm off the grasp point")
 

@@ -67,8 +67,6 @@ REST_SPEED = 0.03
 REST_TICKS = 10
 #: Height (m) under which an object's lower axis end must be to count as resting on the table.
 RESTING_HEIGHT = 0.05
-
-
 @dataclass
 class Binding:
     """A recovery waiting to bind its arm: the candidates (entry edge, then its alternatives).

@@ -62,12 +62,12 @@ def off_table(frame: FeatureFrame, objects: list[str]) -> list[str]:
 
 
 def others_move_first(program: EdgeProgram, grasp: Grasp) -> bool:
-    """Whether another arm acts in a step before ``grasp``'s (it may be moving out of the way)."""
+    """Whether another arm acts before or with ``grasp`` (it may be moving out of the way)."""
     for step in program.steps:
-        if grasp in step:
-            return False
         if any(action.arm != grasp.arm for action in step):
             return True
+        if grasp in step:
+            return False
     return False
 
 
@@ -141,6 +141,10 @@ class FeasibilityChecker:
         busy = sorted(o for a, o in frame.holding if a == arm and o != obj)
         if hand_free and busy:
             return GraspCheck(arm, obj, f"the {arm} arm holds {', '.join(busy)}")
+        if (arm, obj) in frame.holding:
+            # It rests on this arm's open fingers (dropped onto them): the grasp lets it fall free
+            # and takes it from there, whatever pose the IK would find for it now.
+            return GraspCheck(arm, obj)
         try:
             poses = grasp.target_poses(self.robot)
         except (ValueError, FloatingPointError) as error:

@@ -11,11 +11,13 @@ measures.
   sets it down on the table, upright or (a tall object) on its side, at a seeded
   spot 6-25 cm from where it was taken (a person's hand: ``hand.PersonHand``).
 - ``perturb``: the object being grasped is pushed a few centimetres (2-5 cm)
-  before the fingers close.
+  before the fingers close. Pushes are gentle (at most 3 m/s^2, and slow enough that a tall
+  object slides instead of tipping).
 - ``shift``: a target the action refers to (the cup the bottle approaches;
   for an action without an object, the free object nearest the tool) slides
   5-8 cm.
-- ``knock``: an object nobody holds is knocked over (a push high on it).
+- ``knock``: an upright object nobody holds, taller than wide, is knocked over (a push high
+  on it); a plate or a tray cannot be knocked over.
 
 Two schedules. :class:`RandomDisturbances` draws once per atomic action
 started (probability ``p``, a moment within the action, a kind): the paper's
@@ -37,6 +39,7 @@ from scipy.spatial.transform import Rotation
 
 from agentchord.features.frame import FeatureFrame
 from agentchord.worlds.sim.hand import set_down_path
+from agentchord.worlds.sim.scene import TABLE_FRICTION
 from agentchord.worlds.sim.world import CONTROL_HZ, SimWorld
 
 if TYPE_CHECKING:
@@ -63,8 +66,10 @@ LYING_SHARE = 0.3
 #: A perturbation pushes the object being grasped this far (m), a shift this far.
 PERTURB_DISTANCE = (0.02, 0.05)
 SHIFT_DISTANCE = (0.05, 0.08)
-#: Ticks a push lasts.
-PUSH_TICKS = 5
+#: Largest acceleration (m/s^2, beyond sliding friction) a push gives an object.
+PUSH_ACCEL = 3.0
+#: Only an object at least this much taller than wide can be knocked over (not a plate, not a tray).
+KNOCK_MIN_ASPECT = 1.2
 
 
 @dataclass
@@ -97,23 +102,28 @@ def _free_objects(frame: FeatureFrame, world: SimWorld) -> list[str]:
 
 
 def _slide(world: SimWorld, obj: str, direction: np.ndarray, distance: float) -> None:
-    """Push ``obj`` along ``direction`` so that it slides about ``distance`` (m) on the table.
+    """Push ``obj`` along ``direction`` so that it slides about ``distance`` (m) on the table, upright.
 
     A net acceleration a for T s beyond sliding friction, then friction stops it:
-    distance = a T^2 / 2 + (a T)^2 / (2 mu g); solved for a. A cylinder lying on its
-    side is pushed along its axis (pushed across it, it would roll away, not slide).
+    distance = a T^2 / 2 + (a T)^2 / (2 mu g). The push is gentle, as a person's is: a is at
+    most :data:`PUSH_ACCEL`, and for a tall object at most half of g * width / height (the
+    inertial torque of a faster push would tip it over), and T is as long as it takes. A
+    cylinder lying on its side is pushed along its axis (pushed across it, it would roll away).
     """
     spec = world.object_spec(obj)
     axis = world.object_pose(obj)[1][:, 2]
     if spec.shape == "cylinder" and abs(axis[2]) < 0.5:
         along = np.array([axis[0], axis[1], 0.0]) / max(np.linalg.norm(axis[:2]), 1e-9)
         direction = along if float(np.dot(along, direction)) >= 0.0 else -along
-    seconds = PUSH_TICKS / CONTROL_HZ
-    mu_g = max(spec.friction, 0.1) * 9.81
-    # a^2 T^2 / (2 mu g) + a T^2 / 2 - distance = 0
+    mu_g = max(spec.friction, TABLE_FRICTION) * 9.81  # the contact's coefficient is the larger of the two
+    accel = min(PUSH_ACCEL, 0.5 * 9.81 * spec.width / max(spec.height, 1e-3))
+    seconds = np.sqrt(distance / (0.5 * accel + accel**2 / (2.0 * mu_g)))
+    ticks = max(int(np.ceil(seconds * CONTROL_HZ)), 1)
+    seconds = ticks / CONTROL_HZ
+    # The same distance over the whole number of ticks: a^2 T^2 / (2 mu g) + a T^2 / 2 - distance = 0.
     qa, qb = seconds**2 / (2.0 * mu_g), 0.5 * seconds**2
     accel = (-qb + np.sqrt(qb * qb + 4.0 * qa * distance)) / (2.0 * qa)
-    world.push(obj, spec.mass * (mu_g + accel) * direction, ticks=PUSH_TICKS)
+    world.push(obj, spec.mass * (mu_g + accel) * direction, ticks=ticks)
 
 
 def _footprint(spec) -> float:
@@ -236,7 +246,8 @@ def inject(kind: str, world: SimWorld, frame: FeatureFrame, rng: np.random.Gener
         _slide(world, target, push_dir, float(rng.uniform(*SHIFT_DISTANCE)))
         return DisturbanceEvent(world.tick, kind, target, arm, name)
     if kind == "knock":
-        upright = [n for n in _free_objects(frame, world) if frame.objects[n].axis[2] > 0.9]
+        upright = [n for n in _free_objects(frame, world) if frame.objects[n].axis[2] > 0.9
+                   and world.object_spec(n).height >= KNOCK_MIN_ASPECT * world.object_spec(n).width]
         if not upright:
             return None
         victim = target if target in upright else upright[int(rng.integers(len(upright)))]

@@ -32,6 +32,8 @@ FINGER_GAP_OFFSET = 0.0448
 TCP_OFFSET = 0.115
 TABLE_HALF = (0.61, 0.381, 0.02)
 TABLE_CENTER = (0.0, 0.6)
+#: Sliding friction of the table top (MuJoCo takes the larger of two touching geoms' coefficients).
+TABLE_FRICTION = 1.0
 #: Home configuration of one arm (gym-aloha's keyframe, arm joints only).
 HOME_Q = np.array([0.0, -0.96, 1.16, 0.0, -0.3, 0.0])
 
@@ -250,7 +252,7 @@ def _add_environment(spec: mujoco.MjSpec) -> None:
     world.add_geom(name="floor", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[2, 2, 0.1], pos=[0, 0.6, -0.75], rgba=[0.35, 0.35, 0.38, 1])
     table = world.add_body(name="table", pos=[TABLE_CENTER[0], TABLE_CENTER[1], -TABLE_HALF[2]])
     # A thick box, not the thin mesh: objects resting on a mesh skin were launched.
-    table.add_geom(name="table", type=mujoco.mjtGeom.mjGEOM_BOX, size=list(TABLE_HALF), rgba=[0.55, 0.45, 0.35, 1], friction=[1.0, 0.005, 0.0001])
+    table.add_geom(name="table", type=mujoco.mjtGeom.mjGEOM_BOX, size=list(TABLE_HALF), rgba=[0.55, 0.45, 0.35, 1], friction=[TABLE_FRICTION, 0.005, 0.0001])
     for xyz, direction in (((-1, -1, 1.5), (1, 1, -1.5)), ((1, -1, 1.5), (-1, 1, -1.5))):
         world.add_light(pos=list(xyz), dir=list(direction), type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL, diffuse=[0.45, 0.45, 0.45], castshadow=0)
     target = mujoco.mjtCamLight.mjCAMLIGHT_TARGETBODY
