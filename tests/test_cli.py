@@ -121,3 +121,13 @@ def test_plan_with_the_llm_reasoner_against_a_replay_server(tmp_path, monkeypatc
         assert result.exit_code == 0, result.output
         assert len(server.requests) == 3
     assert load_graph(out).recovery_edges()
+
+
+def test_run_prints_which_arm_a_recovery_was_bound_to_under_the_real_protocol():
+    from click.testing import CliRunner
+
+    from agentchord.cli import main
+
+    result = CliRunner().invoke(main, ["run", "single_arm_pour_water", "--protocol", "real", "--seed", "9"])
+    assert result.exit_code in (0, 1), result.output
+    assert "disturbance" in result.output and "recovery bound to" in result.output

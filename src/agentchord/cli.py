@@ -347,7 +347,16 @@ def _print_episode(console: Console, result) -> None:
         elif kind == "failure_detected":
             console.print(f"{tick}  [red]failure detected[/red]: {event['failure']} on {event['edge']} (violated since tick {event['onset_tick']})")
         elif kind == "recovery_switch":
-            console.print(f"{tick}  [magenta]recovery switch[/magenta] -> {event['to']} ({event['latency_ticks']} ticks after onset)")
+            others = f" (or {', '.join(event['alternatives'])})" if event.get("alternatives") else ""
+            console.print(f"{tick}  [magenta]recovery switch[/magenta] -> {event['to']}{others} ({event['latency_ticks']} ticks after onset)")
+        elif kind == "recovery_bound":
+            refused = "".join(f"; not {r['edge']}: {r['reason']}" for r in event["refused"])
+            console.print(f"{tick}  [magenta]recovery bound[/magenta] to {event['edge']} ({'+'.join(event['arms'])} arm, "
+                          f"waited {event['waited_ticks']} ticks for it to come to rest{refused})")
+        elif kind == "recovery_failed":
+            console.print(f"{tick}  [red]recovery failed[/red]: {event['edge']}: {event['reason']}; trying the next candidate")
+        elif kind == "unrecoverable":
+            console.print(f"{tick}  [red]unrecoverable[/red]: {event['obj']}: {event['reason']}")
         elif kind == "repair":
             state = "added" if event["accepted"] else f"rejected ({event.get('reason')})"
             console.print(f"{tick}  [cyan]online repair[/cyan] after {event['edge']}: {event['observation']} -> {event['failure']} / {event['recovery']} {state}")
