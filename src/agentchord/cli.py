@@ -7,7 +7,6 @@ Exit statuses (:mod:`agentchord.cli_support`): 0 success, 1 the task failed (``r
 
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 

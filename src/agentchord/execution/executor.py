@@ -67,6 +67,8 @@ REST_SPEED = 0.03
 REST_TICKS = 10
 #: Height (m) under which an object's lower axis end must be to count as resting on the table.
 RESTING_HEIGHT = 0.05
+
+
 @dataclass
 class Binding:
     """A recovery waiting to bind its arm: the candidates (entry edge, then its alternatives).
@@ -289,11 +291,7 @@ class Executor:
             outcome = self._bind(frame)
             if outcome is not None:
                 return outcome
-            if self.binding is not None:  # still waiting: the arms hold their poses
-                self.robot.step()
-                if self.on_tick is not None:
-                    self.on_tick(self)
-                return None
+        # While a recovery is still binding, nothing is armed or running: the arms hold their poses.
         if self.armed is not None:
             detection = self.armed.evaluate(frame)
             if detection is not None:
@@ -336,6 +334,15 @@ class Executor:
                 return f"{UNRECOVERABLE}: {name} fell off the table (z = {z:.2f} m, table top at 0) at {self._where()}"
         return None
 
+    def _beyond_every_arm(self, obj: str, confirm_ik: bool) -> tuple[bool, str] | None:
+        """The unrecoverable outcome when no arm can take ``obj`` where it is (else None)."""
+        beyond = self.feasibility.unreachable(obj, confirm_ik=confirm_ik)
+        if not beyond:
+            return None
+        reasons = "; ".join(c.reason for c in beyond)
+        self.trace.add(self.world.tick, "unrecoverable", obj=obj, reason=reasons)
+        return False, f"{UNRECOVERABLE}: no arm can take {obj} at {self.feasibility.where(obj)} ({reasons})"
+
     # ------------------------------------------------------- binding
     def _begin_recovery(self, candidates: list[EdgeProgram]) -> tuple[bool, str] | None:
         """Start a recovery: at once when it grasps nothing, else after binding its arm."""
@@ -369,16 +376,14 @@ class Executor:
                 self.trace.add(self.world.tick, "recovery_bound", edge=candidate.edge_id, waited_ticks=waited,
                                refused=refused, arms=sorted({a.arm for step in candidate.steps for a in step}))
                 self._start(candidate)
-                self._fallbacks = [EdgeProgram.from_edge(self.graph.edge(c.edge_id)) for c in binding.candidates[k + 1:]]
+                self._fallbacks = binding.candidates[k + 1:]  # not started yet: still fresh programs
                 return None
             refused.append({"edge": candidate.edge_id, "reason": "; ".join(p.reason for p in problems)})
         summary = "; ".join(f"{r['edge']}: {r['reason']}" for r in refused)
         for obj in binding.objects:
-            beyond = self.feasibility.unreachable(obj)
-            if beyond:
-                self.trace.add(self.world.tick, "unrecoverable", obj=obj, reason="; ".join(c.reason for c in beyond))
-                return False, (f"{UNRECOVERABLE}: no arm can take {obj} at {self.feasibility.where(obj)} "
-                               f"({'; '.join(c.reason for c in beyond)})")
+            outcome = self._beyond_every_arm(obj, confirm_ik=True)
+            if outcome is not None:
+                return outcome
         return False, f"no feasible recovery for {', '.join(binding.objects)} at {self.feasibility.where(binding.objects[0])}: {summary}"
 
     # ------------------------------------------------------- transitions
@@ -407,11 +412,9 @@ class Executor:
         program = EdgeProgram.from_edge(self.graph.edge(next_edge))
         for grasp in first_grasps(program):
             # Before the arm moves: an object beyond every arm ends the episode now, not after budgets.
-            beyond = self.feasibility.unreachable(grasp.args.obj, confirm_ik=False)
-            if beyond:
-                self.trace.add(self.world.tick, "unrecoverable", obj=grasp.args.obj, reason="; ".join(c.reason for c in beyond))
-                return False, (f"{UNRECOVERABLE}: no arm can take {grasp.args.obj} at {self.feasibility.where(grasp.args.obj)} "
-                               f"({'; '.join(c.reason for c in beyond)})")
+            outcome = self._beyond_every_arm(grasp.args.obj, confirm_ik=False)
+            if outcome is not None:
+                return outcome
         self._start(program)
         return None
 

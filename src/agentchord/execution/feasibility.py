@@ -25,7 +25,7 @@ from agentchord.worlds.sim.scene import HOME_Q
 #: An object whose centre is this far below the table top (m) has left the table.
 OFF_TABLE_Z = -0.05
 #: How far (m) beyond the reach shell's outer radius a pose is ruled out by the model alone; nearer, the IK decides.
-REACH_SLACK_FLOOR = -0.12
+REACH_BEYOND_LIMIT = 0.12
 #: IK iterations from each start, and the position residual (m) under which a pose counts as reached.
 IK_ITERATIONS = 150
 IK_TOLERANCE = 0.01
@@ -153,7 +153,7 @@ class FeasibilityChecker:
         # radius; anything nearer (a top-down grasp close to the base) is for the IK to judge.
         reach = REACH[arm]
         beyond = max(float(np.linalg.norm(pose.pos - reach.shoulder)) - reach.r_max for pose in poses)
-        if beyond > -REACH_SLACK_FLOOR:
+        if beyond > REACH_BEYOND_LIMIT:
             return GraspCheck(arm, obj, f"{obj} is out of the {arm} arm's reach ({100 * beyond:.0f} cm beyond its shell)")
         if confirm_ik and not self._ik_reaches(arm, poses, avoid_other_arm):
             return GraspCheck(arm, obj, f"the IK finds no {arm}-arm grasp of {obj} where it lies")

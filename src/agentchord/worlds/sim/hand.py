@@ -64,16 +64,17 @@ class PersonHand:
         self.inertia = float(np.max(model.body_inertia[body]))
         start = Waypoint(data.xpos[body].copy(), Rotation.from_matrix(data.xmat[body].reshape(3, 3)), 0.0)
         self._segments = list(zip([start, *waypoints[:-1]], waypoints, strict=True))
+        # One interpolator per segment, built once: the reference is read every physics step.
+        self._slerps = [Slerp([0.0, 1.0], Rotation.concatenate([a.rotation, b.rotation])) for a, b in self._segments]
         self._t = 0.0
         self.done = False
 
     def _reference(self) -> tuple[np.ndarray, Rotation]:
         t = self._t
-        for a, b in self._segments:
+        for (a, b), slerp in zip(self._segments, self._slerps, strict=True):
             if t <= b.seconds:
                 s = min_jerk(t / b.seconds)
-                rot = Slerp([0.0, 1.0], Rotation.concatenate([a.rotation, b.rotation]))([s])[0]
-                return a.pos + s * (b.pos - a.pos), rot
+                return a.pos + s * (b.pos - a.pos), slerp([s])[0]
             t -= b.seconds
         last = self._segments[-1][1]
         return last.pos, last.rotation
