@@ -90,3 +90,20 @@ def test_place_without_the_object_in_hand_fails_with_a_reason(pour_scene):
 def test_unknown_action_arguments_are_refused():
     with pytest.raises(Exception, match="angle"):
         make_action("rotate_eef", "right", {"angel": 90})
+
+
+def test_a_side_grasp_beside_the_arms_own_base_backs_off_less_and_still_holds(pour_scene):
+    import dataclasses
+
+    # The cup set down low beside the left arm's base: the usual 8 cm pre-grasp folds the elbow past its limit.
+    objects = [dataclasses.replace(o, pos=(-0.1, 0.57)) if o.name == "cup" else o for o in pour_scene.objects]
+    world, robot, extractor = _setup(dataclasses.replace(pour_scene, objects=objects))
+    for _ in range(20):
+        robot.step()
+        extractor.update()
+    grasp = make_action("grasp", "left", {"obj": "cup"})
+    pre, point = (pose.pos for pose in grasp.target_poses(robot))
+    backed_off = float(np.linalg.norm((pre - point)[:2]))
+    assert backed_off < 0.079 or pre[2] > point[2] + 0.02  # a shorter or a higher pre-grasp than the asked one
+    status, _ = _run(robot, extractor, grasp)
+    assert status == Status.SUCCESS and world.holding("left", "cup")

@@ -125,3 +125,22 @@ def test_a_perturbed_grasp_re_approaches_the_object_where_it_is_now():
     assert detected and detected[0]["failure"] == "bottle_shifted"
     assert result.trace.of("recovery_switch")[0]["to"] == "e1_r_bottle_dropped"
     assert result.success, result.reason
+
+
+def test_a_recovery_that_merges_with_a_constraint_violated_fires_the_failure_watching_it():
+    from agentchord.graph.models import ActionCall
+    from agentchord.tasks import load_task_graph
+
+    graph = load_task_graph(TASK)
+    # A recovery cut short (here: one that only opens the hand, unwatched) merges at v2 without the bottle.
+    graph.edge("e2_r_bottle_dropped").actions = [{"right": ActionCall(fn="open_gripper")}]
+    graph.edge("r_bottle_regrasped_to_v2").failures = []
+    graph.edges = [e for e in graph.edges if e.alternative_to != "e2_r_bottle_dropped"]
+    drop = ScriptedDrop(action="move_to_obj", nth=0, after=30)
+    result = run_episode(EpisodeSpec(TASK, seed=1, graph=graph, disturbance=drop))
+    merge = result.trace.of("violation_at_merge")
+    assert [(m["node"], m["edge"], m["failure"]) for m in merge] == [("v2", "e3", "bottle_dropped")]
+    # The next edge's own recovery runs at once (it re-grasps), instead of starting e3 without the bottle.
+    switches = [(s["edge"], s["to"], s["latency_ticks"]) for s in result.trace.of("recovery_switch")]
+    assert switches[-1] == ("e3", "e3_r_bottle_dropped", 0)
+    assert result.success, result.reason

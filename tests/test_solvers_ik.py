@@ -36,3 +36,25 @@ def test_arms_sent_through_each_other_stop_short_of_colliding():
     _drive(guarded, goals)
     assert _min_arm_distance(guarded) > -0.01
     assert guarded.tcp_pose("left").pos[0] < guarded.tcp_pose("right").pos[0]
+
+
+def test_a_scratch_solve_from_home_reaches_what_a_stalled_start_does_not():
+    from agentchord.actions.motion import grasp_frame, pose_from_matrix
+    from agentchord.solvers.ik import solve_from_scratch
+    from agentchord.solvers.reach import REACH
+
+    ik = BimanualIK(iterations=150, avoid_arm_collisions=False)
+    home = ik.configuration.q.copy()
+    # A low side grasp beside the left arm's own base: reached with a short pre-grasp, not with the 8 cm one.
+    point = np.array([-0.1, 0.57, 0.044])
+    rotation = grasp_frame(point - np.r_[REACH["left"].shoulder[:2], 0.0])
+    grasp = pose_from_matrix(point, rotation)
+    q = solve_from_scratch(ik, home, "left", [pose_from_matrix(point - 0.04 * rotation[:, 0], rotation), grasp])
+    assert q is not None
+    ik.reset(home)
+    ik.set_arm_q("left", q)
+    assert np.linalg.norm(ik.tcp_pose("left").pos - point) < 0.01
+    assert solve_from_scratch(ik, home, "left", [pose_from_matrix(point - 0.08 * rotation[:, 0], rotation), grasp]) is None
+    far = PoseTarget(np.array([0.0, 2.0, 0.1]), grasp.quat)
+    assert solve_from_scratch(ik, home, "left", [far]) is None
+    assert solve_from_scratch(ik, home, "left", [grasp], from_current=False, from_home=False) is None

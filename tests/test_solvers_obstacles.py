@@ -68,3 +68,19 @@ def test_malformed_spheres_are_refused():
     with pytest.raises(ValueError, match=">= 0"):
         Spheres([[0.0, 0.0, 0.0]], [-0.1])
     assert len(Spheres.concat(Spheres(), Spheres([[0, 0, 0]], [0.1]))) == 1
+
+
+def test_a_carry_goes_straight_when_clear_and_over_an_object_in_the_way():
+    from agentchord.solvers.obstacles import CARRY_CLEARANCE, Spheres, lift_over
+
+    cup = Spheres(np.array([[0.0, 0.5, 0.02], [0.0, 0.5, 0.06]]), np.array([0.04, 0.04]))  # top at 0.10
+    bottle = Spheres(np.array([[0.0, 0.0, -0.05], [0.0, 0.0, 0.05]]), np.array([0.035, 0.035]))  # hangs 8.5 cm below the tool
+    start, goal = np.array([0.0, 0.7, 0.15]), np.array([0.0, 0.38, 0.15])
+    # Clear path (the cup elsewhere): the goal alone.
+    assert [w.tolist() for w in lift_over(start, goal, cup.translated([0.3, 0.0, 0.0]), bottle)] == [goal.tolist()]
+    # Through the cup: up, across, down; the bottle's lowest point clears the cup's top.
+    up, across, down = lift_over(start, goal, cup, bottle)
+    assert up[2] == across[2] and up[2] - 0.085 >= 0.10 + CARRY_CLEARANCE - 1e-9
+    assert np.allclose(up[:2], start[:2]) and np.allclose(across[:2], goal[:2]) and np.allclose(down, goal)
+    # Nothing carried: the tool goes straight.
+    assert len(lift_over(start, goal, cup, Spheres())) == 1

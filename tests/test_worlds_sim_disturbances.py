@@ -93,3 +93,25 @@ def test_landings_stay_in_the_stated_ranges(kind, low, high, upright):
         assert any(x.reachable.values())
         if upright is not None:
             assert x.upright is upright
+
+
+def test_a_push_or_a_knock_never_takes_an_object_in_the_air(pour_scene):
+    from agentchord.features.oracle import OracleExtractor
+    from agentchord.worlds.sim.disturbances import _free_objects
+    from agentchord.worlds.sim.world import SimWorld
+
+    world = SimWorld(pour_scene)
+    extractor = OracleExtractor(world, grasp_signal=lambda arm: False)
+    for _ in range(30):
+        world.step()
+    extractor.update()
+    # Lift the cup 20 cm, as if just dropped from a hand.
+    joint = world.model.body("cup").jntadr[0]
+    world.data.qpos[world.model.jnt_qposadr[joint] + 2] += 0.2
+    world.step()
+    extractor.update()
+    assert _free_objects(extractor.frame, world) == ["bottle"]  # the cup is in the air: no one pushes it
+    for _ in range(150):  # it lands and comes to rest: then it can be pushed again
+        world.step()
+    extractor.update()
+    assert _free_objects(extractor.frame, world) == ["bottle", "cup"]

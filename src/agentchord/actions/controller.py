@@ -18,6 +18,9 @@ from agentchord.solvers.ik import BimanualIK, PoseTarget
 from agentchord.worlds.sim.scene import ARM_PREFIX
 from agentchord.worlds.sim.world import ArmCommand, SimWorld
 
+#: QP iterations per call of a scratch (trial) IK solve.
+SCRATCH_IK_ITERATIONS = 150
+
 
 @dataclass
 class ArmTarget:
@@ -53,7 +56,14 @@ class RobotController:
         self.frame: FeatureFrame | None = None
         #: Wall seconds of every receding-horizon path solve (for the benchmarks).
         self.path_solves: list[float] = []
+        self._scratch_ik: dict[bool, BimanualIK] = {}
         self.sync_from_world()
+
+    def scratch_ik(self, avoid_other_arm: bool = True) -> BimanualIK:
+        """A many-iteration IK solver for trial solves; the live solver's warm start stays untouched."""
+        if avoid_other_arm not in self._scratch_ik:
+            self._scratch_ik[avoid_other_arm] = BimanualIK(iterations=SCRATCH_IK_ITERATIONS, avoid_arm_collisions=avoid_other_arm)
+        return self._scratch_ik[avoid_other_arm]
 
     def sync_from_world(self) -> None:
         """Take the measured robot state as the commanded state (after a reset)."""

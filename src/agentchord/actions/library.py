@@ -17,6 +17,7 @@ from agentchord.actions import catalog
 from agentchord.actions.base import ActionFailed, ArmAction
 from agentchord.actions.controller import RobotController
 from agentchord.actions.motion import (
+    approach,
     grasp_frame,
     grip,
     move_along_solved_path,
@@ -29,10 +30,12 @@ from agentchord.actions.motion import (
 from agentchord.features.frame import tilt_deg
 from agentchord.solvers.exceptions import NoHandoffSpotError
 from agentchord.solvers.handoff import handoff_spot
-from agentchord.solvers.ik import PoseTarget
-from agentchord.solvers.obstacles import held_spheres, scene_spheres
+from agentchord.solvers.ik import PoseTarget, solve_from_scratch
+from agentchord.solvers.obstacles import held_spheres, lift_over, scene_spheres
 from agentchord.worlds.sim.scene import ARM_JOINTS, ARM_PREFIX, FINGER_GAP_OFFSET, FINGER_RANGE, HOME_Q
 
+#: Joint speed (rad/s, largest joint) of joint-space moves with an empty hand.
+EMPTY_HAND_JOINT_SPEED = 2.0
 #: Tilt (deg) beyond which an object counts as fallen for a side grasp.
 UPRIGHT_TOLERANCE_DEG = 25.0
 #: An object that moved more than this (m) while the tool approached it is looked at again.
@@ -120,6 +123,10 @@ class Grasp(ArmAction):
     SIDE_MIN_HEIGHT = 0.08
     #: The finger tips reach this far past the tool centre (m): keep them off the table.
     FINGERTIP_REACH = 0.039
+    #: Side grasps tried in order where the asked one cannot be made: (share of the pre-grasp
+    #: distance, rise of the pre-grasp pose in m, grasp height as a share of the object's or
+    #: None for the asked one; a higher one is only ever taken).
+    SIDE_VARIANTS = ((1.0, 0.0, None), (1.0, 0.03, None), (0.5, 0.0, None), (0.5, 0.03, None), (0.5, 0.03, 0.8))
 
     def script(self, robot: RobotController) -> Iterator[None]:
         held = robot.targets[self.arm].grip_closed_settled and robot.frame.is_holding(self.arm, self.args.obj)
@@ -163,15 +170,14 @@ class Grasp(ArmAction):
             rotation, point = self._fallen_frame(robot)
             pre = point + np.array([0.0, 0.0, self.args.pre_grasp_dis])
         else:
-            point = self._side_point(robot)
-            rotation = self._side_rotation(robot, point)
-            pre = point - self.args.pre_grasp_dis * rotation[:, 0]
+            pre, point, rotation = self._side_plan(robot)
         return [pose_from_matrix(pre, rotation), pose_from_matrix(point, rotation)]
 
     def _attempt(self, robot: RobotController) -> Iterator[None]:
         feats = robot.frame.objects[self.args.obj]
         self._seen_at = feats.pos.copy()
         self._taken_as = self._mode(robot)
+        self._height_fraction: float | None = None
         self._upright_at_start = tilt_deg(feats.axis) <= UPRIGHT_TOLERANCE_DEG
         if feats.pos[2] < -0.02:
             raise ActionFailed(f"{self.args.obj} fell off the table")
@@ -201,7 +207,8 @@ class Grasp(ArmAction):
         yield from grip(robot, arm, 0.0, ticks=8)
         retreat = down - 0.08 * rotation[:, 0] + np.array([0.0, 0.0, 0.04])
         yield from move_to(robot, arm, pose_from_matrix(retreat, rotation))
-        yield from move_joints(robot, arm, HOME_Q)
+        # The hand is empty: unwind the wrist (wound far by the fallen grasp) at twice the usual speed.
+        yield from move_joints(robot, arm, HOME_Q, speed=EMPTY_HAND_JOINT_SPEED)
         robot.set_pose(arm, robot.ik.tcp_pose(arm))
         yield from wait_for_rest(robot, self.args.obj)
         if tilt_deg(robot.frame.objects[self.args.obj].axis) > UPRIGHT_TOLERANCE_DEG:
@@ -224,10 +231,41 @@ class Grasp(ArmAction):
             yield from move_to(robot, arm, pose_from_matrix(robot.commanded_pose(arm).pos + back, rotation), speed=0.2)
         robot.set_grip(arm, 0.0)
 
-    def _side_point(self, robot: RobotController) -> np.ndarray:
+    def _side_point(self, robot: RobotController, height_fraction: float | None = None) -> np.ndarray:
         feats = robot.frame.objects[self.args.obj]
         height = float(np.linalg.norm(feats.top - feats.bottom))
-        return feats.bottom + self.args.height * height * feats.axis + self._offset(feats)
+        fraction = self.args.height if height_fraction is None else height_fraction
+        return feats.bottom + fraction * height * feats.axis + self._offset(feats)
+
+    def _side_variant(self, robot: RobotController, variant: tuple[float, float, float | None]):
+        scale, rise, fraction = variant
+        if fraction is not None:
+            fraction = max(fraction, self.args.height)
+        point = self._side_point(robot, fraction)
+        rotation = self._side_rotation(robot, point)
+        pre = point - scale * self.args.pre_grasp_dis * rotation[:, 0] + np.array([0.0, 0.0, rise])
+        return pre, point, rotation, fraction
+
+    def _side_plan(self, robot: RobotController) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The side grasp's pre-grasp point, grasp point and tool rotation, and remembers its height.
+
+        The asked one, unless the IK reaches it neither from the current configuration nor from
+        home (an object beside the arm's own base: backing off folds the elbow past its limit);
+        then the first of ``SIDE_VARIANTS`` it reaches (a shorter or higher pre-grasp, a higher
+        grasp point).
+        """
+        plans = [self._side_variant(robot, variant) for variant in self.SIDE_VARIANTS]
+        chosen = plans[0]
+        q = robot.ik.configuration.q.copy()
+        ik = robot.scratch_ik(avoid_other_arm=False)
+        for index, (pre, point, rotation, _) in enumerate(plans):
+            poses = [pose_from_matrix(pre, rotation), pose_from_matrix(point, rotation)]
+            # The asked grasp from where the arm is, every grasp from home: the same choice on every frame.
+            if solve_from_scratch(ik, q, self.arm, poses, from_current=index == 0) is not None:
+                chosen = plans[index]
+                break
+        pre, point, rotation, self._height_fraction = chosen
+        return pre, point, rotation
 
     def _clear_from_below(self, robot: RobotController, height: float) -> Iterator[None]:
         # Coming from low (a recovery after a drop): rise first so the fingers clear the object.
@@ -243,6 +281,9 @@ class Grasp(ArmAction):
             moved = float(np.linalg.norm(robot.frame.objects[self.args.obj].pos - self._seen_at))
             if moved > MOVED_DURING_APPROACH:
                 raise GraspMissed(f"{self.args.obj} moved {100 * moved:.1f} cm during the approach") from None
+            if robot.ik.arms_close():
+                # The collision limit held this arm back from the other one (busy beside it): try again.
+                raise GraspMissed(f"the other arm was in the way of the grasp of {self.args.obj}") from None
             raise
         aimed = robot.commanded_pose(self.arm).pos.copy()
         yield from grip(robot, self.arm, 1.0)
@@ -252,8 +293,11 @@ class Grasp(ArmAction):
         # where the grasp point is now, seen from where the tool aimed, says so.
         # (Not for a fallen or leaning object: the closing fingers turn it, which is the point.)
         upright = tilt_deg(robot.frame.objects[self.args.obj].axis) <= UPRIGHT_TOLERANCE_DEG
-        off = float(np.linalg.norm(self.target_poses(robot)[-1].pos - aimed)) if self._taken_as == "top" or (
-            self._taken_as == "side" and upright and self._upright_at_start) else 0.0
+        off = 0.0
+        if self._taken_as == "top":
+            off = float(np.linalg.norm(self._top_frame(robot)[1] - aimed))
+        elif self._taken_as == "side" and upright and self._upright_at_start:
+            off = float(np.linalg.norm(self._side_point(robot, self._height_fraction) - aimed))
         if off > OFF_CENTRE_TOLERANCE:
             raise GraspMissed(f"{self.args.obj} is held {100 * off:.1f} cm off the grasp point")
 
@@ -266,14 +310,12 @@ class Grasp(ArmAction):
 
     def _side_grasp(self, robot: RobotController) -> Iterator[None]:
         arm = self.arm
-        point = self._side_point(robot)
-        rotation = self._side_rotation(robot, point)
-        pre = point - self.args.pre_grasp_dis * rotation[:, 0]
+        pre, point, rotation = self._side_plan(robot)
         if np.linalg.norm(robot.commanded_pose(arm).pos[:2] - pre[:2]) > 0.05:
             yield from self._clear_from_below(robot, pre[2] + 0.08)
-        yield from move_to(robot, arm, pose_from_matrix(pre, rotation))
+        yield from approach(robot, arm, pose_from_matrix(pre, rotation))
         # Re-observe: the object may have moved while the arm approached.
-        point = self._side_point(robot)
+        point = self._side_point(robot, self._height_fraction)
         yield from move_to(robot, arm, pose_from_matrix(point, rotation), speed=0.15)
         yield from self._close_and_check(robot)
         lift = robot.commanded_pose(arm).pos + np.array([0.0, 0.0, self.args.lift])
@@ -327,7 +369,7 @@ class Grasp(ArmAction):
         rotation, point = self._top_frame(robot)
         above = point + np.array([0.0, 0.0, self.args.pre_grasp_dis])
         yield from self._clear_from_below(robot, above[2])
-        yield from move_to(robot, arm, pose_from_matrix(above, rotation))
+        yield from approach(robot, arm, pose_from_matrix(above, rotation))
         # A top-down tool often flips the forearm roll: let the IK converge before descending.
         yield from settle(robot, arm, tolerance=0.003, max_ticks=60, required=0.015)
         rotation, point = self._top_frame(robot)
@@ -355,7 +397,7 @@ class Grasp(ArmAction):
         rotation, point = self._fallen_frame(robot)
         top_dir = rotation[:, 2]
         yield from self._clear_from_below(robot, point[2] + self.args.pre_grasp_dis + 0.05)
-        yield from move_to(robot, arm, pose_from_matrix(point + np.array([0, 0, self.args.pre_grasp_dis]), rotation))
+        yield from approach(robot, arm, pose_from_matrix(point + np.array([0, 0, self.args.pre_grasp_dis]), rotation))
         # A top-down tool often flips the forearm roll: let the IK converge before descending.
         yield from settle(robot, arm, tolerance=0.003, max_ticks=60, required=0.015)
         feats = robot.frame.objects[self.args.obj]
@@ -404,7 +446,10 @@ class MoveToObj(ArmAction):
             # The object aimed at is the goal, not an obstacle.
             yield from move_along_solved_path(robot, arm, pose_from_matrix(target, rotation), lambda: _avoid(robot, arm, (self.args.obj,)))
         else:
-            yield from move_to(robot, arm, pose_from_matrix(target, rotation))
+            # Straight, unless what the arm carries would be driven through another object on the way.
+            obstacles, carried = _avoid(robot, arm, ())
+            for waypoint in lift_over(robot.commanded_pose(arm).pos, target, obstacles, carried):
+                yield from move_to(robot, arm, pose_from_matrix(waypoint, rotation))
         # Re-aim at the object's latest position (it may have been moved).
         target = robot.frame.objects[self.args.obj].top + np.asarray(self.args.offset)
         yield from move_to(robot, arm, pose_from_matrix(target, rotation), speed=0.15)

@@ -14,9 +14,9 @@ from scipy.spatial.transform import Rotation, Slerp
 
 from agentchord.actions.base import ActionFailed
 from agentchord.actions.controller import RobotController
-from agentchord.solvers.ik import PoseTarget
+from agentchord.solvers.ik import PoseTarget, solve_from_scratch
 from agentchord.solvers.obstacles import Spheres
-from agentchord.worlds.sim.scene import TABLE_HALF
+from agentchord.worlds.sim.scene import HOME_Q, TABLE_HALF
 
 #: Cartesian speed limits of the tool (m/s, rad/s).
 LINEAR_SPEED = 0.30
@@ -77,6 +77,47 @@ def move_to(robot: RobotController, arm: str, goal: PoseTarget, speed: float = L
         s = min_jerk(k / ticks)
         robot.set_pose(arm, PoseTarget(pos=start.pos + s * (goal_pos - start.pos), quat=_to_quat(slerp(s))))
         yield
+
+
+#: A tool farther than this (m) from an approach pose once the move ends has stalled on the way.
+APPROACH_TOLERANCE = 0.015
+
+
+def approach(
+    robot: RobotController, arm: str, goal: PoseTarget, speed: float = LINEAR_SPEED, settle_ticks: int = 60
+) -> Iterator[None]:
+    """Move the tool to ``goal`` in a straight line; where it stalls, go round through home.
+
+    The live IK follows the straight line a few iterations per tick and can stall in a local
+    minimum (a joint limit) short of a pose that is reachable (an object pushed or set down
+    beside the arm's own base). When a scratch IK from the current configuration stalls too
+    but one from home reaches the pose, the arm goes there in joint space: back to home first,
+    so the detour starts from a posture clear of the table. Otherwise nothing more happens
+    here: the action's own checks judge the pose as they always did.
+
+    Args:
+        robot: The robot.
+        arm: The arm.
+        goal: The tool pose.
+        speed: Straight-line speed (m/s).
+        settle_ticks: Ticks the IK gets to converge at the end of the line (a tool turning
+            its forearm roll needs many) before it counts as stalled.
+    """
+    yield from move_to(robot, arm, goal, speed=speed)
+    yield from settle(robot, arm, tolerance=APPROACH_TOLERANCE, max_ticks=settle_ticks)
+    if float(np.linalg.norm(robot.frame.arms[arm].ee - goal.pos)) < APPROACH_TOLERANCE:
+        return
+    ik, q = robot.scratch_ik(), robot.ik.configuration.q.copy()
+    if solve_from_scratch(ik, q, arm, [goal], from_home=False) is not None:
+        return  # slow, not stalled
+    q_goal = solve_from_scratch(ik, q, arm, [goal], from_current=False)
+    if q_goal is None:
+        return
+    # The hand is empty (it is on its way to grasp): twice the usual joint speed.
+    yield from move_joints(robot, arm, HOME_Q, speed=2.0)
+    yield from move_joints(robot, arm, q_goal, speed=2.0)
+    robot.set_pose(arm, goal)
+    yield from settle(robot, arm, tolerance=APPROACH_TOLERANCE, max_ticks=settle_ticks)
 
 
 #: Receding-horizon path following: waypoints planned per solve, executed before re-solving.

@@ -395,6 +395,7 @@ class Executor:
         self.path.append(node_id)
         self.trace.add(self.world.tick, "node_reached", node=node_id, kind=node.kind, constraints_hold=held,
                        violated=[] if held else self.violated_constraints(node_id))
+        merging = node.kind == "nominal" and self.recovering_from is not None
         if node.kind == "nominal":
             self.visited_nominal.append(node_id)
             self.keyframes[node_id] = {arm: (self.robot.ik.arm_q(arm), t.grip) for arm, t in self.robot.targets.items()}
@@ -409,6 +410,10 @@ class Executor:
         next_edge = self.strategy.next_edge(self, node_id)
         if next_edge is None:
             return False, f"no edge leaves node {node_id} toward the goal"
+        if merging and not held:
+            detection = self._watched_violation(node_id, next_edge)
+            if detection is not None:
+                return self._on_failure(detection)
         program = EdgeProgram.from_edge(self.graph.edge(next_edge))
         for grasp in first_grasps(program):
             # Before the arm moves: an object beyond every arm ends the episode now, not after budgets.
@@ -416,6 +421,22 @@ class Executor:
             if outcome is not None:
                 return outcome
         self._start(program)
+        return None
+
+    def _watched_violation(self, node_id: str, edge_id: str) -> Detection | None:
+        """A recovery merged at ``node_id`` with one of its constraints violated (a second disturbance
+        cut the first recovery short before it restored what it was for): the failure mode of the
+        next edge whose monitor watches that constraint, fired now, so its recovery runs rather than
+        an edge that cannot start (its monitor may be gated by a signal the cut-short recovery reset).
+        """
+        violated = {" ".join(c.source.split()): c.scalar(self.frame) for c in self.constraints[node_id]
+                     if c.scalar(self.frame) > 0.0}
+        for failure in self.graph.edge(edge_id).failures:
+            monitor = " ".join(failure.monitor.split())
+            watched = [value for source, value in violated.items() if source in monitor]
+            if watched:
+                self.trace.add(self.world.tick, "violation_at_merge", node=node_id, edge=edge_id, failure=failure.name)
+                return Detection(edge_id, failure, self.world.tick, self.world.tick, float(watched[0]))
         return None
 
     def _start(self, program: EdgeProgram) -> None:

@@ -18,16 +18,14 @@ from agentchord.actions.library import POINT_EXTENT, Grasp
 from agentchord.actions.catalog import GraspArgs
 from agentchord.execution.edge_program import EdgeProgram
 from agentchord.features.frame import ARMS, FeatureFrame
-from agentchord.solvers.ik import BimanualIK, PoseTarget
+from agentchord.solvers.ik import PoseTarget, solve_from_scratch
 from agentchord.solvers.reach import REACH
-from agentchord.worlds.sim.scene import HOME_Q
 
 #: An object whose centre is this far below the table top (m) has left the table.
 OFF_TABLE_Z = -0.05
 #: How far (m) beyond the reach shell's outer radius a pose is ruled out by the model alone; nearer, the IK decides.
 REACH_BEYOND_LIMIT = 0.12
-#: IK iterations from each start, and the position residual (m) under which a pose counts as reached.
-IK_ITERATIONS = 150
+#: Position residual (m) under which the IK counts a pose as reached.
 IK_TOLERANCE = 0.01
 
 
@@ -96,7 +94,6 @@ class FeasibilityChecker:
 
     def __init__(self, robot: RobotController) -> None:
         self.robot = robot
-        self._ik: dict[bool, BimanualIK] = {}
 
     def _ik_reaches(self, arm: str, poses: list[PoseTarget], avoid_other_arm: bool = True) -> bool:
         """Whether the IK reaches every pose (from the current configuration, else from home).
@@ -106,23 +103,9 @@ class FeasibilityChecker:
             poses: The poses, in order.
             avoid_other_arm: Keep clear of the other arm where it is now (unless it moves away first).
         """
-        if avoid_other_arm not in self._ik:
-            # Scratch solvers: the live one keeps the robot's warm start untouched.
-            self._ik[avoid_other_arm] = BimanualIK(iterations=IK_ITERATIONS, avoid_arm_collisions=avoid_other_arm)
-        ik = self._ik[avoid_other_arm]
+        ik = self.robot.scratch_ik(avoid_other_arm)
         current = self.robot.ik.configuration.q.copy()
-        for start in ("current", "home"):
-            ik.reset(current)
-            if start == "home":
-                ik.set_arm_q(arm, HOME_Q)
-            if all(self._solve(ik, arm, pose) for pose in poses):
-                return True
-        return False
-
-    @staticmethod
-    def _solve(ik: BimanualIK, arm: str, pose: PoseTarget) -> bool:
-        ik.solve({arm: pose})
-        return ik.residual(arm, pose) < IK_TOLERANCE
+        return solve_from_scratch(ik, current, arm, poses, IK_TOLERANCE) is not None
 
     def check_grasp(self, grasp: Grasp, *, hand_free: bool = True, confirm_ik: bool = True,
                     avoid_other_arm: bool = True) -> GraspCheck:

@@ -138,3 +138,41 @@ class BimanualIK:
     def residual(self, arm: str, target: PoseTarget) -> float:
         """Position error (m) of the current solution to a target."""
         return float(np.linalg.norm(self.tcp_pose(arm).pos - target.pos))
+
+
+def solve_from_scratch(
+    ik: BimanualIK, q: np.ndarray, arm: str, poses: list[PoseTarget], tolerance: float = 0.01,
+    from_current: bool = True, from_home: bool = True,
+) -> np.ndarray | None:
+    """Joints that put ``arm`` at the last of ``poses``, reached through the others in order.
+
+    Tries from the configuration ``q`` (full robot, IK model layout), then with the arm at
+    home: the live solver follows straight tool lines a few iterations per tick and can stall
+    against a joint limit that a solve from home goes around.
+
+    Args:
+        ik: A scratch solver (many iterations per call); its state is overwritten.
+        q: The robot's current configuration.
+        arm: The arm.
+        poses: The tool poses, in order.
+        tolerance: Position residual (m) under which a pose counts as reached.
+        from_current: Try the start ``q``.
+        from_home: Try ``q`` with the arm at home.
+
+    Returns:
+        The arm's six joints at the last pose, or None where no start reaches every pose.
+    """
+    starts = [start for start, wanted in ((False, from_current), (True, from_home)) if wanted]
+    for at_home in starts:
+        ik.reset(q)
+        if at_home:
+            ik.set_arm_q(arm, HOME_Q)
+        reached = True
+        for pose in poses:
+            ik.solve({arm: pose})
+            if ik.residual(arm, pose) >= tolerance:
+                reached = False
+                break
+        if reached:
+            return ik.arm_q(arm)
+    return None

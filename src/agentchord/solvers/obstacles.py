@@ -183,3 +183,49 @@ def _object_axes(features: ObjectFeatures) -> np.ndarray:
         x = rot[:, 1] - np.dot(rot[:, 1], z) * z
     x /= np.linalg.norm(x)
     return np.column_stack([x, np.cross(z, x), z])
+
+
+#: Overlap (m) beyond the covering's own slack that counts as a collision on a straight carry.
+CARRY_PENETRATION = 0.01
+#: Clearance (m) a lifted carry keeps over the obstacles it passes.
+CARRY_CLEARANCE = 0.02
+#: Obstacles this far (m) from the carried object's straight path in the plane are not passed over.
+CARRY_CORRIDOR = 0.12
+
+
+def lift_over(start: np.ndarray, goal: np.ndarray, obstacles: Spheres, carried: Spheres, samples: int = 24) -> list[np.ndarray]:
+    """Tool waypoints that carry an object from ``start`` to ``goal`` without driving it through another.
+
+    The straight line, where what the tool carries stays clear of every obstacle; else up over
+    the obstacles near the path, across at that height, and down onto the goal.
+
+    Args:
+        start: Tool position now (m).
+        goal: Tool position at the end (m).
+        obstacles: Obstacle spheres (world frame).
+        carried: What the tool carries, as offsets from the tool.
+        samples: Points checked along the line.
+
+    Returns:
+        The waypoints after ``start``, the last one ``goal``.
+    """
+    start, goal = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
+    if not len(obstacles) or not len(carried):
+        return [goal]
+    # The last few centimetres are the goal's own business (placed beside or above an object).
+    line = start + np.linspace(0.0, 1.0, samples)[:-3, None] * (goal - start)
+    points = (line[:, None, :] + carried.centres[None, :, :]).reshape(-1, 3)
+    radii = np.tile(carried.radii, len(line))
+    if float(obstacles.clearance(points, radii).min()) > -CARRY_PENETRATION:
+        return [goal]
+    # Height: the carried object's lowest point clears the tallest obstacle near the path.
+    direction = (goal - start)[:2]
+    length = max(float(np.linalg.norm(direction)), 1e-9)
+    offsets = obstacles.centres[:, :2] - start[:2]
+    along = np.clip(offsets @ direction / length, 0.0, length)
+    across = np.linalg.norm(offsets - along[:, None] * direction / length, axis=1)
+    near = across < CARRY_CORRIDOR + float(np.max(np.linalg.norm(carried.centres[:, :2], axis=1) + carried.radii))
+    top = float(np.max((obstacles.centres[:, 2] + obstacles.radii)[near])) if near.any() else 0.0
+    below = float(np.min(carried.centres[:, 2] - carried.radii))  # negative: how far the object hangs below the tool
+    height = max(start[2], goal[2], top - below + CARRY_CLEARANCE)
+    return [np.r_[start[:2], height], np.r_[goal[:2], height], goal]

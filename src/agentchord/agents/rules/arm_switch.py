@@ -2,9 +2,9 @@
 
 For every recovery entry edge that starts by one arm grasping a rigid object again
 (``regrasp``, ``re-approach`` of a grasp), the rule adds an alternative edge
-(``Edge.alternative_to``) with the same ends: the *other* arm takes the object
-wherever it lies, sets it down where both arms reach (``place`` with ``within_reach``;
-the spot is chosen when it runs), goes home, and then the entry edge's own steps run
+(``Edge.alternative_to``) with the same ends: the first arm opens and goes home out of
+the way while the *other* arm takes the object wherever it lies, sets it down where both
+arms reach (``place`` with ``within_reach``; the spot is chosen when it runs), goes home, and then the entry edge's own steps run
 unchanged, so the recovery merges where it always did. Still one pre-compiled branch
 per failure mode, still forward-moving (the alternative has the entry edge's ends, so
 Eq. 8 judges both alike): no re-planning at run time. Which of the two runs is decided
@@ -66,7 +66,9 @@ def arm_switch_alternative(entry: Edge, rigid: Iterable[str]) -> Edge | None:
     rest_first = {a: c for a, c in entry.steps[0].items() if a != other}
     hand_off: list[Step] = [
         # The arm that lost the object opens: its grasp-done signal resets, so its drop monitors wait for its own grasp.
-        {other: ActionCall(fn="grasp", args=args), arm: ActionCall(fn="open_gripper")},
+        {arm: ActionCall(fn="open_gripper")},
+        # ...and goes home while the other arm reaches: it may stand where it just tried to grasp.
+        {other: ActionCall(fn="grasp", args=args), arm: ActionCall(fn="back")},
         {other: ActionCall(fn="place", args={"obj": obj, "within_reach": arm})},
         {other: ActionCall(fn="back")},
     ]

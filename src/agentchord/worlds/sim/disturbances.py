@@ -95,10 +95,24 @@ def _held_by(frame: FeatureFrame, arm: str) -> list[str]:
     return sorted(obj for a, obj in frame.holding if a == arm)
 
 
+#: An object slower than this (m/s) and supported by the table or another object is at rest.
+RESTING_SPEED = 0.05
+
+
 def _free_objects(frame: FeatureFrame, world: SimWorld) -> list[str]:
+    """Objects at rest that no arm holds: what a person pushes or knocks over.
+
+    Not one in the air (just dropped, still falling): a push at table height on it would spin it.
+    """
     # Rigid bodies only: a frame may also carry feature points (a cloth's corners).
     held = {obj for _, obj in frame.holding}
-    return sorted(name for name in world.object_names if name not in held)
+    names = world.object_names
+
+    def resting(name: str) -> bool:
+        supported = world.on_table(name) or any(world.touching(name, other) for other in names if other != name)
+        return supported and world.object_velocity(name) < RESTING_SPEED
+
+    return sorted(name for name in names if name not in held and resting(name))
 
 
 def _slide(world: SimWorld, obj: str, direction: np.ndarray, distance: float) -> None:
