@@ -38,7 +38,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from agentchord.features.frame import FeatureFrame
-from agentchord.worlds.sim.hand import set_down_path
+from agentchord.worlds.sim.hand import OUT_S, set_down_path
 from agentchord.worlds.sim.scene import TABLE_FRICTION
 from agentchord.worlds.sim.world import CONTROL_HZ, SimWorld
 
@@ -51,6 +51,11 @@ KINDS = ("drop", "pull", "perturb", "shift", "knock")
 PRESETS: dict[str, tuple[str, ...]] = {"real": ("perturb", "pull"), "stress": KINDS}
 #: How long a gripper fault forces the fingers open (ticks at 50 Hz).
 FAULT_TICKS = 12
+#: ... and a pull: until the person's hand has taken the object out of the fingers (its first phase).
+PULL_FAULT_TICKS = int(np.ceil(OUT_S * CONTROL_HZ)) + 3
+#: How far (m) a pulled object slides out of the fingers: at least this, and its half length plus the margin.
+PULL_OUT_DISTANCE = 0.10
+PULL_OUT_MARGIN = 0.04
 #: A person sets a pulled object down this far (m, horizontal) from where they took it ...
 SET_DOWN_DISTANCE = (0.06, 0.25)
 #: ... inside this part of the table (x range, y range; m): in front of the robot, off its bases ...
@@ -191,7 +196,18 @@ def _take_and_set_down(world: SimWorld, frame: FeatureFrame, obj: str, arm: str,
         rest, height = yaw * Rotation.from_euler("y", 90.0, degrees=True), 0.5 * spec.width
     else:
         rest, height = yaw, 0.5 * spec.height
-    world.hand_carry(obj, set_down_path(pos, Rotation.from_matrix(matrix), out, spot, height, rest))
+    # Out of the fingers entirely: a fork taken out of a top grasp slides along its length.
+    distance = max(PULL_OUT_DISTANCE, _half_extent_along(spec, matrix, out) + PULL_OUT_MARGIN)
+    world.hand_carry(obj, set_down_path(pos, Rotation.from_matrix(matrix), out, spot, height, rest, distance))
+
+
+def _half_extent_along(spec, matrix: np.ndarray, direction: np.ndarray) -> float:
+    """Half the object's extent (m) along a world direction, in its pose ``matrix``."""
+    local = np.abs(matrix.T @ direction)
+    if spec.shape == "cylinder":
+        radius, half_height = spec.size[0], spec.size[1]
+        return float(local[2] * half_height + np.sqrt(max(1.0 - local[2] ** 2, 0.0)) * radius)
+    return float(local @ np.asarray(spec.size[:3], dtype=float))
 
 
 def _horizontal(rng: np.random.Generator) -> np.ndarray:
@@ -239,7 +255,8 @@ def inject(kind: str, world: SimWorld, frame: FeatureFrame, rng: np.random.Gener
         two_handed = any(a != arm for a, o in frame.holding if o == obj)
         if kind == "pull" and rigid and (world.hand_busy or two_handed):
             return None  # a person takes a rigid object out of one hand (not a tray held in two)
-        world.inject_gripper_fault(arm, FAULT_TICKS)
+        # A person pulling holds the fingers open until the object is out of them.
+        world.inject_gripper_fault(arm, PULL_FAULT_TICKS if kind == "pull" and rigid else FAULT_TICKS)
         if kind == "pull" and rigid:
             _take_and_set_down(world, frame, obj, arm, rng, spot, lying)
         # A cloth's corner pulled out of the fingers just falls back onto the table.

@@ -115,6 +115,7 @@ def set_down_path(
     spot: np.ndarray,
     rest_height: float,
     rest_rotation: Rotation,
+    out_distance: float = 0.10,
 ) -> list[Waypoint]:
     """Waypoints of a take-and-set-down: out of the fingers along ``out_dir``, over ``spot``, down.
 
@@ -125,8 +126,10 @@ def set_down_path(
         spot: (x, y) on the table where it is set down.
         rest_height: Height (m) of the object's centre when it rests in ``rest_rotation``.
         rest_rotation: Orientation it is set down in (upright or on its side).
+        out_distance: How far (m) it slides out of the fingers (a long object, taken out along
+            its length, needs more than its half length).
     """
-    out = pos + 0.10 * out_dir + np.array([0.0, 0.0, 0.03])
+    out = pos + out_distance * out_dir + np.array([0.0, 0.0, 0.03])
     above = np.array([spot[0], spot[1], rest_height + CARRY_CLEARANCE])
     down = np.array([spot[0], spot[1], rest_height + RELEASE_CLEARANCE])
     return [
