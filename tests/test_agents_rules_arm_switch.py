@@ -35,6 +35,28 @@ def test_the_other_arm_takes_the_object_sets_it_down_within_reach_then_the_entry
     assert [c[1] for c in calls[-3:]] == ["back", "grasp", "move_to_obj"]
 
 
+def test_a_busy_other_arm_sets_its_object_down_hands_over_and_takes_its_object_again():
+    entry = Edge.model_validate({
+        "id": "e3_r", "source": "v2", "target": "v2", "kind": "recovery",
+        "actions": [{"left": {"fn": "move_to_target", "args": {"pos": [-0.12, 0.72, 0.22]}},
+                     "right": {"fn": "grasp", "args": {"obj": "bottle", "reseat": True}}}],
+        "failures": [{"name": "bottle_dropped", "monitor": "right.closed * (0.5 - holding(right, bottle))", "intent": "regrasp", "recovery": "e3_r"},
+                     {"name": "cup_dropped", "monitor": "left.closed * (0.5 - holding(left, cup))", "intent": "regrasp", "recovery": "e3_c"}],
+    })
+    alt = arm_switch_alternative(entry, ["bottle", "cup"], {("left", "cup"): {"height": 0.4}})
+    assert alt is not None and alt.id == "e3_r_via_left"
+    steps = [{arm: (call.fn, call.args) for arm, call in step.items() if call is not None} for step in alt.steps]
+    assert steps[0] == {"right": ("open_gripper", {}), "left": ("place", {"obj": "cup"})}
+    assert steps[1] == {"left": ("grasp", {"obj": "bottle"}), "right": ("back", {})}
+    assert steps[2] == {"left": ("place", {"obj": "bottle", "within_reach": "right"})}
+    assert steps[3] == {"left": ("grasp", {"obj": "cup", "height": 0.4})}
+    assert steps[4]["left"][0] == "move_to_target" and steps[4]["right"][0] == "grasp"  # then the entry as written
+    # The left arm's own monitor would fire as it sets the cup down on purpose: not copied.
+    assert [f.name for f in alt.failures] == ["bottle_dropped"]
+    # Two objects in the other hand, or one it cannot set down: no alternative.
+    assert arm_switch_alternative(entry, ["bottle"]) is None
+
+
 def test_no_alternative_for_a_cloth_point_or_a_two_arm_grasp():
     cloth = Edge.model_validate({"id": "r", "source": "a", "target": "b", "kind": "recovery",
                                  "actions": {"left": {"fn": "grasp", "args": {"obj": "towel_bl"}}}})

@@ -34,6 +34,18 @@ def test_an_alternative_checks_the_hand_off_grasp_not_the_grasp_after_it():
     assert [(g.arm, g.args.obj) for g in grasps] == [("left", "bottle")]
 
 
+def test_a_busy_arm_that_sets_its_object_down_first_is_checked_for_the_hand_off_with_its_hand_freed():
+    from agentchord.execution.feasibility import places_first
+
+    graph = load_task_graph("dual_arm_pour_water")
+    alt = next(e for e in graph.edges if e.alternative_to == "e3_r_bottle_dropped")
+    program = EdgeProgram.from_edge(alt)
+    grasps = first_grasps(program)
+    # The left arm sets the cup down, then takes the bottle: that grasp is checked, with its hand counted free.
+    assert [(g.arm, g.args.obj) for g in grasps] == [("left", "bottle")]
+    assert places_first(program, grasps[0])
+
+
 def test_an_object_below_the_table_top_is_off_the_table():
     robot = _robot()
     assert off_table(robot.frame, ["bottle", "cup"]) == []

@@ -88,10 +88,13 @@ def test_library_graph_checks_clean_and_watches_every_held_object():
     assert check_graph(graph) == []
     assert forward_filter(graph).removed == []
     assert nominal_path(graph) == ["e1", "e2", "e3", "e4", "e5", "e6", "e7"]
-    # Every edge that holds the cup or the bottle -- nominal and recovery -- watches for its drop.
+    # Every edge that holds the cup or the bottle -- nominal and recovery -- watches for its drop;
+    # an arm-switch alternative watches the object it hands over (the other is set down on purpose).
     for edge in graph.edges:
         names = {f.name for f in edge.failures}
-        if edge.id != "e7":
+        if edge.alternative_to:
+            assert names == {f.name for f in graph.edge(edge.alternative_to).failures if f.recovery == edge.alternative_to}, edge.id
+        elif edge.id != "e7":
             assert {"cup_dropped", "bottle_dropped"} <= names, edge.id
     # Synchronous grasp and place: both arms in one step.
     assert set(graph.edge("e1").steps[0]) == {"left", "right"}

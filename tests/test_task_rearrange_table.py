@@ -80,9 +80,12 @@ def test_library_graph_checks_clean_with_drop_monitors_on_every_edge_that_holds_
     # The final edge's re-place branches (a piece pushed as the arms leave) hold one piece each.
     replace = {"fork": {"e4_r_fork_moved", "e4_r_fork_moved_via_right"}, "spoon": {"e4_r_spoon_moved", "e4_r_spoon_moved_via_left"}}
     holding = {e.id for e in graph.edges if e.id != "e4"} - replace["fork"] - replace["spoon"]
-    for piece in ("fork", "spoon"):
+    # An arm-switch alternative for one piece sets the other down on purpose: it watches its own piece only.
+    handing = {piece: {e.id for e in graph.edges if e.alternative_to and e.alternative_to.startswith(f"e3_r_{piece}")}
+               for piece in ("fork", "spoon")}
+    for piece, other in (("fork", "spoon"), ("spoon", "fork")):
         watching = {e.id for e in graph.edges if any(f.name == f"{piece}_dropped" for f in e.failures)}
-        assert watching == holding | replace[piece]
+        assert watching == (holding - handing[other]) | replace[piece]
     assert {f.name for f in graph.edge("e4").failures} == {"fork_moved", "spoon_moved"}
     # Grasp, lift and place are synchronous (both arms in one step), as in the paper.
     for edge_id in ("e1", "e2", "e3"):

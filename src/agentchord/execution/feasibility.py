@@ -69,20 +69,38 @@ def others_move_first(program: EdgeProgram, grasp: Grasp) -> bool:
     return False
 
 
+#: Actions after which an arm's hand is (still) free for a grasp: a place sets its object down.
+FREEING_ACTIONS = ("open_gripper", "back", "place")
+
+
 def first_grasps(program: EdgeProgram) -> list[Grasp]:
-    """The grasps made from the state at the program's start: each arm's first action, on an
-    object no earlier step of the program has handled (a hand-off sets it down for a later grasp)."""
-    seen: set[str] = set()
+    """The grasps made from the state at the program's start: each arm's first grasp, before which it
+    only opens, goes home or sets its object down, of an object no earlier step of the program has
+    handled (a hand-off sets it down for a later grasp)."""
+    busy: set[str] = set()
+    taken: set[str] = set()
     handled: set[str] = set()
     grasps = []
     for step in program.steps:
         for action in step:
             obj = getattr(action.args, "obj", None)
-            if action.arm not in seen and isinstance(action, Grasp) and obj not in handled:
+            if action.arm not in busy | taken and isinstance(action, Grasp) and obj not in handled:
                 grasps.append(action)
-            seen.add(action.arm)
+                taken.add(action.arm)
+            elif action.name not in FREEING_ACTIONS:
+                busy.add(action.arm)
         handled |= {getattr(action.args, "obj", None) for action in step} - {None}
     return grasps
+
+
+def places_first(program: EdgeProgram, grasp: Grasp) -> bool:
+    """Whether ``grasp``'s arm sets an object down earlier in the program (its hand is freed for it)."""
+    for step in program.steps:
+        if grasp in step:
+            return False
+        if any(action.arm == grasp.arm and action.name == "place" for action in step):
+            return True
+    return False
 
 
 class FeasibilityChecker:
@@ -144,7 +162,8 @@ class FeasibilityChecker:
 
     def check_program(self, program: EdgeProgram) -> list[GraspCheck]:
         """The infeasible first grasps of ``program`` (empty: it can start)."""
-        checks = (self.check_grasp(g, avoid_other_arm=not others_move_first(program, g)) for g in first_grasps(program))
+        checks = (self.check_grasp(g, hand_free=not places_first(program, g), avoid_other_arm=not others_move_first(program, g))
+                  for g in first_grasps(program))
         return [check for check in checks if not check.feasible]
 
     def unreachable(self, obj: str, *, confirm_ik: bool = True) -> list[GraspCheck]:
