@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import gc
 import json
 from pathlib import Path
 
@@ -9,6 +10,7 @@ import pytest
 import yaml
 
 from agentchord.graph import GraphFileError, TaskGraph, dump_graph, load_graph
+from agentchord.graph.loader import read_document
 
 POUR = Path(__file__).parent / "data" / "graphs" / "pour_water.yaml"
 
@@ -61,6 +63,64 @@ def test_yaml_duplicate_key_is_an_error(tmp_path: Path) -> None:
     assert _problems(path) == [
         f"{path}: line 3, column 1: invalid YAML: while constructing a mapping found duplicate key 'task'"
     ]
+
+
+@pytest.mark.parametrize(
+    ("text", "where", "key"),
+    [
+        ("a: {b: 1, b: 2}\n", "line 1, column 11", "'b'"),
+        ("a: 1\n1.0: 2\n1: 3\n", "line 3, column 1", "1"),  # 1.0 and 1 are the same key
+        ("base: &b {x: 1}\nd:\n  <<: *b\n  z: 3\n  z: 4\n", "line 5, column 3", "'z'"),  # beside a merge key
+        ("- {id: v0}\n- {id: v1, id: v2}\n", "line 2, column 12", "'id'"),
+    ],
+)
+def test_yaml_duplicate_keys_anywhere_are_errors(tmp_path: Path, text: str, where: str, key: str) -> None:
+    path = _write(tmp_path, text)
+    with pytest.raises(GraphFileError) as info:
+        read_document(path)
+    assert info.value.problems == [
+        f"{path}: {where}: invalid YAML: while constructing a mapping found duplicate key {key}"
+    ]
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        "a: &x [1, {b: 2}]\nc: *x\nd: &s word\ne: *s\n",
+        "base: &b {x: 1, y: 2}\nd:\n  <<: *b\n  x: 3\n",
+        "? '1'\n: quoted\n1: int\nnull: n\nfalse: f\n2.5: g\n",
+        "t: 2001-12-14\nu: yes\nv: 1_000\nw: 0x1F\nx: !!str 12\ny: !!int '7'\nz: 0o17\n",
+        "s: !!set {a, b}\no: !!omap [a: 1, b: 2]\nm: !!map {a: 1}\nq: !!seq [1]\nbin: !!binary aGVsbG8=\n",
+        "text: |\n  block\n  lines\nflow: [a, 'b: c', \"d\", -1.5e3, ~]\n",
+    ],
+    ids=["aliases", "merge key", "keys of each kind", "YAML 1.1 scalars", "explicit tags", "styles"],
+)
+def test_yaml_documents_read_as_the_safe_loader_reads_them(tmp_path: Path, text: str) -> None:
+    # The fast constructor (iterative, cached scalar tags) must build what PyYAML's own does.
+    assert read_document(_write(tmp_path, text)) == yaml.safe_load(text)
+
+
+def test_yaml_python_tags_are_refused(tmp_path: Path) -> None:
+    path = _write(tmp_path, "task: !!python/object/apply:os.system [echo hi]\n")
+    [line] = _problems(path)
+    assert "could not determine a constructor for the tag 'tag:yaml.org,2002:python/object/apply:os.system'" in line
+
+
+@pytest.mark.parametrize("text", ["task: t\n", "task: [\n", "task: t\ntask: u\n"], ids=["ok", "syntax", "duplicate"])
+def test_loading_resumes_the_garbage_collector(tmp_path: Path, text: str) -> None:
+    # Loading pauses the cyclic collector (large graphs load 3x faster) and always resumes it.
+    path = _write(tmp_path, text)
+    assert gc.isenabled()
+    with pytest.raises(GraphFileError):
+        load_graph(path)
+    assert gc.isenabled()
+    gc.disable()
+    try:
+        with pytest.raises(GraphFileError):
+            load_graph(path)
+        assert not gc.isenabled()  # a caller's own pause is kept
+    finally:
+        gc.enable()
 
 
 def test_json_syntax_error_and_duplicate_key(tmp_path: Path) -> None:
