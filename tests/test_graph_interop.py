@@ -355,7 +355,7 @@ def test_frame_parse_and_identity() -> None:
 
 def test_workspace_constants_match_the_motion_module() -> None:
     from agentchord.actions.motion import WORKSPACE_HIGH, WORKSPACE_LOW
-    from agentchord.worlds.sim.scene import TABLE_CENTER, TABLE_HALF
+    from agentchord.robot.aloha import TABLE_CENTER, TABLE_HALF
 
     assert WORKSPACE[0] == pytest.approx(tuple(WORKSPACE_LOW))
     assert WORKSPACE[1] == pytest.approx(tuple(WORKSPACE_HIGH))

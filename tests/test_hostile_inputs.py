@@ -594,7 +594,7 @@ def test_the_document_guards_directly(tmp_path):
 
 
 def test_an_unexpected_error_is_one_line_and_a_log(tmp_path, monkeypatch):
-    import agentchord.graph.cli as graph_cli
+    import agentchord.cli_graph as graph_cli
 
     def broken(graph):
         raise ZeroDivisionError("a bug")
@@ -608,7 +608,7 @@ def test_an_unexpected_error_is_one_line_and_a_log(tmp_path, monkeypatch):
 
 
 def test_an_interrupt_is_not_a_task_failure(monkeypatch):
-    import agentchord.graph.cli as graph_cli
+    import agentchord.cli_graph as graph_cli
 
     def interrupted(graph):
         raise KeyboardInterrupt

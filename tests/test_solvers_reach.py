@@ -7,7 +7,8 @@ import pytest
 from agentchord.actions.motion import grasp_frame, pose_from_matrix
 from agentchord.solvers.ik import BimanualIK
 from agentchord.solvers.reach import REACH, REACH_MAX, REACH_MIN, SHOULDER, ReachModel, measure_reach
-from agentchord.worlds.sim.scene import ARM_PREFIX, build_robot_model
+from agentchord.robot.aloha import ARM_PREFIX
+from agentchord.robot.model import build_robot_model
 
 
 def test_shoulder_constants_match_the_robot_model():

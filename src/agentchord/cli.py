@@ -16,7 +16,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 
 from agentchord import __version__
 from agentchord.cli_support import BadInput, FiniteFloatRange, GuardedGroup, check_outputs
-from agentchord.graph.cli import graph_group, import_release_command, schema_command
+from agentchord.cli_graph import graph_group, import_release_command, schema_command
 from agentchord.guard.outputs import atomic_write_text, finite_json
 
 STRATEGY_NAMES = ("agentchord", "agentchord-bt")

@@ -15,7 +15,7 @@ from scipy.spatial.transform import Rotation
 
 from agentchord.features.frame import FeatureFrame
 from agentchord.solvers.ik import BimanualIK, PoseTarget
-from agentchord.worlds.sim.scene import ARM_PREFIX
+from agentchord.robot.aloha import ARM_PREFIX
 from agentchord.worlds.sim.world import ArmCommand, SimWorld
 
 #: QP iterations per call of a scratch (trial) IK solve.

@@ -32,7 +32,7 @@ from agentchord.solvers.exceptions import NoHandoffSpotError
 from agentchord.solvers.handoff import handoff_spot
 from agentchord.solvers.ik import PoseTarget, solve_from_scratch
 from agentchord.solvers.obstacles import held_spheres, lift_over, scene_spheres
-from agentchord.worlds.sim.scene import ARM_JOINTS, ARM_PREFIX, FINGER_GAP_OFFSET, FINGER_RANGE, HOME_Q
+from agentchord.robot.aloha import ARM_JOINTS, ARM_PREFIX, FINGER_GAP_OFFSET, FINGER_RANGE, HOME_Q
 
 #: Joint speed (rad/s, largest joint) of joint-space moves with an empty hand.
 EMPTY_HAND_JOINT_SPEED = 2.0

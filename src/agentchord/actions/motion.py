@@ -14,9 +14,16 @@ from scipy.spatial.transform import Rotation, Slerp
 
 from agentchord.actions.base import ActionFailed
 from agentchord.actions.controller import RobotController
+from agentchord.robot.aloha import HOME_Q, TABLE_HALF
 from agentchord.solvers.ik import PoseTarget, solve_from_scratch
 from agentchord.solvers.obstacles import Spheres
-from agentchord.worlds.sim.scene import HOME_Q, TABLE_HALF
+from agentchord.solvers.poses import (  # noqa: F401  (grasp_frame, pose_from_matrix, UP: re-exported for the actions)
+    UP,
+    grasp_frame,
+    pose_from_matrix,
+    quat_to_rotation,
+    rotation_to_quat,
+)
 
 #: Cartesian speed limits of the tool (m/s, rad/s).
 LINEAR_SPEED = 0.30
@@ -24,33 +31,6 @@ ANGULAR_SPEED = 1.6
 #: Workspace every pose target is clipped to (m): above the table, within reach.
 WORKSPACE_LOW = np.array([-TABLE_HALF[0] + 0.05, 0.22, 0.015])
 WORKSPACE_HIGH = np.array([TABLE_HALF[0] - 0.05, 0.95, 0.55])
-UP = np.array([0.0, 0.0, 1.0])
-
-
-def _to_rotation(quat: np.ndarray) -> Rotation:
-    w, x, y, z = quat
-    return Rotation.from_quat([x, y, z, w])
-
-
-def _to_quat(rotation: Rotation) -> np.ndarray:
-    x, y, z, w = rotation.as_quat()
-    return np.array([w, x, y, z])
-
-
-def pose_from_matrix(pos: np.ndarray, matrix: np.ndarray) -> PoseTarget:
-    """Pose target from a position and a rotation matrix."""
-    return PoseTarget(pos=np.asarray(pos, dtype=float), quat=_to_quat(Rotation.from_matrix(matrix)))
-
-
-def grasp_frame(approach: np.ndarray) -> np.ndarray:
-    """Tool rotation for a side grasp: x along the horizontal approach, z up."""
-    x = np.array([approach[0], approach[1], 0.0])
-    norm = np.linalg.norm(x)
-    if norm < 1e-6:
-        raise ValueError("a side grasp needs a horizontal approach direction, got a vertical one")
-    x /= norm
-    y = np.cross(UP, x)
-    return np.column_stack([x, y, UP])
 
 
 def clip_to_workspace(pos: np.ndarray) -> np.ndarray:
@@ -67,7 +47,7 @@ def move_to(robot: RobotController, arm: str, goal: PoseTarget, speed: float = L
     """Move the tool to ``goal`` along a straight line, position and orientation together."""
     start = robot.commanded_pose(arm)
     goal_pos = clip_to_workspace(goal.pos)
-    r0, r1 = _to_rotation(start.quat), _to_rotation(goal.quat)
+    r0, r1 = quat_to_rotation(start.quat), quat_to_rotation(goal.quat)
     angle = (r0.inv() * r1).magnitude()
     distance = float(np.linalg.norm(goal_pos - start.pos))
     # Min-jerk peaks at 1.875x the mean speed: size the duration for the peak.
@@ -75,7 +55,7 @@ def move_to(robot: RobotController, arm: str, goal: PoseTarget, speed: float = L
     slerp = Slerp([0.0, 1.0], Rotation.concatenate([r0, r1]))
     for k in range(1, ticks + 1):
         s = min_jerk(k / ticks)
-        robot.set_pose(arm, PoseTarget(pos=start.pos + s * (goal_pos - start.pos), quat=_to_quat(slerp(s))))
+        robot.set_pose(arm, PoseTarget(pos=start.pos + s * (goal_pos - start.pos), quat=rotation_to_quat(slerp(s))))
         yield
 
 
@@ -145,7 +125,7 @@ def move_along_solved_path(
     start = robot.commanded_pose(arm)
     goal_pos = clip_to_workspace(goal.pos)
     total = max(float(np.linalg.norm(goal_pos - start.pos)), 1e-6)
-    slerp = Slerp([0.0, 1.0], Rotation.concatenate([_to_rotation(start.quat), _to_rotation(goal.quat)]))
+    slerp = Slerp([0.0, 1.0], Rotation.concatenate([quat_to_rotation(start.quat), quat_to_rotation(goal.quat)]))
     warm = None
     previous = start.pos
     for _ in range(PATH_MAX_SOLVES):
@@ -159,7 +139,7 @@ def move_along_solved_path(
         for waypoint in plan.waypoints[:PATH_EXECUTE]:
             previous = robot.commanded_pose(arm).pos
             done = 1.0 - min(1.0, float(np.linalg.norm(goal_pos - waypoint)) / total)
-            robot.set_pose(arm, PoseTarget(pos=waypoint, quat=_to_quat(slerp(done))))
+            robot.set_pose(arm, PoseTarget(pos=waypoint, quat=rotation_to_quat(slerp(done))))
             yield
         warm = plan
     yield from move_to(robot, arm, PoseTarget(pos=goal_pos, quat=goal.quat), speed=0.15)

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 from agentchord.execution.edge_program import EdgeProgram, ReturnToKeyframe
 
 if TYPE_CHECKING:
-    from agentchord.execution.executor import Executor
+    from agentchord.execution.context import ExecutionContext as Executor  # the executor as a strategy sees it
     from agentchord.monitor import Detection
 
 

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import networkx as nx
 
-from agentchord.actions.catalog import ACTIONS
+from agentchord.graph.catalog import ACTIONS
 from agentchord.graph.exceptions import NoPathError, UnknownActionError
 from agentchord.graph.models import Edge, TaskGraph
 

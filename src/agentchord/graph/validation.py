@@ -16,7 +16,7 @@ from pathlib import Path
 import networkx as nx
 from pydantic import ValidationError
 
-from agentchord.actions.catalog import ACTIONS
+from agentchord.graph.catalog import ACTIONS
 from agentchord.expr import ExprError, Vocabulary, compile_expr
 from agentchord.features.frame import ARMS
 from agentchord.graph._hints import did_you_mean

@@ -7,11 +7,7 @@ still inspect (or knowingly use) the best compromise.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
-
-if TYPE_CHECKING:
-    from agentchord.solvers.path import ExecutedPath
-    from agentchord.solvers.subgoal import SubgoalSolution
+from typing import Any
 
 
 class SolverError(Exception):
@@ -26,10 +22,12 @@ class InfeasibleSubgoalError(SolverError):
     """The sub-goal solver found no point meeting every hard constraint (raised on request only).
 
     Attributes:
-        solution: The best compromise found; ``solution.violations`` says which constraints fail.
+        solution: The best compromise found (a :class:`~agentchord.solvers.subgoal.SubgoalSolution`);
+            ``solution.violations`` says which constraints fail.
     """
 
-    def __init__(self, message: str, solution: SubgoalSolution) -> None:
+    # The solvers import this module, never the reverse: the attached results are typed ``Any``.
+    def __init__(self, message: str, solution: Any) -> None:
         self.solution = solution
         super().__init__(message)
 
@@ -42,10 +40,10 @@ class PathNotReachedError(SolverError):
     """``plan_path`` ran out of solves before the tool reached the goal (raised on request only).
 
     Attributes:
-        path: What was executed before giving up.
+        path: What was executed before giving up (a :class:`~agentchord.solvers.path.ExecutedPath`).
     """
 
-    def __init__(self, message: str, path: ExecutedPath) -> None:
+    def __init__(self, message: str, path: Any) -> None:
         self.path = path
         super().__init__(message)
 

@@ -16,7 +16,8 @@ import mink
 import mujoco
 import numpy as np
 
-from agentchord.worlds.sim.scene import ARM_JOINTS, ARM_PREFIX, COLLISION_PROXIES, HOME_Q, build_robot_model
+from agentchord.robot.aloha import ARM_JOINTS, ARM_PREFIX, COLLISION_PROXIES, HOME_Q
+from agentchord.robot.model import build_robot_model
 
 
 @dataclass
@@ -55,7 +56,7 @@ class BimanualIK:
         self.limits = [mink.ConfigurationLimit(self.model)]
         self.arm_collision_limit = None
         if avoid_arm_collisions:
-            # Capsule proxies around forearm, wrist and gripper (scene.COLLISION_PROXIES).
+            # Capsule proxies around forearm, wrist and gripper (robot.aloha.COLLISION_PROXIES).
             geoms = {arm: [f"{arm}_proxy_{k}" for k in range(len(COLLISION_PROXIES))] for arm in ARM_PREFIX}
             self._proxy_pairs = [
                 (self.model.geom(a).id, self.model.geom(b).id) for a in geoms["left"] for b in geoms["right"]

@@ -526,7 +526,7 @@ class SubgoalSolver:
     def _ik_residuals(self, solution: SubgoalSolution) -> dict[str, float]:
         """Position error of the arms' IK at the solution, side-grasp orientation (tool level)."""
         # Imported here: mink and the robot model are only needed when the check is asked for.
-        from agentchord.actions.motion import grasp_frame, pose_from_matrix  # noqa: PLC0415
+        from agentchord.solvers.poses import grasp_frame, pose_from_matrix  # noqa: PLC0415
         from agentchord.solvers.ik import BimanualIK  # noqa: PLC0415
 
         if self._ik is None:

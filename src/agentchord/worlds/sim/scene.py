@@ -1,53 +1,34 @@
 """Build the MuJoCo scene: the ALOHA bimanual ViperX on a table, plus task objects.
 
-The robot's XML and meshes are loaded by path from the installed ``gym-aloha``
-package (we neither import its environments nor copy its files) and edited
-through ``mujoco.MjSpec``: a tool-centre site between the fingers, gravity
-compensation, lighter joint friction, our own actuators, a thick collision
-table and a floor. Objects are added as free bodies with explicit inertia.
+The robot's model comes from :mod:`agentchord.robot.model` (the ALOHA files of the
+installed ``gym-aloha`` package, edited: a tool-centre site, gravity compensation,
+lighter joint friction, our own actuators); here come a thick collision table, a
+floor, lights and cameras. Objects are added as free bodies with explicit inertia.
 """
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
 
+from agentchord.robot.aloha import (  # noqa: F401  (the robot's numbers, re-exported for the simulator's modules)
+    ARM_JOINTS,
+    ARM_PREFIX,
+    FINGER_GAP_OFFSET,
+    FINGER_RANGE,
+    HOME_Q,
+    TABLE_CENTER,
+    TABLE_HALF,
+    TCP_OFFSET,
+)
+from agentchord.robot.exceptions import RobotModelError
+from agentchord.robot.model import add_collision_proxies, edit_robot, robot_xml
 from agentchord.worlds.sim.exceptions import SceneError
 
-ARM_PREFIX = {"left": "vx300s_left", "right": "vx300s_right"}
-ARM_JOINTS = ("waist", "shoulder", "elbow", "forearm_roll", "wrist_angle", "wrist_rotate")
-#: Position gains of the arm joint actuators (N m / rad). Higher than gym-aloha's
-#: so that a 0.4 kg bottle does not sag the wrist during a pour.
-ARM_KP = (800.0, 1600.0, 800.0, 300.0, 300.0, 200.0)
-ARM_FORCE = (150.0, 300.0, 150.0, 60.0, 60.0, 40.0)
-FINGER_KP = 400.0
-FINGER_FORCE = 12.0
-#: Finger joint range; the pad gap is ``2 q - FINGER_GAP_OFFSET``.
-FINGER_RANGE = (0.021, 0.057)
-FINGER_GAP_OFFSET = 0.0448
-#: Tool centre point: between the finger pads, along the gripper's x (approach) axis.
-TCP_OFFSET = 0.115
-TABLE_HALF = (0.61, 0.381, 0.02)
-TABLE_CENTER = (0.0, 0.6)
 #: Sliding friction of the table top (MuJoCo takes the larger of two touching geoms' coefficients).
 TABLE_FRICTION = 1.0
-#: Home configuration of one arm (gym-aloha's keyframe, arm joints only).
-HOME_Q = np.array([0.0, -0.96, 1.16, 0.0, -0.3, 0.0])
-
-
-def aloha_assets_dir() -> str:
-    """The folder of the ALOHA model files inside the installed gym-aloha package."""
-    try:
-        import gym_aloha  # noqa: PLC0415  (imported for its data files only)
-    except ImportError as exc:  # pragma: no cover - install problem
-        raise SceneError("gym-aloha is not installed: run `make install` (it ships the ALOHA model)") from exc
-    path = os.path.join(os.path.dirname(gym_aloha.__file__), "assets")
-    if not os.path.isfile(os.path.join(path, "vx300s_right.xml")):
-        raise SceneError(f"{path}: the ALOHA model files are missing from the gym-aloha package")
-    return path
 
 
 @dataclass
@@ -191,62 +172,6 @@ class SceneSpec:
     cloth: ClothSpec | None = None
 
 
-def _edit_robot(spec: mujoco.MjSpec) -> None:
-    for arm, prefix in ARM_PREFIX.items():
-        for body in spec.bodies:
-            if body.name.startswith(prefix + "/"):
-                # Gravity compensation: hold error 2.4 mm -> 0.5 mm in the prototype.
-                body.gravcomp = 1.0
-        for joint_name in ARM_JOINTS:
-            joint = spec.joint(f"{prefix}/{joint_name}")
-            # gym-aloha's 30-60 N m of friction loss made the arm lag and knock objects over.
-            joint.frictionloss = 1.0
-            joint.damping = [2.0, 0.0, 0.0]
-            joint.armature = 0.01
-        for finger in ("left_finger", "right_finger"):
-            joint = spec.joint(f"{prefix}/{finger}")
-            joint.frictionloss = 0.2
-            joint.damping = [5.0, 0.0, 0.0]
-        gripper = spec.body(f"{prefix}/gripper_link")
-        gripper.add_site(name=f"{arm}_tcp", pos=[TCP_OFFSET, 0.0, 0.0], size=[0.004, 0.004, 0.004], rgba=[1, 0, 0, 0])
-        for joint_name, kp, force in zip(ARM_JOINTS, ARM_KP, ARM_FORCE):
-            joint = spec.joint(f"{prefix}/{joint_name}")
-            spec.add_actuator(
-                name=f"{arm}_{joint_name}",
-                target=joint.name,
-                trntype=mujoco.mjtTrn.mjTRN_JOINT,
-                gaintype=mujoco.mjtGain.mjGAIN_FIXED,
-                biastype=mujoco.mjtBias.mjBIAS_AFFINE,
-                gainprm=[kp] + [0] * 9,
-                biasprm=[0, -kp, -0.05 * kp] + [0] * 7,
-                ctrlrange=list(joint.range),
-                ctrllimited=True,
-                forcerange=[-force, force],
-                forcelimited=True,
-            )
-        for finger, sign in (("left_finger", 1.0), ("right_finger", -1.0)):
-            lo, hi = FINGER_RANGE
-            spec.add_actuator(
-                name=f"{arm}_{finger}",
-                target=f"{prefix}/{finger}",
-                trntype=mujoco.mjtTrn.mjTRN_JOINT,
-                gaintype=mujoco.mjtGain.mjGAIN_FIXED,
-                biastype=mujoco.mjtBias.mjBIAS_AFFINE,
-                gainprm=[FINGER_KP] + [0] * 9,
-                biasprm=[0, -FINGER_KP, -0.1 * FINGER_KP] + [0] * 7,
-                ctrlrange=[lo, hi] if sign > 0 else [-hi, -lo],
-                ctrllimited=True,
-                forcerange=[-FINGER_FORCE, FINGER_FORCE],
-                forcelimited=True,
-            )
-            # Friction high enough to hold a 0.4 kg bottle with a 12 N squeeze.
-            geom = spec.geom(f"{prefix}/10_{finger.split('_')[0]}_gripper_finger")
-            geom.friction = [1.5, 0.01, 0.001]
-            geom.condim = 4
-            geom.solimp = [0.95, 0.99, 0.001, 0.5, 2.0]
-            geom.solref = [0.01, 1.0]
-
-
 def _add_environment(spec: mujoco.MjSpec) -> None:
     world = spec.worldbody
     world.add_geom(name="floor", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[2, 2, 0.1], pos=[0, 0.6, -0.75], rgba=[0.35, 0.35, 0.38, 1])
@@ -330,63 +255,21 @@ def _compound_inertia(mass: float, parts) -> tuple[np.ndarray, np.ndarray, np.nd
     return com, principal, quat
 
 
-#: Capsules (body, from, to, radius) that wrap each arm's distal links for the IK's
-#: arm-arm collision avoidance: analytic capsule distances are ~20x cheaper than mesh ones.
-COLLISION_PROXIES = (
-    ("upper_forearm_link", (0.0, 0.0, 0.0), (0.2, 0.0, 0.0), 0.035),
-    ("lower_forearm_link", (0.0, 0.0, 0.0), (0.1, 0.0, 0.0), 0.035),
-    ("gripper_link", (-0.04, 0.0, 0.0), (0.06, 0.0, 0.0), 0.05),
-    ("gripper_link", (0.07, 0.0, 0.0), (0.155, 0.0, 0.0), 0.045),
-)
-
-
-def _add_collision_proxies(spec: mujoco.MjSpec) -> None:
-    for arm, prefix in ARM_PREFIX.items():
-        for k, (body, start, end, radius) in enumerate(COLLISION_PROXIES):
-            spec.body(f"{prefix}/{body}").add_geom(
-                name=f"{arm}_proxy_{k}",
-                type=mujoco.mjtGeom.mjGEOM_CAPSULE,
-                fromto=[*start, *end],
-                size=[radius, 0.0, 0.0],
-                group=5,
-                # Own collision bits: proxies only ever meet the other arm's proxies.
-                contype=2,
-                conaffinity=2,
-                mass=0.0,
-                rgba=[1, 0, 0, 0.2],
-            )
-
-
 def build_model(scene: SceneSpec, collision_proxies: bool = False) -> mujoco.MjModel:
     """Compile the robot, the table and the scene's objects into one model.
 
     Raises:
         SceneError: If the ALOHA assets are missing or the model does not compile.
     """
-    assets = aloha_assets_dir()
-    xml = f"""<mujoco model="agentchord_aloha">
-  <compiler meshdir="{assets}" angle="radian"/>
-  <option timestep="{scene.timestep}" integrator="implicitfast" cone="elliptic" noslip_iterations="3"/>
-  <include file="{assets}/vx300s_dependencies.xml"/>
-  <worldbody>
-    <include file="{assets}/vx300s_left.xml"/>
-    <include file="{assets}/vx300s_right.xml"/>
-    {_cloth_xml(scene.cloth) if scene.cloth is not None else ""}
-  </worldbody>
-</mujoco>"""
     try:
-        spec = mujoco.MjSpec.from_string(xml)
-        _edit_robot(spec)
+        cloth = _cloth_xml(scene.cloth) if scene.cloth is not None else ""
+        spec = mujoco.MjSpec.from_string(robot_xml(scene.timestep, cloth))
+        edit_robot(spec)
         if collision_proxies:
-            _add_collision_proxies(spec)
+            add_collision_proxies(spec)
         _add_environment(spec)
         for obj in scene.objects:
             _add_object(spec, obj)
         return spec.compile()
-    except ValueError as exc:
+    except (ValueError, RobotModelError) as exc:
         raise SceneError(f"the scene does not compile: {exc}") from exc
-
-
-def build_robot_model() -> mujoco.MjModel:
-    """The robot alone, with collision proxies: what the IK solver works on."""
-    return build_model(SceneSpec(objects=[]), collision_proxies=True)

@@ -1,4 +1,4 @@
-"""Command-line interface of the graph package: ``agentchord schema`` and ``agentchord graph ...``.
+"""The `agentchord schema` and `agentchord graph ...` commands (the graph package's command line).
 
 Exit statuses as everywhere (:mod:`agentchord.cli_support`): 0 valid / written, 2 an
 unreadable or invalid file or an output that cannot be written.

@@ -1,0 +1,48 @@
+"""What a recovery strategy may read and ask of the executor running it.
+
+The executor hands itself to its strategy; the strategy names only this protocol, so
+``strategies`` does not import ``executor`` (which imports ``strategies``).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Protocol
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from agentchord.execution.edge_program import EdgeProgram
+    from agentchord.execution.trace import Trace
+    from agentchord.features.frame import FeatureFrame
+    from agentchord.graph.models import TaskGraph
+    from agentchord.monitor import RecoveryMap
+
+
+class ExecutionContext(Protocol):
+    """The executor, as its recovery strategy sees it.
+
+    Attributes:
+        graph: The (filtered) augmented graph being run.
+        frame: The feature frame of this tick.
+        trace: The episode's trace.
+        node: The last node reached.
+        program: The edge program running now (None between edges).
+        nominal_next: Nominal node -> the nominal edge out of it.
+        recovery_map: (edge, failure mode) -> recovery entry edges (Eq. 13).
+        visited_nominal: Nominal nodes reached so far, in order.
+        keyframes: Nominal node -> per arm (joint targets, grip) when it was reached.
+    """
+
+    graph: TaskGraph
+    frame: FeatureFrame
+    trace: Trace
+    node: str
+    program: EdgeProgram | None
+    nominal_next: dict[str, str]
+    recovery_map: RecoveryMap
+    visited_nominal: list[str]
+    keyframes: dict[str, dict[str, tuple[np.ndarray, float]]]
+
+    def constraints_hold(self, node_id: str) -> bool:
+        """Whether a node's sub-goal constraints hold on the current frame."""
+        ...

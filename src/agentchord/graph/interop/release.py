@@ -1,0 +1,151 @@
+"""The release's format as the import reads it: arm calls with their JSON paths, steps,
+recovery bindings, each arm's history, and what the arms hold along a chain of steps."""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+from agentchord.graph.models import ActionCall
+
+
+def _fmt(x: float) -> str:
+    return f"{x:g}"
+
+
+
+
+def _slug(text: str) -> str:
+    return re.sub(r"[^a-z0-9]+", "_", text.lower()).strip("_") or "imported_task"
+
+
+def _norm(text: str) -> str:
+    return re.sub(r"[^a-z0-9]", "", text.lower())
+
+
+
+
+@dataclass
+class _Raw:
+    """A release arm call (``{fn, kwargs}``), where it is, and recovery-step extras."""
+
+    call: dict[str, Any]
+    file: str
+    path: str
+    extra: dict[str, Any] = field(default_factory=dict)
+
+
+#: One step: our arm -> release call (None: idle).
+_RawStep = dict[str, "_Raw | None"]
+
+
+@dataclass
+class _Track:
+    """Each arm's history along a translation.
+
+    Attributes:
+        before: The arm's last release call.
+        previous: Our last action on the arm.
+        turned: Arms whose tool turned (a roll, a pitch) since they last grasped.
+    """
+
+    before: dict[str, _Raw] = field(default_factory=dict)
+    previous: dict[str, str] = field(default_factory=dict)
+    turned: set[str] = field(default_factory=set)
+
+    def update(self, arm: str, call: ActionCall) -> None:
+        self.previous[arm] = call.fn
+        if call.fn == "grasp":
+            self.turned.discard(arm)
+        elif call.fn == "rotate_eef" or any(call.args.get("angles", ())):
+            self.turned.add(arm)
+
+    def copy(self) -> _Track:
+        return _Track(dict(self.before), dict(self.previous), set(self.turned))
+
+
+@dataclass
+class _Ctx:
+    """What one release call is translated in view of.
+
+    Attributes:
+        arm: The call's arm.
+        nxt: The arm's next release call (later in the steps, then in the continuation).
+        before: The arm's previous release call.
+        previous: Our previous action on the arm.
+        holds: What each arm holds.
+        turned: Whether the arm's tool turned since it last grasped.
+    """
+
+    arm: str
+    nxt: _Raw | None
+    before: _Raw | None
+    previous: str | None
+    holds: dict[str, str]
+    turned: bool
+
+
+@dataclass
+class _Binding:
+    index: int
+    edge_id: str
+    name: str
+    monitors: list[tuple[str, dict[str, Any]]]
+    steps: list[_RawStep]
+    merge: str
+    repeat: bool
+    intent: str
+
+
+
+
+def _number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def _fmt_vec(v: Sequence[float]) -> str:
+    return "(" + ", ".join(_fmt(x) for x in v) + ")"
+
+
+def _roll_of(raw: _Raw | None) -> float:
+    """The roll (deg) of a release ``rotate_eef`` call, 0 for anything else."""
+    if raw is None or not isinstance(raw.call, dict) or raw.call.get("fn") != "rotate_eef":
+        return 0.0
+    degree = (raw.call.get("kwargs") or {}).get("degree", 0)
+    return float(degree) if _number(degree) else 0.0
+
+
+def _fn_of(raw: _Raw | None) -> str | None:
+    """The release action name of a call, None for none."""
+    return raw.call.get("fn") if raw is not None and isinstance(raw.call, dict) else None
+
+
+def _after(holds: dict[str, str], steps: list[dict[str, ActionCall | None]]) -> dict[str, str]:
+    """What each arm holds after ``steps``: a grasp takes its object, a place or opening lets go."""
+    holds = dict(holds)
+    for step in steps:
+        for arm, call in step.items():
+            if call is None:
+                continue
+            if call.fn == "grasp":
+                holds[arm] = call.args["obj"]
+            elif call.fn in ("place", "open_gripper"):
+                holds.pop(arm, None)
+    return holds
+
+
+def _released(before: dict[str, str], steps: list[dict[str, ActionCall | None]]) -> list[tuple[str, str]]:
+    """``(arm, obj)`` pairs that ``steps`` let go of on purpose."""
+    holds, out = dict(before), []
+    for step in steps:
+        for arm, call in step.items():
+            if call is None:
+                continue
+            if call.fn == "grasp":
+                holds[arm] = call.args["obj"]
+            elif call.fn in ("place", "open_gripper") and arm in holds:
+                out.append((arm, holds.pop(arm)))
+    return sorted(out)
