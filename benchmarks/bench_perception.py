@@ -28,7 +28,7 @@ from rich.console import Console  # noqa: E402
 from rich.table import Table  # noqa: E402
 
 from agentchord.features.rgbd import PERCEPTION_CAMERAS, RgbdExtractor  # noqa: E402
-from agentchord.features.segmentation import NoisySegmenter, SimSegmenter  # noqa: E402
+from agentchord.features.segmentation import LabelSegmenter, NoisySegmenter  # noqa: E402
 from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: E402
 from agentchord.worlds.sim.world import SimWorld  # noqa: E402
 
@@ -143,7 +143,7 @@ def main() -> None:
                 row += [fmt(e, TARGET_AXIS_DEG) for e in axis_errs]
                 row.append(f"{centroid:.1f}")
                 table.add_row(*row)
-        segmenter = NoisySegmenter(SimSegmenter.for_world(world), erode_px=1, drop=0.2, seed=1)
+        segmenter = NoisySegmenter(LabelSegmenter.for_world(world), erode_px=1, drop=0.2, seed=1)
         with RgbdExtractor(world, width=args.width, height=args.height, segmenter=segmenter, depth_noise=args.noise, seed=1) as extractor:
             for _ in range(2):
                 extractor.perceive()

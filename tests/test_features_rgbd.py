@@ -8,8 +8,8 @@ import pytest
 
 from agentchord.expr.templates import lost_view
 from agentchord.features.oracle import OracleExtractor
-from agentchord.features.rgbd import MIN_POINTS, RgbdExtractor
-from agentchord.features.segmentation import NoisySegmenter, SimSegmenter
+from agentchord.features.rgbd import MIN_POINTS, RgbdExtractor, frame_points
+from agentchord.features.segmentation import LabelSegmenter, NoisySegmenter
 from agentchord.worlds.sim.world import SimWorld
 
 SMALL = {"width": 160, "height": 120}
@@ -73,8 +73,9 @@ def test_a_centroid_would_be_centimetres_off_but_the_fit_is_not(world, extractor
     for k, image in enumerate(images):
         fit = extractor.fit("bottle", [clouds["bottle"][k]], [image.pos])
         assert np.linalg.norm(fit.pos - pos) < 0.005
-        table = image.seg[..., 0] == world.model.geom("table").id
-        z = image.points(table)[:, 2]
+        _, seg = extractor.cameras[k].render()
+        table = seg[..., 0] == world.model.geom("table").id
+        z = frame_points(image, table)[:, 2]
         assert z.max() < 1e-4 and z.min() > -0.0401  # the table box: 4 cm thick, top at z = 0
         assert np.mean(np.abs(z) < 1e-4) > 0.8  # mostly its top
 
@@ -124,7 +125,7 @@ def test_an_object_hidden_from_every_camera_keeps_its_last_estimate(world, extra
 
 
 def test_degraded_segmentation_and_noisy_depth_stay_within_tolerance(world):
-    segmenter = NoisySegmenter(SimSegmenter.for_world(world), erode_px=1, drop=0.2, seed=0)
+    segmenter = NoisySegmenter(LabelSegmenter.for_world(world), erode_px=1, drop=0.2, seed=0)
     with RgbdExtractor(world, segmenter=segmenter, depth_noise=0.002, seed=0) as extractor:
         for name in ("bottle", "cup"):
             centre_mm, axis_deg = _errors(world, name, extractor.frame.objects[name])

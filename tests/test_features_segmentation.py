@@ -1,4 +1,4 @@
-"""Segmentation: the simulator's segmenter, the degraded one, and the Segmenter protocol."""
+"""Segmentation: the world's own labels, the degraded segmenter, and the Segmenter protocol."""
 
 from __future__ import annotations
 
@@ -6,34 +6,41 @@ import mujoco
 import numpy as np
 import pytest
 
-from agentchord.features.rgbd import DepthCamera
-from agentchord.features.segmentation import NoisySegmenter, Segmenter, SimSegmenter, erode
+from agentchord.features.rgbd import frame_points
+from agentchord.features.segmentation import (
+    LabelSegmenter,
+    NoisySegmenter,
+    SegmentationUnavailableError,
+    Segmenter,
+    erode,
+)
 from agentchord.worlds.sim.world import SimWorld
 
 
 @pytest.fixture
 def rendered(pour_scene):
     world = SimWorld(pour_scene)
-    camera = DepthCamera(world.model, "front", width=160, height=120)
+    camera = world.open_camera("front", width=160, height=120)
     try:
-        yield world, camera.capture(world.data)
+        _, seg = camera.render()
+        yield world, camera.capture(), seg
     finally:
         camera.close()
 
 
-def test_sim_segmenter_masks_hold_only_that_objects_pixels(rendered):
-    world, image = rendered
-    segmenter = SimSegmenter.for_world(world)
+def test_label_segmenter_masks_hold_only_that_objects_pixels(rendered):
+    world, image, seg = rendered
+    segmenter = LabelSegmenter.for_world(world)
     assert isinstance(segmenter, Segmenter)
-    masks = segmenter.masks(image.seg, "front")
+    masks = segmenter.masks(image)
     assert set(masks) == set(world.object_names)
-    is_geom = image.seg[..., 1] == int(mujoco.mjtObj.mjOBJ_GEOM)
+    is_geom = seg[..., 1] == int(mujoco.mjtObj.mjOBJ_GEOM)
     for name, mask in masks.items():
         geom = world.model.geom(name).id
         assert mask.shape == image.depth.shape and mask.dtype == bool
         assert mask.sum() > 30, f"{name} not seen by the front camera"
         # Exactly the pixels of the object's geom: none of the table, the robot or the other object.
-        np.testing.assert_array_equal(mask, is_geom & (image.seg[..., 0] == geom))
+        np.testing.assert_array_equal(mask, is_geom & (seg[..., 0] == geom))
     bottle, cup = masks["bottle"], masks["cup"]
     assert not (bottle & cup).any()
     # The masked depth lies on the object: within its radius + half-height of its centre.
@@ -41,11 +48,18 @@ def test_sim_segmenter_masks_hold_only_that_objects_pixels(rendered):
         pos, _ = world.object_pose(name)
         spec = world.object_spec(name)
         reach = np.hypot(spec.size[0], spec.size[1]) + 1e-3
-        assert np.linalg.norm(image.points(mask) - pos, axis=1).max() < reach
+        assert np.linalg.norm(frame_points(image, mask) - pos, axis=1).max() < reach
+
+
+def test_a_frame_without_labels_needs_a_segmenter(rendered):
+    world, image, _ = rendered
+    image.labels = None
+    with pytest.raises(SegmentationUnavailableError, match="no segmentation of its own"):
+        LabelSegmenter.for_world(world).masks(image)
 
 
 def test_single_pass_render_matches_the_renderers_own_depth_and_segmentation(rendered):
-    world, image = rendered
+    world, image, seg_single = rendered
     renderer = mujoco.Renderer(world.model, 120, 160)
     try:
         renderer.update_scene(world.data, camera="front", scene_option=_no_sites())
@@ -55,7 +69,7 @@ def test_single_pass_render_matches_the_renderers_own_depth_and_segmentation(ren
         seg = renderer.render()
     finally:
         renderer.close()
-    np.testing.assert_array_equal(image.seg, seg)
+    np.testing.assert_array_equal(seg_single, seg)
     np.testing.assert_allclose(image.depth, depth, rtol=1e-5)
 
 
@@ -66,14 +80,14 @@ def _no_sites() -> mujoco.MjvOption:
 
 
 def test_noisy_segmenter_only_removes_pixels(rendered):
-    world, image = rendered
-    base = SimSegmenter.for_world(world)
-    clean = base.masks(image.seg, "front")
-    noisy = NoisySegmenter(base, erode_px=1, drop=0.3, seed=3).masks(image.seg, "front")
+    world, image, _ = rendered
+    base = LabelSegmenter.for_world(world)
+    clean = base.masks(image)
+    noisy = NoisySegmenter(base, erode_px=1, drop=0.3, seed=3).masks(image)
     for name in clean:
         assert not (noisy[name] & ~clean[name]).any()
         assert 0.3 * clean[name].sum() < noisy[name].sum() < 0.75 * clean[name].sum()
-    missed = NoisySegmenter(base, erode_px=0, miss=1.0).masks(image.seg, "front")
+    missed = NoisySegmenter(base, erode_px=0, miss=1.0).masks(image)
     assert all(not m.any() for m in missed.values())
 
 

@@ -44,7 +44,7 @@ def _readme_layers() -> list[list[str]]:
     block = section[start : section.index("\n```", start)]
     layers: list[list[str]] = []
     for line in block.splitlines()[1:]:
-        match = re.match(r"^ {2,3}(\| )?([a-z_]+(?:/[a-z_]+)*/|[a-z_]+\.py)(?:\s|$)", line)
+        match = re.match(r"^ {2,3}(\| )?((?:[a-z_]+/)*[a-z_]+(?:/|\.py))(?:\s|$)", line)
         if not match:
             continue
         module = "agentchord." + match.group(2).removesuffix(".py").strip("/").replace("/", ".")

@@ -111,15 +111,13 @@ def plan(instruction, task, seed, goal_path, reasoner, perception, output, rende
 
     Exit status 0 when a valid graph was written, 2 when the instruction cannot be planned.
     """
-    import numpy as np  # noqa: PLC0415
-
     from agentchord.agents.exceptions import ReasonerError  # noqa: PLC0415
     from agentchord.agents.observe import observe, task_regions  # noqa: PLC0415
     from agentchord.agents.pipeline import make_reasoner, plan_task  # noqa: PLC0415
     from agentchord.execution.trace import Trace  # noqa: PLC0415
     from agentchord.graph.loader import dump_graph  # noqa: PLC0415
     from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: PLC0415
-    from agentchord.worlds.sim.world import SimWorld  # noqa: PLC0415
+    from agentchord.worlds.sim.trial import open_world  # noqa: PLC0415
 
     _task_name(task, "--task")
     _check_plan_outputs(output, render_path, trace_path)
@@ -127,7 +125,7 @@ def plan(instruction, task, seed, goal_path, reasoner, perception, output, rende
     if not instruction and goal is None:
         raise click.UsageError("give an INSTRUCTION or --goal")
     sim_task = SIM_TASKS[task]
-    world = SimWorld(sim_task.sample_scene(np.random.default_rng([seed, 0x5CE7E])))
+    world = open_world(task, seed)
     scene = observe(world, task_regions(sim_task), perception)
     try:
         agent = make_reasoner(reasoner, goal=goal, watch_visibility=perception == "rgbd")
@@ -245,14 +243,9 @@ def _check_camera(task: str, camera: str, video_path) -> None:
     """Refuse an unknown --camera before the episode, not when its first frame is drawn."""
     if video_path is None:
         return
-    import mujoco  # noqa: PLC0415
-    import numpy as np  # noqa: PLC0415
+    from agentchord.worlds.sim.trial import open_world  # noqa: PLC0415
 
-    from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: PLC0415
-    from agentchord.worlds.sim.world import SimWorld  # noqa: PLC0415
-
-    model = SimWorld(SIM_TASKS[task].sample_scene(np.random.default_rng(0))).model
-    cameras = [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_CAMERA, i) for i in range(model.ncam)]
+    cameras = open_world(task, 0).camera_names
     if camera not in cameras:
         raise click.BadParameter(f"no camera {camera!r} in the {task} scene (cameras: {', '.join(cameras)})",
                                  param_hint="--camera")

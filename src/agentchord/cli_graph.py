@@ -81,14 +81,12 @@ def check_command(files: tuple[Path, ...], task: str | None) -> None:
 
 def _scene_objects(task: str) -> list[str]:
     """The names the feature frame of ``task``'s scene holds (objects, cloth points)."""
-    import numpy as np  # noqa: PLC0415
-
     from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: PLC0415
-    from agentchord.worlds.sim.world import SimWorld  # noqa: PLC0415
+    from agentchord.worlds.sim.trial import open_world  # noqa: PLC0415
 
     if task not in SIM_TASKS:
         raise click.BadParameter(f"unknown task {task!r} (tasks: {', '.join(SIM_TASKS)})", param_hint="--task")
-    world = SimWorld(SIM_TASKS[task].sample_scene(np.random.default_rng(0)))
+    world = open_world(task, 0)
     return [*world.object_names, *world.cloth_point_names]
 
 

@@ -14,9 +14,9 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from agentchord.features.frame import FeatureFrame
-from agentchord.solvers.ik import BimanualIK, PoseTarget
 from agentchord.robot.aloha import ARM_PREFIX
-from agentchord.worlds.sim.world import ArmCommand, SimWorld
+from agentchord.solvers.ik import BimanualIK, PoseTarget
+from agentchord.worlds.protocol import ArmCommand, World
 
 #: QP iterations per call of a scratch (trial) IK solve.
 SCRATCH_IK_ITERATIONS = 150
@@ -48,7 +48,7 @@ class RobotController:
         ik: The bimanual IK solver.
     """
 
-    def __init__(self, world: SimWorld, ik: BimanualIK | None = None) -> None:
+    def __init__(self, world: World, ik: BimanualIK | None = None) -> None:
         self.world = world
         self.ik = ik or BimanualIK()
         self.targets: dict[str, ArmTarget] = {}

@@ -11,7 +11,7 @@ import numpy as np
 
 from agentchord.agents.reasoner import Region, Scene
 from agentchord.features.extractors import make_extractor
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.worlds.protocol import World
 
 #: Named colours (RGB in [0, 1]) for object descriptions.
 COLOURS = {
@@ -39,11 +39,11 @@ def task_regions(task: object) -> list[Region]:
     return [Region(name=name, center=centre, radius=radius, description=words) for name, (centre, radius, words) in getattr(task, "regions", {}).items()]
 
 
-def observe(world: SimWorld, regions: list[Region] | None = None, perception: str = "oracle") -> Scene:
+def observe(world: World, regions: list[Region] | None = None, perception: str = "oracle") -> Scene:
     """The scene as the agents see it now.
 
     Args:
-        world: The simulated world (its objects' colours describe them).
+        world: The world (its objects' colours describe them).
         regions: The task's named regions.
         perception: ``oracle`` or ``rgbd`` features.
     """

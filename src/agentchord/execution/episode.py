@@ -5,8 +5,6 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
-import numpy as np
-
 from agentchord.agents.observe import observe, task_regions
 from agentchord.agents.pipeline import ReasonerRepairer, make_reasoner, plan_task
 from agentchord.agents.rules.goals import GoalSpec
@@ -18,7 +16,7 @@ from agentchord.graph.models import TaskGraph
 from agentchord.tasks import load_task_graph
 from agentchord.worlds.sim.disturbances import Disturbance, ProtocolDisturbances, RandomDisturbances
 from agentchord.worlds.sim.tasks import SIM_TASKS
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.worlds.sim.trial import open_world
 
 
 @dataclass
@@ -86,8 +84,7 @@ def run_episode(spec: EpisodeSpec, on_tick: Callable[[Executor], None] | None = 
     if spec.task not in SIM_TASKS:
         raise KeyError(f"unknown task {spec.task!r} (tasks: {', '.join(SIM_TASKS)})")
     task = SIM_TASKS[spec.task]
-    scene = task.sample_scene(np.random.default_rng([spec.seed, 0x5CE7E]))
-    world = SimWorld(scene)
+    world = open_world(spec.task, spec.seed)
     repairer = spec.repairer
     calls = []
     if spec.planned:

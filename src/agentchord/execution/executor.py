@@ -26,6 +26,7 @@ from agentchord.agents.exceptions import ReasonerError
 from agentchord.agents.reasoner import UnanticipatedFailure
 from agentchord.execution.edge_program import EdgeProgram
 from agentchord.execution.feasibility import FeasibilityChecker, first_grasps, off_table
+from agentchord.execution.harness import Disturbance, DisturbanceEvent, SuccessTracker
 from agentchord.execution.repair import RepairRejectedError, Repairer, validate_repair
 from agentchord.execution.strategies import RecoveryStrategy
 from agentchord.execution.trace import Trace
@@ -35,9 +36,7 @@ from agentchord.features.extractors import make_extractor
 from agentchord.graph.models import TaskGraph
 from agentchord.graph.progress import forward_filter, nominal_path
 from agentchord.monitor import Detection, EdgeMonitors, RecoveryMap
-from agentchord.worlds.sim.disturbances import Disturbance, DisturbanceEvent
-from agentchord.worlds.sim.tasks import SuccessTracker
-from agentchord.worlds.sim.world import CONTROL_HZ, SimWorld
+from agentchord.worlds.protocol import CONTROL_HZ, World
 
 
 @dataclass
@@ -159,7 +158,7 @@ class Executor:
     def __init__(
         self,
         graph: TaskGraph,
-        world: SimWorld,
+        world: World,
         strategy: RecoveryStrategy,
         tracker: SuccessTracker,
         disturbance: Disturbance | None = None,

@@ -4,17 +4,18 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.worlds.protocol import World
 
 #: Names accepted by ``--perception``.
 PERCEPTION_MODES = ("oracle", "rgbd")
 
 
-def make_extractor(mode: str, world: SimWorld, grasp_signal: Callable[[str], bool]):
+def make_extractor(mode: str, world: World, grasp_signal: Callable[[str], bool]):
     """The feature extractor for a perception mode.
 
     Raises:
         ValueError: Unknown mode.
+        GroundTruthUnavailableError: ``oracle`` on a world without ground truth.
     """
     if mode == "oracle":
         from agentchord.features.oracle import OracleExtractor  # noqa: PLC0415

@@ -1,7 +1,9 @@
-"""Oracle feature extraction: the feature frame read from the simulator state.
+"""Oracle feature extraction: the feature frame read from the world's ground truth.
 
 What a perfect perception stack would report (the paper's simulation setting,
-Sec. IV-B): object poses from the physics, the grasp from finger contacts.
+Sec. IV-B): object poses from the physics, the grasp from finger contacts. It
+needs a :class:`~agentchord.worlds.protocol.GroundTruthWorld` (a simulator); on a
+world without ground truth it says so (:class:`~agentchord.worlds.protocol.GroundTruthUnavailableError`).
 """
 
 from __future__ import annotations
@@ -10,23 +12,29 @@ import numpy as np
 
 from agentchord.features.frame import ARMS, ArmFeatures, FeatureFrame, ObjectFeatures
 from agentchord.features.pointcloud import quat_from_matrix
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.worlds.protocol import World, require_ground_truth
 
 
 class OracleExtractor:
-    """Builds a :class:`FeatureFrame` from a :class:`SimWorld` every tick.
+    """Builds a :class:`FeatureFrame` from a world's ground truth every tick.
 
     The same frame object is updated in place, so the references captured with
     ``capture_refs`` survive between ticks.
 
     Args:
-        world: The simulated world to read.
+        world: The world to read; it must have ground truth.
         grasp_signal: Callable ``arm -> bool``: the robot's latched "grasp done"
             signal (the controller knows it, the world does not).
+
+    Raises:
+        GroundTruthUnavailableError: ``world`` has no ground truth (a real robot).
     """
 
-    def __init__(self, world: SimWorld, grasp_signal=None) -> None:
-        self.world = world
+    #: What this extractor reads of the world besides the robot's signals.
+    needs_ground_truth = True
+
+    def __init__(self, world: World, grasp_signal=None) -> None:
+        self.world = require_ground_truth(world, "oracle perception")
         self.grasp_signal = grasp_signal or (lambda arm: False)
         self.frame = FeatureFrame(objects={}, arms={})
         self._half_heights = {}
@@ -43,8 +51,8 @@ class OracleExtractor:
         # A cloth's named points (its corners) are point-like objects: ``pos`` is the vertex, ``top`` and
         # ``bottom`` are half a cloth thickness above and below it, ``axis`` is up, and the local x axis of
         # ``quat`` is the corner's horizontal outward diagonal (a top grasp closes across it).
-        self._cloth_radius = world.scene.cloth.radius if getattr(world.scene, "cloth", None) is not None else 0.0
-        self._cloth_points = list(getattr(world, "cloth_point_names", []))
+        self._cloth_radius = self.world.cloth_radius
+        self._cloth_points = list(world.cloth_point_names)
         for name in self._cloth_points:
             self.frame.objects[name] = ObjectFeatures(
                 pos=np.zeros(3), quat=np.zeros(4), axis=np.zeros(3), extent=np.full(3, 2 * self._cloth_radius),
@@ -84,7 +92,7 @@ class OracleExtractor:
         return frame
 
 
-def update_robot_signals(frame: FeatureFrame, world: SimWorld, grasp_signal) -> None:
+def update_robot_signals(frame: FeatureFrame, world: World, grasp_signal) -> None:
     """The robot's own signals, read every tick in every perception mode: tool poses, joints,
     gripper widths, the grasp-done signal, contact-based holding, the tick."""
     holding = set()

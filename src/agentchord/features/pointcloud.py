@@ -1,6 +1,6 @@
 """Point clouds from depth images, and shape fits to them (RGB-D perception).
 
-Numpy only, no renderer: back-projection of a depth image through a pinhole
+Numpy only, no renderer, no MuJoCo: back-projection of a depth image through a pinhole
 camera, voxel down-sampling, PCA, and least-squares fits of the two model
 families of the scene's objects (cylinders and boxes).
 
@@ -16,9 +16,9 @@ Conventions: MuJoCo cameras look along their -z axis with y up and x right;
 from __future__ import annotations
 
 import itertools
+import math
 from dataclasses import dataclass
 
-import mujoco
 import numpy as np
 
 from agentchord.features.frame import UP
@@ -126,10 +126,31 @@ def quat_from_axis(axis: np.ndarray) -> np.ndarray:
 
 
 def quat_from_matrix(rot: np.ndarray) -> np.ndarray:
-    """Quaternion (w, x, y, z) of a rotation matrix."""
-    quat = np.empty(4)
-    mujoco.mju_mat2Quat(quat, np.ascontiguousarray(rot, dtype=float).reshape(-1))
-    return quat
+    """Quaternion (w, x, y, z) of a rotation matrix.
+
+    MuJoCo's ``mju_mat2Quat``, operation for operation (the same bits): the largest
+    component first, the others from it, then normalised.
+    """
+    m0, m1, m2, m3, m4, m5, m6, m7, m8 = (float(x) for x in np.asarray(rot, dtype=float).reshape(-1))
+    if m0 + m4 + m8 > 0:
+        w = 0.5 * math.sqrt(1 + m0 + m4 + m8)
+        q = (w, 0.25 * (m7 - m5) / w, 0.25 * (m2 - m6) / w, 0.25 * (m3 - m1) / w)
+    elif m0 > m4 and m0 > m8:
+        x = 0.5 * math.sqrt(1 + m0 - m4 - m8)
+        q = (0.25 * (m7 - m5) / x, x, 0.25 * (m1 + m3) / x, 0.25 * (m2 + m6) / x)
+    elif m4 > m8:
+        y = 0.5 * math.sqrt(1 - m0 + m4 - m8)
+        q = (0.25 * (m2 - m6) / y, 0.25 * (m1 + m3) / y, y, 0.25 * (m5 + m7) / y)
+    else:
+        z = 0.5 * math.sqrt(1 - m0 - m4 + m8)
+        q = (0.25 * (m3 - m1) / z, 0.25 * (m2 + m6) / z, 0.25 * (m5 + m7) / z, z)
+    norm = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+    if norm < 1e-15:
+        return np.array([1.0, 0.0, 0.0, 0.0])
+    if abs(norm - 1.0) > 1e-15:
+        inv = 1.0 / norm
+        q = tuple(c * inv for c in q)
+    return np.array(q)
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:

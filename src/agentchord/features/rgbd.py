@@ -17,22 +17,18 @@ chooses the model family and a soft size prior; its pose is never read.
 
 from __future__ import annotations
 
-import atexit
 import time
-import weakref
 from collections import deque
-from dataclasses import dataclass
 
-import mujoco
 import numpy as np
 
 from agentchord.features.frame import ARMS, ArmFeatures, FeatureFrame, ObjectFeatures
 from agentchord.features.oracle import update_robot_signals
 from agentchord.features.pointcloud import ShapeFit, backproject, fit_box, fit_cylinder, quat_from_axis, quat_from_matrix, voxel_downsample
-from agentchord.features.segmentation import Segmenter, SimSegmenter
-from agentchord.worlds.sim.world import CONTROL_HZ, SimWorld
+from agentchord.features.segmentation import LabelSegmenter, Segmenter
+from agentchord.worlds.protocol import CONTROL_HZ, Camera, CameraFrame, World
 
-#: Scene cameras used for perception (defined in :mod:`agentchord.worlds.sim.scene`).
+#: Cameras used for perception (the simulated scene's are defined in :mod:`agentchord.worlds.sim.scene`).
 PERCEPTION_CAMERAS = ("front", "side")
 #: Camera frame rate (Hz) of the paper's RGB-D setting.
 CAMERA_RATE_HZ = 10
@@ -42,140 +38,9 @@ MIN_POINTS = 30
 VOXEL_M = 0.003
 
 
-_OPEN_CAMERAS: weakref.WeakSet = weakref.WeakSet()
-_EXIT_HOOK = False
-
-
-def _close_open_cameras() -> None:
-    # Renderers still open at exit would be freed by their finalisers after EGL shut down.
-    for camera in list(_OPEN_CAMERAS):
-        camera.close()
-
-
-def _track(camera: DepthCamera) -> None:
-    global _EXIT_HOOK
-    if not _EXIT_HOOK:
-        # Registered after the renderer created its GL context (so after the EGL module set up
-        # its own exit handler): exit handlers run last-in first-out, so this one runs first.
-        atexit.register(_close_open_cameras)
-        _EXIT_HOOK = True
-    _OPEN_CAMERAS.add(camera)
-
-
-@dataclass
-class CameraImage:
-    """One camera's depth and segmentation, with the camera geometry they were taken with.
-
-    Attributes:
-        camera: Camera name.
-        depth: (H, W) float32 distance along the viewing axis (m); row 0 at the top.
-        seg: (H, W, 2) int32 (object id, object type) per pixel; -1 for background.
-        fovy: Vertical field of view (deg).
-        pos: Camera position (world).
-        rot: (3, 3) camera axes as columns (world); the camera looks along -z.
-    """
-
-    camera: str
-    depth: np.ndarray
-    seg: np.ndarray
-    fovy: float
-    pos: np.ndarray
-    rot: np.ndarray
-
-    def points(self, mask: np.ndarray | None = None) -> np.ndarray:
-        """World points of the (masked) pixels."""
-        return backproject(self.depth, self.fovy, self.pos, self.rot, mask)
-
-
-class DepthCamera:
-    """A scene camera that renders depth and segmentation with its own ``mujoco.Renderer``.
-
-    Both images come from one render pass when the renderer's GL context is
-    reachable (segmentation colours and the depth buffer of the same pass),
-    else from two passes with the public ``enable_*_rendering`` switches.
-
-    Args:
-        model: The compiled model.
-        camera: Name of a camera of the model.
-        width: Image width (px).
-        height: Image height (px).
-    """
-
-    def __init__(self, model: mujoco.MjModel, camera: str, width: int = 320, height: int = 240) -> None:
-        self.model = model
-        self.camera = camera
-        self.camera_id = model.camera(camera).id
-        self.width, self.height = width, height
-        self.renderer = mujoco.Renderer(model, height, width)
-        self.option = mujoco.MjvOption()
-        self.option.sitegroup[:] = 0  # sites (the TCP markers) are not scene surfaces
-        extent = model.stat.extent
-        znear = np.float32(model.vis.map.znear * extent)
-        zfar = np.float32(model.vis.map.zfar * extent)
-        c_coef = -(zfar + znear) / (zfar - znear)
-        d_coef = -(np.float32(2) * zfar * znear) / (zfar - znear)
-        # Reversed-Z depth buffer (the renderer's readDepthMap = ZEROFAR).
-        self._c = float(np.float32(-0.5) * c_coef - np.float32(0.5))
-        self._d = float(np.float32(-0.5) * d_coef)
-        r = self.renderer
-        self.single_pass = all(hasattr(r, a) for a in ("_rect", "_mjr_context", "_gl_context"))
-        self._rgb = np.empty((height, width, 3), dtype=np.uint8)
-        self._zbuf = np.empty((height, width), dtype=np.float32)
-        _track(self)
-
-    def capture(self, data: mujoco.MjData) -> CameraImage:
-        """Render the current state."""
-        r = self.renderer
-        if r is None:
-            raise RuntimeError(f"camera {self.camera!r} was closed")
-        r.update_scene(data, camera=self.camera_id, scene_option=self.option)
-        if self.single_pass:
-            depth, seg = self._render_single_pass()
-        else:  # pragma: no cover - depends on the mujoco version's internals
-            r.enable_depth_rendering()
-            depth = r.render()
-            r.enable_segmentation_rendering()
-            seg = r.render()
-            r.disable_segmentation_rendering()
-        return CameraImage(
-            camera=self.camera,
-            depth=depth,
-            seg=seg,
-            fovy=float(self.model.cam_fovy[self.camera_id]),
-            pos=data.cam_xpos[self.camera_id].copy(),
-            rot=data.cam_xmat[self.camera_id].reshape(3, 3).copy(),
-        )
-
-    def _render_single_pass(self) -> tuple[np.ndarray, np.ndarray]:
-        r = self.renderer
-        scene = r.scene
-        flags = scene.flags.copy()
-        scene.flags[mujoco.mjtRndFlag.mjRND_SEGMENT] = True
-        scene.flags[mujoco.mjtRndFlag.mjRND_IDCOLOR] = True
-        if r._gl_context:
-            r._gl_context.make_current()
-        mujoco.mjr_render(r._rect, scene, r._mjr_context)
-        mujoco.mjr_readPixels(self._rgb, self._zbuf, r._rect, r._mjr_context)
-        np.copyto(scene.flags, flags)
-        depth = (self._d / (self._zbuf.astype(np.float64) + self._c)).astype(np.float32)
-        rgb = self._rgb.astype(np.int32)
-        segid = rgb[..., 0] + (rgb[..., 1] << 8) + (rgb[..., 2] << 16)
-        lut = np.full((scene.ngeom + 2, 2), -1, dtype=np.int32)
-        for geom in scene.geoms[: scene.ngeom]:
-            if geom.segid != -1:
-                lut[geom.segid + 1] = (geom.objid, geom.objtype)
-        seg = lut[np.minimum(segid, scene.ngeom + 1)]
-        if r._gl_context:  # EGL/OSMesa images are bottom-up
-            depth = np.flipud(depth)
-            seg = np.flipud(seg)
-        return np.ascontiguousarray(depth), np.ascontiguousarray(seg)
-
-    def close(self) -> None:
-        """Free the renderer's GL resources."""
-        if self.renderer is not None:
-            self.renderer.close()
-            self.renderer = None
-        _OPEN_CAMERAS.discard(self)
+def frame_points(image: CameraFrame, mask: np.ndarray | None = None) -> np.ndarray:
+    """World points of the (masked) pixels of a camera frame."""
+    return backproject(image.depth, image.fovy, image.pos, image.rot, mask)
 
 
 class RgbdExtractor:
@@ -189,13 +54,14 @@ class RgbdExtractor:
     the count seen (so a ``lost_view`` monitor fires).
 
     Args:
-        world: The simulated world (rendered; its object poses are not read).
+        world: The world (its cameras are read, its object poses never).
         grasp_signal: Callable ``arm -> bool``: the controller's latched grasp signal.
         cameras: Names of the scene cameras to fuse.
         rate_hz: Camera rate (Hz).
         width: Image width (px).
         height: Image height (px).
-        segmenter: Object masks per image; default :class:`SimSegmenter`.
+        segmenter: Object masks per image; default :class:`LabelSegmenter` (the world's own
+            labels: a simulator has them, a real camera needs a segmenter).
         min_points: Fewest fused points for a new estimate.
         voxel: Voxel edge (m) of the fused cloud's down-sampling (0: none).
         depth_noise: Standard deviation (m) of Gaussian depth noise at 1 m, growing
@@ -210,9 +76,12 @@ class RgbdExtractor:
         estimated: Per object, whether it has been seen at least once.
     """
 
+    #: Objects are read from the cameras only, never from the world's ground truth.
+    needs_ground_truth = False
+
     def __init__(
         self,
-        world: SimWorld,
+        world: World,
         grasp_signal=None,
         cameras: tuple[str, ...] = PERCEPTION_CAMERAS,
         rate_hz: float = CAMERA_RATE_HZ,
@@ -231,11 +100,11 @@ class RgbdExtractor:
         self.voxel = voxel
         self.depth_noise = depth_noise
         self.rng = np.random.default_rng(seed)
-        self.segmenter = segmenter if segmenter is not None else SimSegmenter.for_world(world)
-        self.cameras: list[DepthCamera] = []
+        self.segmenter = segmenter if segmenter is not None else LabelSegmenter.for_world(world)
+        self.cameras: list[Camera] = []
         try:
             for name in cameras:
-                self.cameras.append(DepthCamera(world.model, name, width, height))
+                self.cameras.append(world.open_camera(name, width, height))
         except Exception:
             self.close()
             raise
@@ -292,31 +161,27 @@ class RgbdExtractor:
         return frame
 
     # ------------------------------------------------------------------ perception
-    def capture(self) -> list[CameraImage]:
-        """Render every perception camera at the current state."""
-        images = [camera.capture(self.world.data) for camera in self.cameras]
+    def capture(self) -> list[CameraFrame]:
+        """A frame of every perception camera at the current state."""
+        images = [camera.capture() for camera in self.cameras]
         if self.depth_noise > 0:
             for image in images:
                 noise = self.rng.standard_normal(image.depth.shape, dtype=np.float32)
                 image.depth = image.depth + noise * np.float32(self.depth_noise) * image.depth**2
         return images
 
-    def object_clouds(self, images: list[CameraImage]) -> dict[str, list[np.ndarray]]:
+    def object_clouds(self, images: list[CameraFrame]) -> dict[str, list[np.ndarray]]:
         """Per object, the world points of its mask in each image (in camera order)."""
         clouds: dict[str, list[np.ndarray]] = {name: [] for name in self.frame.objects}
         for image in images:
-            masks = self.segmenter.masks(image.seg, image.camera)
+            masks = self.segmenter.masks(image)
             for name in clouds:
                 mask = masks.get(name)
                 if mask is None or not mask.any():
                     clouds[name].append(np.empty((0, 3)))
                 else:
-                    clouds[name].append(image.points(mask & (image.depth < 0.99 * self._far)))
+                    clouds[name].append(frame_points(image, mask & (image.depth < 0.99 * image.far)))
         return clouds
-
-    @property
-    def _far(self) -> float:
-        return float(self.world.model.vis.map.zfar * self.world.model.stat.extent)
 
     def fuse(self, views: list[np.ndarray], origins: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
         """Fuse per-camera clouds: each voxel-downsampled, then concatenated.

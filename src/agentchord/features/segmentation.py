@@ -1,33 +1,28 @@
-"""Object segmentation of camera images: the interface and the simulator's segmenter.
+"""Object segmentation of camera frames: the interface, the world's own labels, and noise.
 
-RGB-D perception needs, per camera image, one pixel mask per named object. On a
+RGB-D perception needs, per camera frame, one pixel mask per named object. On a
 real robot an open-vocabulary segmenter (SAM3, Grounded-SAM) prompted with the
-object names provides them; in simulation :class:`SimSegmenter` reads MuJoCo's
-segmentation rendering (geom id and object type per pixel) and maps geoms to
-objects. :class:`NoisySegmenter` degrades any segmenter's masks (eroded
-borders, dropped pixels, missed detections) for robustness tests.
+object names provides them from ``frame.rgb``; a world that segments its own
+frames (the simulator renders instance labels) fills ``frame.labels``, which
+:class:`LabelSegmenter` reads. :class:`NoisySegmenter` degrades any segmenter's
+masks (eroded borders, dropped pixels, missed detections) for robustness tests.
 """
 
 from __future__ import annotations
 
 from typing import Protocol, runtime_checkable
 
-import mujoco
 import numpy as np
+
+from agentchord.worlds.protocol import CameraFrame, World
 
 
 @runtime_checkable
 class Segmenter(Protocol):
-    """Per-object pixel masks of one camera image."""
+    """Per-object pixel masks of one camera frame."""
 
-    def masks(self, seg_image: np.ndarray, camera: str) -> dict[str, np.ndarray]:
-        """Masks of the objects seen by ``camera``.
-
-        Args:
-            seg_image: (H, W, 2) int image of (object id, object type) per pixel,
-                as ``mujoco.Renderer`` gives with segmentation rendering; -1 is
-                background. A learned segmenter would take the RGB image instead.
-            camera: Name of the camera the image comes from.
+    def masks(self, image: CameraFrame) -> dict[str, np.ndarray]:
+        """Masks of the objects seen in ``image`` (``image.camera`` names its camera).
 
         Returns:
             ``{object name: (H, W) bool mask}``; an object not seen may be absent
@@ -36,40 +31,43 @@ class Segmenter(Protocol):
         ...
 
 
-class SimSegmenter:
-    """The simulator's ground-truth segmentation: geom id -> object name.
+class SegmentationUnavailableError(ValueError):
+    """A camera frame has no labels of its own, and no segmenter was given for it."""
 
-    Every geom attached to an object's body counts as that object (most objects
-    have one geom, named like the object; a compound one, such as a tray, has several).
+
+class LabelSegmenter:
+    """The world's own instance segmentation (``frame.labels``): label k is ``object_names[k]``.
+
+    In simulation these are exact: every geom of an object's body counts as that object
+    (a compound one, such as a tray, has several).
 
     Args:
-        model: The compiled MuJoCo model.
-        object_names: Names of the object bodies to segment.
+        object_names: The world's object names, in its order.
     """
 
-    def __init__(self, model: mujoco.MjModel, object_names: list[str] | tuple[str, ...]) -> None:
+    def __init__(self, object_names: list[str] | tuple[str, ...]) -> None:
         self.object_names = list(object_names)
-        self._lut = np.full(model.ngeom + 1, -1, dtype=np.int32)  # index geom id + 1 (-1 -> background)
-        for index, name in enumerate(self.object_names):
-            body = model.body(name).id
-            for geom in np.nonzero(model.geom_bodyid == body)[0]:
-                self._lut[geom + 1] = index
 
     @classmethod
-    def for_world(cls, world) -> SimSegmenter:
-        """The segmenter of a :class:`~agentchord.worlds.sim.world.SimWorld`'s objects."""
-        return cls(world.model, world.object_names)
+    def for_world(cls, world: World) -> LabelSegmenter:
+        """The segmenter of a world's objects."""
+        return cls(world.object_names)
 
-    def labels(self, seg_image: np.ndarray) -> np.ndarray:
-        """(H, W) object index per pixel (-1: no object)."""
-        ids = seg_image[..., 0]
-        is_geom = seg_image[..., 1] == int(mujoco.mjtObj.mjOBJ_GEOM)
-        ids = np.where(is_geom & (ids >= 0) & (ids < len(self._lut) - 1), ids, -1)
-        return self._lut[ids + 1]
+    def labels(self, image: CameraFrame) -> np.ndarray:
+        """(H, W) object index per pixel (-1: no object).
 
-    def masks(self, seg_image: np.ndarray, camera: str) -> dict[str, np.ndarray]:
-        """One mask per object, containing exactly that object's geom pixels."""
-        labels = self.labels(seg_image)
+        Raises:
+            SegmentationUnavailableError: The frame carries no labels (a real camera).
+        """
+        if image.labels is None:
+            raise SegmentationUnavailableError(
+                f"camera {image.camera!r} gives no segmentation of its own: give the RGB-D extractor a segmenter"
+            )
+        return image.labels
+
+    def masks(self, image: CameraFrame) -> dict[str, np.ndarray]:
+        """One mask per object, containing exactly that object's pixels."""
+        labels = self.labels(image)
         return {name: labels == index for index, name in enumerate(self.object_names)}
 
 
@@ -106,10 +104,10 @@ class NoisySegmenter:
         self.miss = miss
         self.rng = np.random.default_rng(seed)
 
-    def masks(self, seg_image: np.ndarray, camera: str) -> dict[str, np.ndarray]:
+    def masks(self, image: CameraFrame) -> dict[str, np.ndarray]:
         """The base masks, eroded, thinned and sometimes missing."""
         out = {}
-        for name, mask in self.base.masks(seg_image, camera).items():
+        for name, mask in self.base.masks(image).items():
             if self.miss > 0 and self.rng.random() < self.miss:
                 out[name] = np.zeros_like(mask)
                 continue

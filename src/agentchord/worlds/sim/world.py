@@ -6,11 +6,11 @@ the object with friction, and a drop happens because the fingers open.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import mujoco
 import numpy as np
 
+from agentchord.worlds.protocol import CONTROL_HZ, ArmCommand, CameraFrame  # noqa: F401  (re-exported)
+from agentchord.worlds.sim.cameras import DepthCamera
 from agentchord.worlds.sim.exceptions import UnknownObjectError
 from agentchord.worlds.sim.hand import PersonHand, Waypoint
 from agentchord.worlds.sim.scene import (
@@ -23,29 +23,18 @@ from agentchord.worlds.sim.scene import (
     build_model,
 )
 
-#: Control rate of the robot (Hz); physics runs at 1 / timestep.
-CONTROL_HZ = 50
 #: A finger touches a cloth point (a corner) when it touches the cloth within this distance of it (m).
 CLOTH_HOLD_RADIUS = 0.04
 #: ... and only with at least this gap between its finger pads (m): cloth pinched between them.
 CLOTH_MIN_PINCH = 0.002
 
 
-@dataclass
-class ArmCommand:
-    """What one arm is told to do for one control tick.
-
-    Attributes:
-        q: Joint position targets of the 6 arm joints (rad).
-        grip: Gripper target in [0, 1]: 0 fully open, 1 closed.
-    """
-
-    q: np.ndarray
-    grip: float
-
-
 class SimWorld:
-    """One trial's MuJoCo world.
+    """One trial's MuJoCo world: a :class:`~agentchord.worlds.protocol.World` with ground truth
+    (:class:`~agentchord.worlds.protocol.GroundTruthWorld`), plus the simulator's own means of
+    disturbing it (gripper faults, pushes, knocks, a person's hand) and contact queries.
+
+    Physics runs at ``1 / timestep``, control at :data:`~agentchord.worlds.protocol.CONTROL_HZ`.
 
     Args:
         scene: The objects and their initial placement.
@@ -276,7 +265,28 @@ class SimWorld:
         """Position of the arm's shoulder (its waist axis) in the world."""
         return self.data.xpos[self.model.body(f"{ARM_PREFIX[arm]}/shoulder_link").id].copy()
 
+    # ---------------------------------------------------------------- cameras
+    @property
+    def camera_names(self) -> list[str]:
+        """The scene's cameras."""
+        return [mujoco.mj_id2name(self.model, mujoco.mjtObj.mjOBJ_CAMERA, i) for i in range(self.model.ncam)]
+
+    def open_camera(self, name: str, width: int = 320, height: int = 240) -> DepthCamera:
+        """A rendering camera of this world (close it when done): depth, geometry, object labels.
+
+        Raises:
+            KeyError: No such camera.
+        """
+        if name not in self.camera_names:
+            raise KeyError(f"no camera {name!r} in the scene (cameras: {', '.join(self.camera_names)})")
+        return DepthCamera(self.model, name, width, height, object_names=self.object_names, data=self.data)
+
     # ------------------------------------------------------------------ cloth
+    @property
+    def cloth_radius(self) -> float:
+        """Half the cloth's thickness (m); 0 without a cloth."""
+        return float(self.scene.cloth.radius) if self.scene.cloth is not None else 0.0
+
     @property
     def cloth_point_names(self) -> list[str]:
         """Named points of the scene's cloth (its corners ``{cloth}_bl`` ...); empty without a cloth."""
