@@ -46,6 +46,7 @@ bench: install
 	$(BIN)/python benchmarks/bench_perception.py
 	$(BIN)/python benchmarks/bench_planning.py
 	$(BIN)/python benchmarks/bench_solvers.py
+	$(BIN)/python benchmarks/bench_remote_world.py
 
 clean:
 	rm -rf $(VENV) .pytest_cache .hypothesis

@@ -44,6 +44,21 @@ def _kinds(ctx, param, value: str) -> tuple[str, ...]:
         raise click.BadParameter(str(exc)) from exc
 
 
+WORLD_HELP = ("Drive the world served at this address (tcp://HOST:PORT, see `agentchord serve`) instead of the "
+              "simulator in this process: same seed, same episode.")
+
+
+def _world_address(ctx, param, value: str | None) -> str | None:
+    if value is None:
+        return None
+    from agentchord.worlds.remote import check_address  # noqa: PLC0415
+
+    try:
+        return check_address(value)
+    except ValueError as exc:
+        raise click.BadParameter(str(exc)) from exc
+
+
 def _task_name(task: str, param_hint: str) -> None:
     from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: PLC0415
 
@@ -76,6 +91,32 @@ def tasks() -> None:
         else:
             mark = "" if name in graphs else "  (no library graph yet)"
         click.echo(f"{name:<{width}}  {task.description}{mark}")
+
+
+@main.command()
+@click.option("--task", required=True, help="The simulated task served.")
+@click.option("--port", type=click.IntRange(0, 65535), default=5555, show_default=True, help="TCP port (0: any free one, printed).")
+@click.option("--host", default="127.0.0.1", show_default=True, help="Interface to listen on (0.0.0.0: every one).")
+@click.option("--seed", type=click.IntRange(0), default=0, show_default=True, help="Seed of a trial a client opens without one.")
+def serve(task, port, host, seed) -> None:
+    """Serve TASK's simulator over the world protocol (ZeroMQ) until interrupted.
+
+    `run`/`demo --world tcp://HOST:PORT` drive it as a remote world, the way they would drive a
+    real robot's driver: docs/world_protocol.md lists the messages. One client at a time.
+    """
+    _task_name(task, "--task")
+    import zmq  # noqa: PLC0415
+
+    from agentchord.worlds.sim.serve import WorldServer  # noqa: PLC0415
+
+    def ready(endpoint: str) -> None:
+        click.echo(f"serving {task} on {endpoint} (Ctrl-C to stop)")
+        sys.stdout.flush()
+
+    try:
+        WorldServer(task, seed).serve(f"tcp://{host}:{port or '*'}", ready=ready)
+    except zmq.ZMQError as exc:
+        raise BadInput(f"cannot listen on {host}:{port}: {exc}") from exc
 
 
 def _load_graph_option(graph_path: str | None):
@@ -172,8 +213,9 @@ def plan(instruction, task, seed, goal_path, reasoner, perception, output, rende
 @click.option("--json", "json_path", type=click.Path(dir_okay=False), help="Write the episode summary as JSON.")
 @click.option("--video", "video_path", type=click.Path(dir_okay=False), help="Write an MP4 of the episode.")
 @click.option("--camera", default="front", show_default=True, help="Scene camera for --video.")
+@click.option("--world", "world", callback=_world_address, help=WORLD_HELP)
 def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, instruction, goal_path, reasoner, repair,
-        trace_path, json_path, video_path, camera) -> None:
+        trace_path, json_path, video_path, camera, world) -> None:
     """Run one episode of TASK and print its path through the graph.
 
     Exit status 0 when the task succeeded, 1 when it failed, 2 on bad input.
@@ -181,6 +223,8 @@ def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, inst
     from agentchord.execution.episode import EpisodeSpec  # noqa: PLC0415
 
     _task_name(task, "TASK")
+    if world is not None and video_path is not None:
+        raise click.UsageError("--video renders the simulator in this process: it cannot be used with --world")
     check_outputs(("--trace", trace_path, ()), ("--json", json_path, ()), ("--video", video_path, (".mp4",)))
     _check_camera(task, camera, video_path)
     graph = _load_graph_option(graph_path)
@@ -213,7 +257,8 @@ def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, inst
 
     disturb = _protocol_kinds(protocol, disturb)
     spec = EpisodeSpec(task=task, strategy=strategy, p=p, seed=seed, graph=graph, disturb=disturb, protocol=protocol is not None,
-                       perception=perception, instruction=instruction, goal=goal, reasoner=reasoner, repair=repair)
+                       perception=perception, instruction=instruction, goal=goal, reasoner=reasoner, repair=repair,
+                       world=world)
     result = _run_or_explain(spec, on_tick, trace_path, graph_path)
     _print_episode(console, result)
     _write_outputs(console, [
@@ -229,9 +274,12 @@ def _run_or_explain(spec, on_tick=None, trace_path=None, graph_path=None):
     from agentchord.agents.exceptions import ReasonerError  # noqa: PLC0415
     from agentchord.execution.episode import run_episode  # noqa: PLC0415
     from agentchord.graph.exceptions import GraphNotRunnableError  # noqa: PLC0415
+    from agentchord.worlds.remote import RemoteWorldError  # noqa: PLC0415
 
     try:
         return run_episode(spec, on_tick=on_tick)
+    except RemoteWorldError as exc:
+        raise BadInput(str(exc)) from exc
     except ReasonerError as exc:
         raise click.UsageError(str(exc) + _failed_calls_trace(exc, trace_path)) from exc
     except GraphNotRunnableError as exc:
@@ -378,17 +426,23 @@ def _print_episode(console: Console, result) -> None:
 @click.option("--planned", is_flag=True, help="Plan each episode's graph with --reasoner from the task's instruction instead of the library graph.")
 @click.option("--instruction", help="Plan each episode's graph from this instruction (implies --planned).")
 @click.option("--reasoner", type=click.Choice(REASONER_NAMES), default="rules", show_default=True)
-@click.option("--json", "json_path", type=click.Path(dir_okay=False), help="Write the aggregates as JSON.")
-def demo(task, trials, first_seed, p, disturb, protocol, perception, strategies, workers, planned, instruction, reasoner, json_path) -> None:
+@click.option("--json", "json_path", type=click.Path(dir_okay=False), help="Write the aggregates (and each episode's summary) as JSON.")
+@click.option("--world", "world", callback=_world_address, help=WORLD_HELP + " Episodes then run one at a time.")
+def demo(task, trials, first_seed, p, disturb, protocol, perception, strategies, workers, planned, instruction, reasoner, json_path,
+         world) -> None:
     """Seeded episodes of each strategy under random drops, then a table per strategy."""
     from agentchord.bench.report import aggregate, paired_steps, print_tables  # noqa: PLC0415
     from agentchord.bench.runner import run_many  # noqa: PLC0415
     from agentchord.execution.episode import EpisodeSpec  # noqa: PLC0415
+    from agentchord.worlds.remote import RemoteWorldError  # noqa: PLC0415
+
     names = [s.strip() for s in strategies.split(",") if s.strip()]
     unknown = [s for s in names if s not in STRATEGY_NAMES]
     if unknown or not names:
         raise click.BadParameter(f"unknown strategy {unknown} (choose from {', '.join(STRATEGY_NAMES)})", param_hint="--strategies")
     _task_name(task, "--task")
+    if world is not None and workers not in (None, 1):
+        raise click.BadParameter("one remote world runs one episode at a time: use --workers 1 with --world", param_hint="--workers")
     check_outputs(("--json", json_path, ()))
     console = Console()
     disturb = _protocol_kinds(protocol, disturb)
@@ -401,15 +455,20 @@ def demo(task, trials, first_seed, p, disturb, protocol, perception, strategies,
         instruction = load_task_graph(task).instruction
     if instruction:
         console.print(f"graphs planned per episode by the {reasoner} reasoner from: {instruction!r}")
+    if world is not None:
+        console.print(f"world: {world} (one episode at a time)")
     specs = [EpisodeSpec(task=task, strategy=name, p=p, seed=seed, disturb=disturb, protocol=protocol is not None,
-                         perception=perception, instruction=instruction, reasoner=reasoner)
+                         perception=perception, instruction=instruction, reasoner=reasoner, world=world)
              for name in names for seed in range(first_seed, first_seed + trials)]
     summaries: dict[str, list[dict]] = {name: [] for name in names}
     with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(), console=console) as bar:
         job = bar.add_task("episodes", total=len(specs))
-        for spec, summary in run_many(specs, workers=workers):
-            summaries[spec.strategy].append(summary)
-            bar.advance(job)
+        try:
+            for spec, summary in run_many(specs, workers=1 if world is not None else workers):
+                summaries[spec.strategy].append(summary)
+                bar.advance(job)
+        except RemoteWorldError as exc:
+            raise BadInput(str(exc)) from exc
     for runs in summaries.values():
         runs.sort(key=lambda s: s["seed"])
     results = {name: aggregate(summaries[name]) for name in names}
@@ -417,7 +476,8 @@ def demo(task, trials, first_seed, p, disturb, protocol, perception, strategies,
     print_tables(results, console, paired)
     if json_path:
         payload = {"task": task, "p": p, "trials": trials, "first_seed": first_seed, "disturb": list(disturb), "protocol": protocol,
-                   "perception": perception, "instruction": instruction, "reasoner": reasoner if instruction else None, "strategies": results, "paired_steps": paired}
+                   "perception": perception, "instruction": instruction, "reasoner": reasoner if instruction else None, "strategies": results, "paired_steps": paired,
+                   "world": world, "runs": summaries}
         atomic_write_text(json_path, finite_json(payload, indent=2) + "\n")
         console.print(f"aggregates: {json_path}")
 

@@ -14,6 +14,8 @@ from agentchord.execution.strategies import make_strategy
 from agentchord.graph.grounding import require_runnable
 from agentchord.graph.models import TaskGraph
 from agentchord.tasks import load_task_graph
+from agentchord.worlds.protocol import World
+from agentchord.worlds.remote import RemoteWorld
 from agentchord.worlds.sim.disturbances import Disturbance, ProtocolDisturbances, RandomDisturbances
 from agentchord.worlds.sim.tasks import SIM_TASKS
 from agentchord.worlds.sim.trial import open_world
@@ -41,6 +43,8 @@ class EpisodeSpec:
         goal: Plan from this goal spec instead of reading ``instruction``.
         reasoner: ``rules`` (offline) or ``llm``.
         repair: Online repair through the reasoner; None = on when the graph is planned.
+        world: The address of a world served by another process (``tcp://host:port``, see
+            ``agentchord serve``); None: the simulator in this process. Same seed, same episode.
     """
 
     task: str
@@ -58,6 +62,7 @@ class EpisodeSpec:
     goal: GoalSpec | None = None
     reasoner: str = "rules"
     repair: bool | None = None
+    world: str | None = None
 
     @property
     def planned(self) -> bool:
@@ -74,17 +79,25 @@ class EpisodeSpec:
 
 
 def run_episode(spec: EpisodeSpec, on_tick: Callable[[Executor], None] | None = None) -> EpisodeResult:
-    """Run one episode.
+    """Run one episode, on the simulator in this process or on the world at ``spec.world``.
 
     Raises:
         KeyError: Unknown task.
         ValueError: Unknown strategy or a probability outside [0, 1].
         GraphNotRunnableError: The graph fails ``graph check`` or names objects the scene lacks.
+        RemoteWorldError: The remote world did not answer or refused the trial.
     """
     if spec.task not in SIM_TASKS:
         raise KeyError(f"unknown task {spec.task!r} (tasks: {', '.join(SIM_TASKS)})")
+    if spec.world is None:
+        return _run_in(open_world(spec.task, spec.seed), spec, on_tick)
+    with RemoteWorld(spec.world, spec.task, spec.seed) as world:
+        return _run_in(world, spec, on_tick)
+
+
+def _run_in(world: World, spec: EpisodeSpec, on_tick: Callable[[Executor], None] | None) -> EpisodeResult:
+    """The episode of ``spec`` on ``world`` (a fresh trial of its task and seed)."""
     task = SIM_TASKS[spec.task]
-    world = open_world(spec.task, spec.seed)
     repairer = spec.repairer
     calls = []
     if spec.planned:
