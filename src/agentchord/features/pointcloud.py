@@ -131,7 +131,7 @@ def quat_from_matrix(rot: np.ndarray) -> np.ndarray:
     MuJoCo's ``mju_mat2Quat``, operation for operation (the same bits): the largest
     component first, the others from it, then normalised.
     """
-    m0, m1, m2, m3, m4, m5, m6, m7, m8 = (float(x) for x in np.asarray(rot, dtype=float).reshape(-1))
+    m0, m1, m2, m3, m4, m5, m6, m7, m8 = np.asarray(rot, dtype=float).ravel().tolist()
     if m0 + m4 + m8 > 0:
         w = 0.5 * math.sqrt(1 + m0 + m4 + m8)
         q = (w, 0.25 * (m7 - m5) / w, 0.25 * (m2 - m6) / w, 0.25 * (m3 - m1) / w)
