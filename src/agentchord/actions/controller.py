@@ -20,6 +20,8 @@ from agentchord.worlds.protocol import ArmCommand, World
 
 #: QP iterations per call of a scratch (trial) IK solve.
 SCRATCH_IK_ITERATIONS = 150
+#: A scratch solve stops once a step moves no joint more than this (rad).
+SCRATCH_IK_CONVERGED = 1e-4
 
 
 @dataclass
@@ -62,7 +64,9 @@ class RobotController:
     def scratch_ik(self, avoid_other_arm: bool = True) -> BimanualIK:
         """A many-iteration IK solver for trial solves; the live solver's warm start stays untouched."""
         if avoid_other_arm not in self._scratch_ik:
-            self._scratch_ik[avoid_other_arm] = BimanualIK(iterations=SCRATCH_IK_ITERATIONS, avoid_arm_collisions=avoid_other_arm)
+            self._scratch_ik[avoid_other_arm] = BimanualIK(
+                iterations=SCRATCH_IK_ITERATIONS, avoid_arm_collisions=avoid_other_arm, converged_step=SCRATCH_IK_CONVERGED,
+            )
         return self._scratch_ik[avoid_other_arm]
 
     def sync_from_world(self) -> None:

@@ -52,10 +52,11 @@ def move_to(robot: RobotController, arm: str, goal: PoseTarget, speed: float = L
     distance = float(np.linalg.norm(goal_pos - start.pos))
     # Min-jerk peaks at 1.875x the mean speed: size the duration for the peak.
     ticks = max(int(np.ceil(1.875 * max(distance / speed, angle / ANGULAR_SPEED) * 50)), 5)
-    slerp = Slerp([0.0, 1.0], Rotation.concatenate([r0, r1]))
-    for k in range(1, ticks + 1):
-        s = min_jerk(k / ticks)
-        robot.set_pose(arm, PoseTarget(pos=start.pos + s * (goal_pos - start.pos), quat=rotation_to_quat(slerp(s))))
+    phases = [min_jerk(k / ticks) for k in range(1, ticks + 1)]
+    # One vectorised slerp for the whole line (a call per tick cost ~10% of an episode).
+    quats_xyzw = Slerp([0.0, 1.0], Rotation.concatenate([r0, r1]))(phases).as_quat()
+    for s, (x, y, z, w) in zip(phases, quats_xyzw):
+        robot.set_pose(arm, PoseTarget(pos=start.pos + s * (goal_pos - start.pos), quat=np.array([w, x, y, z])))
         yield
 
 

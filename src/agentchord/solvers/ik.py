@@ -41,12 +41,17 @@ class BimanualIK:
         iterations: QP iterations per call (each ~0.1 ms, ~0.8 ms with collision avoidance).
         dt: Integration step of the differential IK.
         avoid_arm_collisions: Keep the two arms apart.
+        converged_step: Stop before ``iterations`` once a QP step moves the joints less than
+            this (rad): a scratch solve that converges in 30 of its 150 iterations (or stalls
+            against a limit) costs a fifth. None runs every iteration (the live solver).
     """
 
-    def __init__(self, iterations: int = 2, dt: float = 0.05, avoid_arm_collisions: bool = True) -> None:
+    def __init__(self, iterations: int = 2, dt: float = 0.05, avoid_arm_collisions: bool = True,
+                 converged_step: float | None = None) -> None:
         self.model = build_robot_model()
         self.configuration = mink.Configuration(self.model)
         self.iterations = iterations
+        self.converged_step = converged_step
         self.dt = dt
         self.tasks = {
             arm: mink.FrameTask(frame_name=f"{arm}_tcp", frame_type="site", position_cost=1.0, orientation_cost=0.3, lm_damping=1e-3)
@@ -119,6 +124,8 @@ class BimanualIK:
         for _ in range(self.iterations):
             velocity = mink.solve_ik(self.configuration, tasks, self.dt, solver="daqp", damping=1e-4, limits=limits)
             self.configuration.integrate_inplace(velocity, self.dt)
+            if self.converged_step is not None and float(np.max(np.abs(velocity))) * self.dt < self.converged_step:
+                break
         if guarded and self.arm_clearance() < 0.0:
             # The linearised limit can still be stepped through when targets cross: then both
             # arms hold their last configuration rather than collide.
