@@ -111,3 +111,87 @@ class ReasonerRepairer:
             return self.reasoner.arrange(ArrangeRequest(graph=graph, scene=scene, failure=failure))
         except ReasonerError:
             return None
+
+
+#: Distance (m) of a tool from its first-observation (home) position within which the arm is home.
+HOME_TOLERANCE = 0.03
+
+
+def _distance(a, b) -> float:
+    return sum((float(x) - float(y)) ** 2 for x, y in zip(a, b, strict=True)) ** 0.5
+
+
+@dataclass
+class Replanner:
+    """Plan the rest of a task from a mid-task observation: the re-planning baselines' planner.
+
+    The same composer, arranger and conductor as the first plan, asked again with the
+    current observation (something held, something fallen) and the goal predicates not yet
+    achieved. What is achieved is told, not guessed: event predicates (a pour, a handover)
+    that happened are dropped, as a re-planning LLM would read them from its history; a
+    "put it down" with no place becomes "put it down where it was first seen". Destinations
+    already reached are read from the observation by the planner itself.
+
+    Attributes:
+        reasoner_kind: ``rules`` or ``llm``.
+        instruction: The task's instruction.
+        goal: The goal spec the instruction states (grounded on the first observation).
+        first: The first observation.
+        regions: The task's named regions.
+        task: The task's name.
+        llm_options: Options for an LLM reasoner.
+    """
+
+    reasoner_kind: str
+    instruction: str
+    goal: GoalSpec
+    first: Scene
+    regions: list[Region] = field(default_factory=list)
+    task: str = ""
+    llm_options: dict = field(default_factory=dict)
+
+    def remaining(self, achieved: set[int]) -> GoalSpec | None:
+        """The goal spec left once the goals at indices ``achieved`` happened (None: nothing left)."""
+        from agentchord.agents.rules.goals import Placed  # noqa: PLC0415
+
+        seen = {o.name: o for o in self.first.objects}
+        goals = []
+        for index, goal in enumerate(self.goal.goals):
+            if index in achieved:
+                continue
+            if isinstance(goal, Placed) and goal.region is None and goal.at is None and goal.relative_to is None and goal.obj in seen:
+                x, y = seen[goal.obj].pos[:2]
+                goal = goal.model_copy(update={"at": (round(float(x), 4), round(float(y), 4))})
+            goals.append(goal)
+        if not goals:
+            return None
+        return GoalSpec(goals=goals, home=self.goal.home)
+
+    def __call__(self, frame: FeatureFrame, achieved: set[int], descriptions: dict[str, str] | None = None) -> PlanResult | None:
+        """The plan from ``frame`` for what is left (None when nothing is left).
+
+        Raises:
+            ReasonerError: No plan reaches what is left from here (the message says why).
+        """
+        remaining = self.remaining(achieved)
+        if remaining is None:
+            return None
+        done = [g.model_dump(mode="json") for i, g in enumerate(self.goal.goals) if i in achieved]
+        notes = ("Re-plan from this observation, taken in the middle of the task. Already achieved: "
+                 f"{done}. Still to achieve, in order: {remaining.model_dump(mode='json')['goals']}.")
+        scene = Scene.from_frame(frame, descriptions=descriptions, regions=self.regions, notes=notes)
+        # Both arms were home at the first observation: an arm more than 3 cm from there is not.
+        homes = {arm.name: arm.ee for arm in self.first.arms}
+        scene = scene.model_copy(update={"arms": [
+            arm.model_copy(update={"home": arm.name not in homes or _distance(arm.ee, homes[arm.name]) < HOME_TOLERANCE})
+            for arm in scene.arms]})
+        if self.reasoner_kind == "rules":
+            from agentchord.agents.rules import skills  # noqa: PLC0415
+
+            state = skills.initial_state(scene, remaining)
+            if skills.goal_facts(remaining, scene)[-1] <= state:
+                return None  # what is left already holds in this observation
+            reasoner = make_reasoner("rules", goal=remaining)
+        else:
+            reasoner = make_reasoner(self.reasoner_kind, **self.llm_options)
+        return plan_task(self.instruction, scene, reasoner, task=self.task)

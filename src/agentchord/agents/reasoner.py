@@ -79,6 +79,8 @@ class ArmState(_Model):
         width: Gripper opening (m).
         closed: Whether the gripper is commanded closed.
         holding: Name of the object in the gripper, if any.
+        home: Whether the arm is at its home pose (false in an observation taken mid-task
+            with the arm elsewhere: a plan that ends at home sends it back).
     """
 
     name: str
@@ -86,6 +88,7 @@ class ArmState(_Model):
     width: float = 0.0
     closed: bool = False
     holding: str | None = None
+    home: bool = True
 
 
 class Region(_Model):

@@ -6,11 +6,15 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from agentchord.agents.observe import observe, task_regions
-from agentchord.agents.pipeline import ReasonerRepairer, make_reasoner, plan_task
+from agentchord.agents.pipeline import ReasonerRepairer, Replanner, make_reasoner, plan_task
+from agentchord.agents.reasoner import Scene
 from agentchord.agents.rules.goals import GoalSpec
+from agentchord.execution.baselines.progress import GoalEvents
+from agentchord.execution.baselines.strategies import BaselineContext
 from agentchord.execution.executor import EpisodeResult, Executor, ExecutorConfig
+from agentchord.execution.methods import is_baseline, make_method
+from agentchord.execution.reasoning import ReasoningConfig
 from agentchord.execution.repair import Repairer
-from agentchord.execution.strategies import make_strategy
 from agentchord.graph.grounding import require_runnable
 from agentchord.graph.models import TaskGraph
 from agentchord.tasks import load_task_graph
@@ -27,7 +31,8 @@ class EpisodeSpec:
 
     Attributes:
         task: Simulated task name.
-        strategy: ``agentchord`` or ``agentchord-bt``.
+        strategy: A method of :data:`~agentchord.execution.methods.METHODS`: ``agentchord``,
+            ``agentchord-bt`` or a baseline (``inner-monologue``, ``doremi``, ``rekep``, ``code-as-monitor``).
         p: Drop probability per atomic action.
         seed: Seeds the scene (object instances, poses) and the disturbance schedule.
         graph: The graph to run; None = the task library's graph.
@@ -43,6 +48,8 @@ class EpisodeSpec:
         goal: Plan from this goal spec instead of reading ``instruction``.
         reasoner: ``rules`` (offline) or ``llm``.
         repair: Online repair through the reasoner; None = on when the graph is planned.
+        reasoning: The latency model and the simulated VQA (None: no reasoning charged for
+            AgentChord's strategies, the defaults for the baselines).
         world: The address of a world served by another process (``tcp://host:port``, see
             ``agentchord serve``); None: the simulator in this process. Same seed, same episode.
     """
@@ -62,6 +69,7 @@ class EpisodeSpec:
     goal: GoalSpec | None = None
     reasoner: str = "rules"
     repair: bool | None = None
+    reasoning: ReasoningConfig | None = None
     world: str | None = None
 
     @property
@@ -100,11 +108,15 @@ def _run_in(world: World, spec: EpisodeSpec, on_tick: Callable[[Executor], None]
     task = SIM_TASKS[spec.task]
     repairer = spec.repairer
     calls = []
+    first_scene: Scene | None = None
+    goal_spec: GoalSpec | None = spec.goal
     if spec.planned:
         regions = task_regions(task)
         reasoner = make_reasoner(spec.reasoner, goal=spec.goal, watch_visibility=spec.perception == "rgbd")
-        planned = plan_task(spec.instruction or "", observe(world, regions, spec.perception), reasoner, task=spec.task)
+        first_scene = observe(world, regions, spec.perception)
+        planned = plan_task(spec.instruction or "", first_scene, reasoner, task=spec.task)
         graph, calls = planned.graph, planned.calls
+        goal_spec = goal_spec or getattr(reasoner, "last_goal", None)
         tracker = task.success_tracker()
         if hasattr(tracker, "expect"):  # a task judged by the goal it was planned for
             goal = spec.goal or getattr(reasoner, "last_goal", None)
@@ -119,10 +131,14 @@ def _run_in(world: World, spec: EpisodeSpec, on_tick: Callable[[Executor], None]
     # A graph that fails `graph check` or names objects this scene lacks is refused before the first tick.
     source = "planned graph" if spec.planned else "graph" if spec.graph is not None else f"{spec.task} library graph"
     require_runnable(graph, [*world.object_names, *world.cloth_point_names], spec.task, source)
+    context = None
+    if is_baseline(spec.strategy):
+        context = _baseline_context(spec, task, world, graph, first_scene, goal_spec)
+    strategy = make_method(spec.strategy, spec.reasoning, context, tuple(calls))
     executor = Executor(
         graph=graph,
         world=world,
-        strategy=make_strategy(spec.strategy),
+        strategy=strategy,
         tracker=tracker,
         disturbance=spec.make_disturbance(),
         config=spec.config,
@@ -136,3 +152,26 @@ def _run_in(world: World, spec: EpisodeSpec, on_tick: Callable[[Executor], None]
     # The agents' calls came before the first tick: they open the trace.
     result.trace.events[:0] = [{"tick": 0, "event": "reasoner_call", **call.to_trace_event()} for call in calls]
     return result
+
+
+def _baseline_context(spec: EpisodeSpec, task, world: World, graph: TaskGraph, first: Scene | None,
+                      goal: GoalSpec | None) -> BaselineContext:
+    """A baseline's re-planner (the project's agents, from the current observation) and progress watcher."""
+    from agentchord.agents.exceptions import ReasonerError  # noqa: PLC0415
+    from agentchord.agents.rules.instructions import ground_instruction  # noqa: PLC0415
+
+    regions = task_regions(task)
+    if first is None:
+        first = observe(world, regions, spec.perception)
+    instruction = spec.instruction or graph.instruction
+    if goal is None:
+        try:
+            goal = ground_instruction(instruction, first)
+        except ReasonerError:
+            goal = None
+    descriptions = {o.name: o.description for o in first.objects}
+    if goal is None:  # nothing the re-planner can read: the baseline cannot re-plan
+        return BaselineContext(seed=spec.seed, descriptions=descriptions)
+    replanner = Replanner(spec.reasoner, instruction, goal, first, regions, spec.task)
+    events = GoalEvents(goal, [*world.object_names, *world.cloth_point_names])
+    return BaselineContext(seed=spec.seed, replanner=replanner, events=events, descriptions=descriptions)

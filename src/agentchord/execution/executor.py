@@ -111,6 +111,21 @@ class EpisodeResult:
     reaction_latency_ticks: list[int]
     disturbances: dict[str, list[int]]
     trace: Trace = field(repr=False)
+    #: Measured wall time of the planner's own work during the episode (re-plans, repairs).
+    compute_s: float = 0.0
+    #: Reasoning latency charged: modelled per call offline, measured for a real LLM.
+    reasoning_s: float = 0.0
+    #: Reasoning calls by kind (``plan``, ``vqa``, ``vlm``).
+    reasoning_calls: dict[str, int] = field(default_factory=dict)
+    #: Seconds from each detected disturbance to the start of its recovery, reasoning included.
+    reaction_latency_s: list[float] = field(default_factory=list)
+    #: Re-plans made (the re-planning baselines).
+    replans: int = 0
+
+    @property
+    def exec_time_s(self) -> float:
+        """Execution time: robot time + measured compute + reasoning latency (DESIGN section 6)."""
+        return self.time_s + self.compute_s + self.reasoning_s
 
     @property
     def unrecoverable(self) -> bool:
@@ -132,6 +147,13 @@ class EpisodeResult:
             "drops_detected": self.drops_detected,
             "drops_recovered": self.drops_recovered,
             "reaction_latency_ticks": self.reaction_latency_ticks,
+            "reaction_latency_s": [round(x, 3) for x in self.reaction_latency_s],
+            "exec_time_s": round(self.exec_time_s, 3),
+            "robot_time_s": round(self.time_s, 3),
+            "compute_s": round(self.compute_s, 3),
+            "reasoning_s": round(self.reasoning_s, 3),
+            "reasoning_calls": dict(self.reasoning_calls),
+            "replans": self.replans,
             "disturbances": self.disturbances,
             "unrecoverable": self.unrecoverable,
             "path": self.path,
@@ -204,6 +226,13 @@ class Executor:
         self._unmerged: list[DisturbanceEvent] = []
         # (edge, target) pairs a repair was attempted for: one attempt each.
         self._repair_attempts: set[tuple[str, str]] = set()
+        # Reasoning charged so far (see charge()), and at the last disturbance (for reaction seconds).
+        self.reasoning_s = 0.0
+        self.compute_s = 0.0
+        self.reasoning_calls: dict[str, int] = {}
+        self.replans = 0
+        self._reasoning_at_disturbance = 0.0
+        self._reaction_s: list[float] = []
 
     def _compile(self, graph: TaskGraph) -> None:
         """Adopt a (filtered) graph: compile what the tick loop evaluates.
@@ -218,6 +247,27 @@ class Executor:
         self.constraints = {node.id: [compile_expr(c, vocabulary) for c in node.constraints] for node in graph.nodes}
         self.recovery_map = RecoveryMap(graph)
         self.nominal_next = {graph.edge(e).source: e for e in nominal_path(graph)}
+
+    def adopt(self, graph: TaskGraph) -> None:
+        """Run a re-planned graph from now on (the re-planning baselines): compiled like the first.
+
+        The episode's bookkeeping (trace, path, counts) carries on; the new graph starts at
+        its start node, which is where the robot is now.
+        """
+        filtered = forward_filter(graph)
+        for removed in filtered.removed:
+            self.trace.add(self.world.tick, "branch_removed", failure=removed.failure, edge=removed.edge, reason=removed.reason)
+        self._compile(filtered.graph)
+        self.node = self.graph.start
+        self.replans += 1
+
+    def charge(self, kind: str, agent: str, latency_s: float, measured: bool = False, compute_s: float = 0.0) -> None:
+        """Charge one reasoning call: its latency (modelled or measured) and any compute it measured here."""
+        self.reasoning_s += latency_s
+        self.compute_s += compute_s
+        self.reasoning_calls[kind] = self.reasoning_calls.get(kind, 0) + 1
+        self.trace.add(self.world.tick, "reasoning", kind=kind, agent=agent, latency_s=round(latency_s, 4),
+                       measured=measured, compute_s=round(compute_s, 4))
 
     # ------------------------------------------------------------- queries
     @property
@@ -244,6 +294,7 @@ class Executor:
         """Execute until the goal, a failure or a budget ends the episode."""
         wall0 = time.perf_counter()
         self.trace.add(self.world.tick, "episode_start", task=self.graph.task, strategy=self.strategy.name, start=self.graph.start)
+        self.strategy.begin(self)
         outcome = self._arrive(self.graph.start)
         while outcome is None:
             outcome = self._tick()
@@ -266,6 +317,11 @@ class Executor:
                           for kind in sorted({e.kind for e in injected})},
             reaction_latency_ticks=self._latencies,
             trace=self.trace,
+            compute_s=self.compute_s,
+            reasoning_s=self.reasoning_s,
+            reasoning_calls=dict(sorted(self.reasoning_calls.items())),
+            reaction_latency_s=self._reaction_s,
+            replans=self.replans,
         )
         self.trace.add(self.world.tick, "episode_end", success=success, reason=reason, steps=result.steps)
         close = getattr(self.extractor, "close", None)
@@ -280,6 +336,7 @@ class Executor:
             event = self.disturbance.apply(self.world, frame)
             if event is not None:
                 self._open_disturbance = event
+                self._reasoning_at_disturbance = self.reasoning_s
                 self.trace.add(event.tick, "disturbance", kind=event.kind, arm=event.arm, obj=event.obj, action=event.action)
         if self.world.tick >= self.config.tick_limit:
             return False, f"tick limit {self.config.tick_limit} reached at {self._where()}"
@@ -298,8 +355,21 @@ class Executor:
                 if outcome is not None:
                     return outcome
         if self.program is not None:
+            # The strategy's own detection (VQA queries, path-constraint checks), if it has one.
+            detection = self.strategy.watch(self, frame)
+            if detection is not None:
+                outcome = self._on_failure(detection)
+                if outcome is not None:
+                    return outcome
+        if self.program is not None:
             status = self.program.update(self.robot)
             if status == Status.FAILURE:
+                detection = None if self._fallbacks else self.strategy.on_program_failure(self, self.program)
+                if detection is not None:
+                    # The skill reported failure: a strategy that re-plans takes it as a detected failure.
+                    self.trace.add(self.world.tick, "action_failed", edge=self.program.edge_id, reason=self.program.failure_reason)
+                    self.program = None
+                    return self._on_failure(detection)
                 if self._fallbacks:
                     # The bound recovery could not be carried out (a grasp out of reach after all):
                     # the next candidate is bound from where the robot is now.
@@ -409,7 +479,7 @@ class Executor:
         next_edge = self.strategy.next_edge(self, node_id)
         if next_edge is None:
             return False, f"no edge leaves node {node_id} toward the goal"
-        if merging and not held:
+        if merging and not held and self.strategy.uses_monitors:
             detection = self._watched_violation(node_id, next_edge)
             if detection is not None:
                 return self._on_failure(detection)
@@ -446,7 +516,7 @@ class Executor:
         program.on_action_end = self._action_ended
         # Only the active edge's own monitors are armed. A failure during a recovery edge
         # without monitors shows at its merge node: the next edge's monitors catch it.
-        edge_monitors = self.monitors.get(program.edge_id)
+        edge_monitors = self.monitors.get(program.edge_id) if self.strategy.uses_monitors else None
         self.armed = edge_monitors if edge_monitors is not None and edge_monitors.monitors else None
         if self.armed is not None:
             self.armed.reset()
@@ -459,6 +529,10 @@ class Executor:
         program = self.program
         self.trace.add(self.world.tick, "edge_end", edge=program.edge_id)
         self.program = None
+        # The strategy's check at a sub-goal's completion (a VQA success query), if it has one.
+        detection = self.strategy.at_subgoal(self, program)
+        if detection is not None:
+            return self._on_failure(detection)
         detection = self._repair(program)
         if detection is not None:
             return self._on_failure(detection)
@@ -478,7 +552,8 @@ class Executor:
         self.fire_counts[key] = self.fire_counts.get(key, 0) + 1
         self.trace.add(detection.tick, "failure_detected", edge=detection.edge_id, failure=detection.failure.name,
                        onset_tick=detection.onset_tick, value=detection.value, count=self.fire_counts[key])
-        if self._open_disturbance is not None:
+        disturbance = self._open_disturbance
+        if disturbance is not None:
             # The first detection after a disturbance is its detection.
             self._detected.append(self._open_disturbance)
             self._latencies.append(detection.tick - self._open_disturbance.tick)
@@ -494,6 +569,9 @@ class Executor:
         if not candidates:
             return False, f"no recovery for {detection.failure.name} on {detection.edge_id}"
         self.recovering_from = failed_nominal
+        if disturbance is not None:
+            # Seconds from the disturbance to this switch: robot time plus the reasoning charged since.
+            self._reaction_s.append((self.world.tick - disturbance.tick) / CONTROL_HZ + self.reasoning_s - self._reasoning_at_disturbance)
         self.trace.add(self.world.tick, "recovery_switch", failure=detection.failure.name, edge=detection.edge_id,
                        to=candidates[0].edge_id, alternatives=[c.edge_id for c in candidates[1:]],
                        strategy=self.strategy.name, latency_ticks=self.world.tick - detection.onset_tick)

@@ -11,16 +11,49 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from agentchord.execution.edge_program import EdgeProgram, ReturnToKeyframe
+from agentchord.execution.reasoning import ReasoningConfig, charge_calls
 
 if TYPE_CHECKING:
     from agentchord.execution.context import ExecutionContext as Executor  # the executor as a strategy sees it
+    from agentchord.features.frame import FeatureFrame
     from agentchord.monitor import Detection
 
 
 class RecoveryStrategy:
-    """Base: follow the nominal path; subclasses decide how to recover."""
+    """Base: follow the nominal path; subclasses decide how to recover.
+
+    Detection is the compiled monitors of the active edge when ``uses_monitors``; a strategy
+    may add its own (``watch`` every tick of motion, ``at_subgoal`` when an edge ends) and
+    take a skill's reported failure as a detection (``on_program_failure``).
+    """
 
     name = "base"
+    #: Whether the active edge's compiled monitors are armed (the baselines that ask a VQA model do not).
+    uses_monitors = True
+    #: The latency model; None charges no reasoning (``run``, ``demo``: robot time only).
+    reasoning: ReasoningConfig | None = None
+    #: The reasoner calls that planned this episode's graph (none: a library graph, modelled).
+    planned_calls: tuple = ()
+    #: Calls that made the graph before the first tick: agent -> call kind. AgentChord's three
+    #: agents each answer once (composer, arranger, conductor).
+    begin_roles: dict[str, str] = {"composer": "plan", "arranger": "plan", "conductor": "plan"}
+
+    def begin(self, executor: Executor) -> None:
+        """Called once before the first tick: charge the reasoning that made the plan."""
+        if self.reasoning is not None:
+            charge_calls(executor, self.reasoning, self.begin_roles, self.planned_calls)
+
+    def watch(self, executor: Executor, frame: FeatureFrame) -> Detection | None:
+        """A failure this strategy detects at this tick of an edge program (None: nothing)."""
+        return None
+
+    def at_subgoal(self, executor: Executor, program: EdgeProgram) -> Detection | None:
+        """A failure this strategy detects when ``program`` has just ended (None: go on)."""
+        return None
+
+    def on_program_failure(self, executor: Executor, program: EdgeProgram) -> Detection | None:
+        """A skill reported failure: a detection to recover from, or None to end the episode."""
+        return None
 
     def next_edge(self, executor: Executor, node_id: str) -> str | None:
         """The nominal edge to run from a nominal node."""

@@ -41,7 +41,7 @@ def compose(goal: GoalSpec, scene: Scene, task: str = "", instruction: str = "")
         PlanningError: A goal cannot be reached with the scene's skills.
     """
     operators = skills.ground(scene, goal)
-    state = skills.initial_state(scene)
+    state = skills.initial_state(scene, goal)
     initial = state
     ops: list[Operator] = []
     states = [state]

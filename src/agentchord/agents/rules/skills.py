@@ -45,23 +45,95 @@ def _r(values: Iterable[float]) -> list[float]:
     return [round(float(v), 4) for v in values]
 
 
-def initial_state(scene: Scene) -> frozenset[Fact]:
-    """The facts of the first observation."""
+def initial_state(scene: Scene, goal: GoalSpec | None = None) -> frozenset[Fact]:
+    """The facts of an observation: the first one, or one taken mid-task (a re-plan).
+
+    A held object that must stay upright is upright in the hand (``tilted`` for its arm
+    when it is held tipped, as in the middle of a pour). With ``goal``, a destination the
+    goal asks for that already holds in the scene (an object released at its place, a
+    cloth corner laid on its partner) is a fact, so a re-plan does not do it again.
+    """
     facts: set[Fact] = set()
+    objects = {o.name: o for o in scene.objects}
     held = {arm.holding: arm.name for arm in scene.arms if arm.holding}
     for arm in ARMS:
         holder = next((a for a in scene.arms if a.name == arm), None)
         if holder is not None and holder.holding:
             facts.add(("holding", arm, holder.holding))
+            obj = objects.get(holder.holding)
+            if obj is not None and kb.keeps_upright(obj):
+                facts.add(("upright", obj.name))
+                if obj.axis[2] < HELD_TILTED_Z:
+                    facts.add(("tilted", arm))
         else:
-            facts |= {("free", arm), ("home", arm)}
+            facts.add(("free", arm))
+            if holder is None or holder.home:
+                facts.add(("home", arm))
     for obj in scene.objects:
         if obj.name in held:
             continue
         facts.add(("on_table", obj.name))
         if kb.keeps_upright(obj):
             facts.add(("upright", obj.name) if obj.axis[2] > 0.8 else ("fallen", obj.name))
+    if goal is not None:
+        for name, key in _destinations(goal):
+            if name not in held and _already_at(name, key, objects, scene):
+                facts.add(("at", name, key))
     return frozenset(facts)
+
+
+#: Axis height (cos 45 deg) under which a held upright object counts as tipped in the hand.
+HELD_TILTED_Z = 0.707
+
+
+def _destinations(goal: GoalSpec) -> list[tuple[str, str]]:
+    out: list[tuple[str, str]] = []
+    for g in goal.goals:
+        if isinstance(g, Placed):
+            out.append((g.obj, placed_key(g)))
+        elif isinstance(g, Inside):
+            out.append((g.obj, f"in:{g.container}"))
+        elif isinstance(g, On):
+            out.append((g.obj, f"on:{g.support}"))
+        elif isinstance(g, Folded):
+            out += [(f"{g.cloth}_bl", f"fold:{g.cloth}_tl"), (f"{g.cloth}_br", f"fold:{g.cloth}_tr")]
+    return out
+
+
+def _already_at(name: str, key: str, objects: dict[str, SceneObject], scene: Scene) -> bool:
+    """Whether a released object already rests at a destination (the tolerances of :func:`fact_constraints`)."""
+    obj = objects.get(name)
+    if obj is None:
+        return False
+    kind, _, rest = key.partition(":")
+    parts = rest.split(":")
+
+    def xy_dist(x: float, y: float) -> float:
+        return float(((obj.pos[0] - x) ** 2 + (obj.pos[1] - y) ** 2) ** 0.5)
+
+    upright = not kb.keeps_upright(obj) or obj.axis[2] >= UPRIGHT_PLACED_Z
+    if kind == "fold":
+        far = objects.get(parts[0])
+        return far is not None and sum((a - b) ** 2 for a, b in zip(obj.pos, far.pos, strict=True)) ** 0.5 <= 0.045
+    if kind == "region":
+        region = next((r for r in scene.regions if r.name == parts[0]), None)
+        return region is not None and upright and xy_dist(*region.center) <= region.radius
+    if kind == "xy":
+        return upright and xy_dist(float(parts[0]), float(parts[1])) <= 0.03
+    if kind == "rel":
+        anchor = objects.get(parts[0])
+        return anchor is not None and upright and xy_dist(anchor.pos[0] + float(parts[1]), anchor.pos[1] + float(parts[2])) <= 0.03
+    if kind in ("in", "on"):
+        host = objects.get(parts[0])
+        if host is None or xy_dist(host.pos[0], host.pos[1]) > 0.5 * min(host.extent[0], host.extent[1]):
+            return False
+        rim = host.pos[2] + 0.5 * host.extent[2]
+        return obj.pos[2] < rim if kind == "in" else obj.pos[2] > rim
+    return False  # "spot": where it was taken from is not in an observation
+
+
+#: Axis height (cos 10 deg) of an object placed upright.
+UPRIGHT_PLACED_Z = 0.985
 
 
 def goal_facts(goal: GoalSpec, scene: Scene) -> list[frozenset[Fact]]:
@@ -134,6 +206,16 @@ def ground(scene: Scene, goal: GoalSpec) -> list[Operator]:
             ops += _pour_ops(g)
         if isinstance(g, HandedOver):
             ops += _handover_ops(g)
+    levelled = {op.arms[0] for op in ops if op.name.startswith("untilt(")}
+    for arm in sorted(set(ARMS) - levelled):
+        # An object seen tipped in the hand (a re-plan in the middle of a pour) is levelled first.
+        ops.append(
+            Operator(
+                name=f"untilt({arm})", arms=(arm,), objects=(), pre=frozenset({("tilted", arm)}),
+                add=frozenset(), delete=frozenset({("tilted", arm)}), cost=80,
+                steps=({arm: _call("rotate_eef", angle=-kb.POUR_TILT)},), semantic="The held object upright again.", skill="pour",
+            )
+        )
     for arm in ARMS:
         ops.append(
             Operator(
@@ -166,7 +248,7 @@ def _one_arm_ops(
             delete=frozenset({("free", arm), ("home", arm), ("on_table", name), ("at", name, "*"), ("fallen", name), ("pour_ready", "*", "*", name)}),
             cost=190 + reach,
             # The giver of a handover holds the object high: the receiver takes it low.
-            steps=({arm: _call("grasp", **kb.grasp_args(obj), **({"height": kb.HANDOVER_GIVER_HEIGHT} if handed else {}))},),
+            steps=({arm: _call("grasp", **_grasp_args(obj), **({"height": kb.HANDOVER_GIVER_HEIGHT} if handed else {}))},),
             semantic=f"{arm.capitalize()} gripper holds the {name}.", skill="grasp",
         )
     ]
@@ -194,6 +276,15 @@ def _one_arm_ops(
             )
         )
     return ops
+
+
+def _grasp_args(obj: SceneObject) -> dict:
+    """A one-arm grasp's arguments; a tall object seen fallen is set upright and taken again from
+    its side (``reseat``): the nominal hold a pour or an upright place needs, not the fallen-object hold."""
+    args = kb.grasp_args(obj)
+    if kb.is_tall(obj) and obj.axis[2] <= 0.8 and args.get("mode", "auto") != "top":
+        args["reseat"] = True
+    return args
 
 
 def _where(key: str) -> str:
