@@ -16,6 +16,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 
 from agentchord import __version__
 from agentchord.cli_support import BadInput, FiniteFloatRange, GuardedGroup, check_outputs
+from agentchord.cli_bench import bench_command
 from agentchord.cli_graph import graph_group, import_release_command, schema_command
 from agentchord.guard.outputs import atomic_write_text, finite_json
 
@@ -75,6 +76,7 @@ def main() -> None:
 main.add_command(schema_command)
 main.add_command(graph_group)
 main.add_command(import_release_command)
+main.add_command(bench_command)
 
 
 @main.command()

@@ -89,6 +89,8 @@ class BacktrackStrategy(RecoveryStrategy):
     """
 
     name = "agentchord-bt"
+    #: The same graph, monitors and compilation without recovery branches: no arranger call.
+    begin_roles = {"composer": "plan", "conductor": "plan"}
 
     def recover(self, executor: Executor, detection: Detection) -> list[EdgeProgram]:
         for node_id in reversed(executor.visited_nominal):

@@ -1,0 +1,144 @@
+"""A benchmark sweep: tasks x methods x conditions x seeds, one record per episode.
+
+A condition is either a drop probability (``p=0.05``, the paper's Table I) or a disturbance
+protocol (``protocol=real``, Table II). Every episode of a sweep is named by its key
+``task|method|condition|seed``; records are written under that key, so a sweep that is
+run again skips what it already has (:mod:`agentchord.bench.store`).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+from agentchord.execution.episode import EpisodeSpec, run_episode
+from agentchord.execution.reasoning import LatencyModel, ReasoningConfig
+
+#: Version of the record layout (a record names it; a reader refuses another).
+RECORD_VERSION = 1
+
+
+@dataclass(frozen=True)
+class Condition:
+    """How an episode is disturbed: random drops with probability ``p``, or a protocol preset.
+
+    Attributes:
+        p: Drop probability per atomic action (ignored under a protocol).
+        protocol: ``real`` or ``stress`` (1-2 disturbances per trial), or None.
+    """
+
+    p: float = 0.0
+    protocol: str | None = None
+
+    @property
+    def label(self) -> str:
+        """``p=0.05`` or ``protocol=real``: the condition part of a record's key."""
+        return f"protocol={self.protocol}" if self.protocol else f"p={self.p:g}"
+
+    @classmethod
+    def from_label(cls, label: str) -> Condition:
+        """The condition a label names (the inverse of :attr:`label`)."""
+        kind, _, value = label.partition("=")
+        return cls(protocol=value) if kind == "protocol" else cls(p=float(value))
+
+
+@dataclass(frozen=True)
+class EpisodeKey:
+    """One episode of a sweep."""
+
+    task: str
+    method: str
+    condition: Condition
+    seed: int
+
+    @property
+    def id(self) -> str:
+        """``task|method|condition|seed``: unique within a sweep."""
+        return f"{self.task}|{self.method}|{self.condition.label}|{self.seed}"
+
+
+@dataclass(frozen=True)
+class SweepConfig:
+    """What a sweep's records depend on besides their keys: a resumed sweep must match it.
+
+    Attributes:
+        reasoning: The latency model, the simulated VQA's error rates, DoReMi's period.
+        perception: ``oracle`` or ``rgbd`` features.
+    """
+
+    reasoning: ReasoningConfig = field(default_factory=ReasoningConfig)
+    perception: str = "oracle"
+
+    def to_dict(self) -> dict:
+        """JSON-ready (the sweep's manifest)."""
+        return {"record_version": RECORD_VERSION, "reasoning": self.reasoning.to_dict(), "perception": self.perception}
+
+    @classmethod
+    def from_dict(cls, data: dict) -> SweepConfig:
+        """The config a manifest holds."""
+        reasoning = dict(data["reasoning"])
+        reasoning["latency"] = LatencyModel(**reasoning["latency"])
+        return cls(reasoning=ReasoningConfig(**reasoning), perception=data["perception"])
+
+
+def sweep_keys(tasks: list[str], methods: list[str], conditions: list[Condition], trials: int, first_seed: int = 0) -> list[EpisodeKey]:
+    """Every episode of a sweep, seeds innermost (the same seeds for every method: paired)."""
+    return [
+        EpisodeKey(task, method, condition, seed)
+        for condition in conditions for task in tasks for method in methods
+        for seed in range(first_seed, first_seed + trials)
+    ]
+
+
+def episode_spec(key: EpisodeKey, config: SweepConfig) -> EpisodeSpec:
+    """The episode a key names, under the sweep's config."""
+    from agentchord.worlds.sim.disturbances import PRESETS  # noqa: PLC0415
+
+    condition = key.condition
+    disturb = PRESETS[condition.protocol] if condition.protocol else ("drop",)
+    return EpisodeSpec(
+        task=key.task, strategy=key.method, p=condition.p, seed=key.seed, disturb=disturb,
+        protocol=condition.protocol is not None, perception=config.perception, reasoning=config.reasoning,
+    )
+
+
+def run_record(key: EpisodeKey, config: SweepConfig) -> dict:
+    """Run one episode and return its record (DESIGN section 7's metrics and the reasoning calls)."""
+    started = time.perf_counter()
+    result = run_episode(episode_spec(key, config))
+    summary = result.summary()
+    injected = sum(counts[0] for counts in summary["disturbances"].values())
+    return {
+        "id": key.id,
+        "version": RECORD_VERSION,
+        "task": key.task,
+        "method": key.method,
+        "condition": key.condition.label,
+        "p": key.condition.p if key.condition.protocol is None else None,
+        "protocol": key.condition.protocol,
+        "seed": key.seed,
+        **{name: summary[name] for name in (
+            "success", "reason", "steps", "exec_time_s", "robot_time_s", "compute_s", "reasoning_s", "reasoning_calls",
+            "replans", "failures_detected", "recoveries", "drops_injected", "drops_detected", "drops_recovered",
+            "disturbances", "reaction_latency_ticks", "reaction_latency_s", "unrecoverable", "path")},
+        "disturbances_injected": injected,
+        "wall_s": round(time.perf_counter() - started, 3),
+    }
+
+
+def record_fields() -> list[str]:
+    """The fields of a record, in order (the CSV export's columns)."""
+    return [
+        "id", "version", "task", "method", "condition", "p", "protocol", "seed", "success", "reason", "steps",
+        "exec_time_s", "robot_time_s", "compute_s", "reasoning_s", "reasoning_calls", "replans", "failures_detected",
+        "recoveries", "drops_injected", "drops_detected", "drops_recovered", "disturbances", "reaction_latency_ticks",
+        "reaction_latency_s", "unrecoverable", "path", "disturbances_injected", "wall_s",
+    ]
+
+
+def describe(config: SweepConfig) -> str:
+    """One line for every table's caption: the latency model and the VQA's error rates."""
+    reasoning = config.reasoning
+    return (f"reasoning latency per call: {reasoning.latency.describe()} (modelled; see docs/results.md); "
+            f"VQA miss {reasoning.vqa_miss:g}, false alarm {reasoning.vqa_false_alarm:g}; "
+            f"DoReMi query every {reasoning.doremi_every} ticks; perception {config.perception}")
