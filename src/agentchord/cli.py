@@ -17,6 +17,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from agentchord import __version__
 from agentchord.cli_support import BadInput, FiniteFloatRange, GuardedGroup, check_outputs
 from agentchord.cli_bench import bench_command
+from agentchord.cli_data import record_command
 from agentchord.cli_graph import graph_group, import_release_command, schema_command
 from agentchord.guard.outputs import atomic_write_text, finite_json
 

@@ -1,0 +1,67 @@
+"""Colour images of the simulated scene's cameras, for observations and datasets.
+
+The simulator's own cameras (``worlds/sim/cameras``) render depth and labels for perception; a
+policy and a dataset want plain RGB frames: one ``mujoco.Renderer`` per camera here.
+"""
+
+from __future__ import annotations
+
+import atexit
+import weakref
+
+import mujoco
+import numpy as np
+
+_OPEN: weakref.WeakSet = weakref.WeakSet()
+_HOOKED = False
+
+
+def _close_open() -> None:
+    # Renderers still open at exit would be freed by their finalisers after EGL shut down.
+    for cameras in list(_OPEN):
+        cameras.close()
+
+
+def _track(cameras: RgbCameras) -> None:
+    global _HOOKED
+    if not _HOOKED:  # registered after EGL's own exit handler: runs before it
+        atexit.register(_close_open)
+        _HOOKED = True
+    _OPEN.add(cameras)
+
+
+class RgbCameras:
+    """RGB renderers for some cameras of one simulated world (close when done).
+
+    Args:
+        world: The simulated world (it has ``model`` and ``data``).
+        cameras: Camera names of its scene.
+        size: (height, width) in pixels.
+
+    Raises:
+        KeyError: A camera the scene lacks.
+    """
+
+    def __init__(self, world, cameras: tuple[str, ...], size: tuple[int, int] = (240, 320)) -> None:
+        missing = [c for c in cameras if c not in world.camera_names]
+        if missing:
+            raise KeyError(f"no camera {missing[0]!r} in the scene (cameras: {', '.join(world.camera_names)})")
+        self.world = world
+        self.cameras = tuple(cameras)
+        self.size = size
+        self._renderer = mujoco.Renderer(world.model, height=size[0], width=size[1]) if cameras else None
+        _track(self)
+
+    def render(self) -> dict[str, np.ndarray]:
+        """One (H, W, 3) uint8 image per camera of the state now."""
+        out = {}
+        for camera in self.cameras:
+            self._renderer.update_scene(self.world.data, camera=camera)
+            out[camera] = self._renderer.render().copy()
+        return out
+
+    def close(self) -> None:
+        """Free the renderer."""
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None

@@ -1,0 +1,95 @@
+"""The Gymnasium environments: registered on import, pass gymnasium's checker, same seed same episode."""
+
+from __future__ import annotations
+
+import gymnasium
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+import agentchord.gym
+from agentchord.gym.aloha import joint_action
+from agentchord.gym.env import AgentChordEnv, disturbance_kinds
+from agentchord.worlds.sim.tasks import SIM_TASKS
+
+
+def test_every_task_is_registered() -> None:
+    assert sorted(agentchord.gym.ENV_IDS.values()) == sorted(SIM_TASKS)
+    assert "agentchord/SingleArmPourWater-v0" in gymnasium.registry
+
+
+@pytest.mark.parametrize("env_id", sorted(agentchord.gym.ENV_IDS))
+def test_env_checker_passes(env_id: str) -> None:
+    env = gymnasium.make(env_id, disturb="stress")
+    try:
+        check_env(env.unwrapped, skip_render_check=True)
+    finally:
+        env.close()
+
+
+def test_env_checker_passes_with_images_and_render() -> None:
+    env = gymnasium.make("agentchord/SingleArmPourWater-v0", obs_type="pixels_state", cameras=("top", "right_wrist"),
+                         image_size=(48, 64), render_mode="rgb_array")
+    try:
+        check_env(env.unwrapped)
+        obs, _ = env.reset(seed=1)
+        assert obs["pixels"]["top"].shape == (48, 64, 3) and obs["pixels"]["top"].dtype == np.uint8
+        assert obs["pixels"]["top"].std() > 0  # not a blank image
+        assert env.render().shape == (48, 64, 3)
+    finally:
+        env.close()
+
+
+def _rollout(seed: int, steps: int, disturb=None, window=(60, 650)) -> tuple[np.ndarray, dict]:
+    env = AgentChordEnv("single_arm_pour_water", disturb=disturb, window=window)
+    obs, info = env.reset(seed=seed)
+    hold = obs["agent_pos"].copy()
+    states = []
+    for _ in range(steps):
+        obs, _, _, _, info = env.step(hold)
+        states.append(np.concatenate([obs["agent_pos"], obs["environment_state"]]))
+    env.close()
+    return np.array(states), info
+
+
+def test_same_seed_same_episode_and_scenes_differ_by_seed() -> None:
+    a, _ = _rollout(4, 30)
+    b, _ = _rollout(4, 30)
+    c, _ = _rollout(5, 30)
+    assert np.array_equal(a, b)
+    assert not np.allclose(a[:, 14:], c[:, 14:])
+
+
+def test_a_shift_disturbance_moves_an_object_at_its_seeded_moment() -> None:
+    quiet, _ = _rollout(2, 80)
+    moved, info = _rollout(2, 80, disturb="shift", window=(10, 20))
+    kinds = [e["kind"] for e in info["disturbances"]]
+    assert kinds and set(kinds) == {"shift"}  # one or two, as the protocol draws them
+    assert np.abs(moved[-1, 14:] - quiet[-1, 14:]).max() > 0.02
+
+
+def test_disturbance_kinds() -> None:
+    assert disturbance_kinds(None) == ()
+    assert disturbance_kinds("real") == ("perturb", "pull")
+    assert disturbance_kinds("drop,shift") == ("drop", "shift")
+    with pytest.raises(ValueError):
+        disturbance_kinds("teleport")
+
+
+def test_replaying_an_agentchord_episode_succeeds_in_the_env() -> None:
+    """The env's scene and physics are the episode's: its commands, replayed, succeed there too."""
+    from agentchord.execution.episode import EpisodeSpec, run_episode
+
+    actions = []
+    result = run_episode(EpisodeSpec(task="single_arm_pour_water", seed=0),
+                         on_tick=lambda ex: actions.append(joint_action(ex.world.commands)))
+    assert result.success
+    env = AgentChordEnv("single_arm_pour_water", max_steps=len(actions) + 200)
+    env.reset(seed=0)
+    terminated = False
+    for action in actions:
+        _, reward, terminated, truncated, info = env.step(action)
+        if terminated:
+            break
+    env.close()
+    assert terminated and reward == 1.0 and info["is_success"]
