@@ -1,0 +1,363 @@
+"""The grasp action: side, top and fallen grasps, the reseat of a righted object, and its failure.
+
+The action perceives through the feature frame (``robot.frame``) and starts from the
+robot's current commanded state, so a recovery edge begins wherever the failure left the arm.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from agentchord.actions import catalog
+from agentchord.actions.base import ActionFailed, ArmAction
+from agentchord.actions.controller import RobotController
+from agentchord.actions.geometry import _matrix, _wrist_margin
+from agentchord.actions.motion import (
+    approach,
+    grasp_frame,
+    grip,
+    move_joints,
+    move_to,
+    pose_from_matrix,
+    settle,
+    wait_for_rest,
+)
+from agentchord.features.frame import tilt_deg
+from agentchord.solvers.ik import PoseTarget, solve_from_scratch
+from agentchord.robot.aloha import HOME_Q
+
+#: Joint speed (rad/s, largest joint) of joint-space moves with an empty hand.
+EMPTY_HAND_JOINT_SPEED = 2.0
+#: Tilt (deg) beyond which an object counts as fallen for a side grasp.
+UPRIGHT_TOLERANCE_DEG = 25.0
+#: An object that moved more than this (m) while the tool approached it is looked at again.
+MOVED_DURING_APPROACH = 0.01
+#: A closed grasp whose grasp point is farther than this (m) from where the tool aimed is off-centre.
+OFF_CENTRE_TOLERANCE = 0.025
+
+
+class GraspMissed(ActionFailed):
+    """The fingers closed but the object is not between them."""
+
+
+class Grasp(ArmAction):
+    """Grasp an object wherever it is, then lift it; a fallen object is set upright in hand.
+
+    Side grasp (tall upright objects: bottles, cups): horizontal approach from
+    the arm's base at ``height`` of the object. Top grasp (short or flat
+    objects: blocks, capsules, cutlery): from above, fingers across the
+    object's narrow horizontal side. A fallen tall object (lying on its side)
+    is grasped from above across its middle, lifted, swung so its top points
+    away from the robot and pitched up: the action ends, like the upright case,
+    with the object held upright in a side grasp.
+    """
+
+    name = "grasp"
+    args: catalog.GraspArgs
+
+    #: Tilt (deg) beyond which the object is treated as lying on its side.
+    FALLEN_DEG = 60.0
+    #: Tilt (deg) beyond which an object leaning on something is grasped like a fallen one.
+    LEANING_AS_FALLEN_DEG = 40.0
+    #: Tries before a grasp that closes on nothing fails.
+    ATTEMPTS = 3
+    #: Objects shorter than this (m) are grasped from above in ``auto`` mode.
+    SIDE_MIN_HEIGHT = 0.08
+    #: The finger tips reach this far past the tool centre (m): keep them off the table.
+    FINGERTIP_REACH = 0.039
+    #: Side grasps tried in order where the asked one cannot be made: (share of the pre-grasp
+    #: distance, rise of the pre-grasp pose in m, grasp height as a share of the object's or
+    #: None for the asked one; a higher one is only ever taken).
+    SIDE_VARIANTS = ((1.0, 0.0, None), (1.0, 0.03, None), (0.5, 0.0, None), (0.5, 0.03, None), (0.5, 0.03, 0.8))
+
+    def script(self, robot: RobotController) -> Iterator[None]:
+        held = robot.targets[self.arm].grip_closed_settled and robot.frame.is_holding(self.arm, self.args.obj)
+        if self.args.skip_if_held and held:
+            return  # already grasped (an interrupted synchronous grasp whose other half failed)
+        for attempt in range(self.ATTEMPTS):
+            try:
+                yield from self._let_go(robot)
+                yield from wait_for_rest(robot, self.args.obj)
+                yield from self._attempt(robot)
+                return
+            except GraspMissed:
+                # The object moved as the fingers closed (a nudge, a roll): look again and retry.
+                if attempt == self.ATTEMPTS - 1:
+                    raise
+
+    def _mode(self, robot: RobotController) -> str:
+        """How the object is taken now: ``top``, ``side`` (upright or leaning a little) or ``fallen`` (lying)."""
+        feats = robot.frame.objects[self.args.obj]
+        tilt = tilt_deg(feats.axis)
+        height = float(np.linalg.norm(feats.top - feats.bottom))
+        mode = self.args.mode
+        if mode == "auto":
+            mode = "side" if height >= self.SIDE_MIN_HEIGHT else "top"
+        if mode == "top":
+            return "top"
+        # Leaning on something (pushed into another object): a little, the closing fingers stand it
+        # up; far, it is taken as if it lay there.
+        return "side" if tilt < self.LEANING_AS_FALLEN_DEG else "fallen"
+
+    def target_poses(self, robot: RobotController) -> list[PoseTarget]:
+        """The tool poses this grasp would go to from the current frame: above/before the object, then at it.
+
+        Feasibility checks (reach, IK) use them before the arm moves.
+        """
+        mode = self._mode(robot)
+        if mode == "top":
+            rotation, point = self._top_frame(robot)
+            pre = point + np.array([0.0, 0.0, self.args.pre_grasp_dis])
+        elif mode == "fallen":
+            rotation, point = self._fallen_frame(robot)
+            pre = point + np.array([0.0, 0.0, self.args.pre_grasp_dis])
+        else:
+            pre, point, rotation = self._side_plan(robot)
+        return [pose_from_matrix(pre, rotation), pose_from_matrix(point, rotation)]
+
+    def _attempt(self, robot: RobotController) -> Iterator[None]:
+        feats = robot.frame.objects[self.args.obj]
+        self._seen_at = feats.pos.copy()
+        self._taken_as = self._mode(robot)
+        self._height_fraction: float | None = None
+        self._upright_at_start = tilt_deg(feats.axis) <= UPRIGHT_TOLERANCE_DEG
+        if feats.pos[2] < -0.02:
+            raise ActionFailed(f"{self.args.obj} fell off the table")
+        mode = self._mode(robot)
+        if mode == "top":
+            yield from self._top_grasp(robot)
+        elif mode == "side":
+            yield from self._side_grasp(robot)
+        elif mode == "fallen":
+            yield from self._fallen_grasp(robot)
+            if self.args.reseat:
+                yield from self._reseat(robot)
+
+    def _reseat(self, robot: RobotController) -> Iterator[None]:
+        """Put an object just set upright in hand down on the table, go home, side-grasp it again.
+
+        The fallen grasp leaves the object off-centre in the hand and the wrist wound far from
+        its usual configuration; a fresh side grasp from home restores the nominal grasp.
+        """
+        arm = self.arm
+        feats = robot.frame.objects[self.args.obj]
+        rotation = robot.rotation(arm)
+        lowest = min(feats.bottom[2], feats.top[2])
+        down = robot.commanded_pose(arm).pos - np.array([0.0, 0.0, lowest - 0.004])
+        yield from move_to(robot, arm, pose_from_matrix(down, rotation), speed=0.12)
+        yield from settle(robot, arm, max_ticks=10)
+        yield from grip(robot, arm, 0.0, ticks=8)
+        retreat = down - 0.08 * rotation[:, 0] + np.array([0.0, 0.0, 0.04])
+        yield from move_to(robot, arm, pose_from_matrix(retreat, rotation))
+        # The hand is empty: unwind the wrist (wound far by the fallen grasp) at twice the usual speed.
+        yield from move_joints(robot, arm, HOME_Q, speed=EMPTY_HAND_JOINT_SPEED)
+        robot.set_pose(arm, robot.ik.tcp_pose(arm))
+        yield from wait_for_rest(robot, self.args.obj)
+        if tilt_deg(robot.frame.objects[self.args.obj].axis) > UPRIGHT_TOLERANCE_DEG:
+            # It fell over when set down: the retry loop grasps it again from where it lies.
+            raise GraspMissed(f"{self.args.obj} did not stay upright when set down")
+        yield from self._side_grasp(robot)
+
+    def _let_go(self, robot: RobotController) -> Iterator[None]:
+        # After a drop the object may still rest on the fingers (a rolled tool stacks them
+        # vertically): open, roll the tool back level and back off so it falls free.
+        arm = self.arm
+        if robot.targets[arm].grip > 0.0 or robot.frame.arms[arm].width < 0.05:
+            robot.set_grip(arm, 0.0)
+            approach = robot.rotation(arm)[:, 0]
+            if abs(approach[2]) > 0.9:  # a top grasp: just rise
+                rotation, back = robot.rotation(arm), np.array([0.0, 0.0, 0.06])
+            else:
+                rotation = grasp_frame(approach)
+                back = -0.12 * rotation[:, 0] + np.array([0.0, 0.0, 0.04])
+            yield from move_to(robot, arm, pose_from_matrix(robot.commanded_pose(arm).pos + back, rotation), speed=0.2)
+        robot.set_grip(arm, 0.0)
+
+    def _side_point(self, robot: RobotController, height_fraction: float | None = None) -> np.ndarray:
+        feats = robot.frame.objects[self.args.obj]
+        height = float(np.linalg.norm(feats.top - feats.bottom))
+        fraction = self.args.height if height_fraction is None else height_fraction
+        return feats.bottom + fraction * height * feats.axis + self._offset(feats)
+
+    def _side_variant(self, robot: RobotController, variant: tuple[float, float, float | None]):
+        scale, rise, fraction = variant
+        if fraction is not None:
+            fraction = max(fraction, self.args.height)
+        point = self._side_point(robot, fraction)
+        rotation = self._side_rotation(robot, point)
+        pre = point - scale * self.args.pre_grasp_dis * rotation[:, 0] + np.array([0.0, 0.0, rise])
+        return pre, point, rotation, fraction
+
+    def _side_plan(self, robot: RobotController) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The side grasp's pre-grasp point, grasp point and tool rotation, and remembers its height.
+
+        The asked one, unless the IK reaches it neither from the current configuration nor from
+        home (an object beside the arm's own base: backing off folds the elbow past its limit);
+        then the first of ``SIDE_VARIANTS`` it reaches (a shorter or higher pre-grasp, a higher
+        grasp point).
+        """
+        plans = [self._side_variant(robot, variant) for variant in self.SIDE_VARIANTS]
+        chosen = plans[0]
+        q = robot.ik.configuration.q.copy()
+        ik = robot.scratch_ik(avoid_other_arm=False)
+        for index, (pre, point, rotation, _) in enumerate(plans):
+            poses = [pose_from_matrix(pre, rotation), pose_from_matrix(point, rotation)]
+            # The asked grasp from where the arm is, every grasp from home: the same choice on every frame.
+            if solve_from_scratch(ik, q, self.arm, poses, from_current=index == 0) is not None:
+                chosen = plans[index]
+                break
+        pre, point, rotation, self._height_fraction = chosen
+        return pre, point, rotation
+
+    def _clear_from_below(self, robot: RobotController, height: float) -> Iterator[None]:
+        # Coming from low (a recovery after a drop): rise first so the fingers clear the object.
+        start = robot.commanded_pose(self.arm).pos
+        if start[2] < height:
+            yield from move_to(robot, self.arm, pose_from_matrix(np.r_[start[:2], height], robot.rotation(self.arm)))
+
+    def _close_and_check(self, robot: RobotController) -> Iterator[None]:
+        try:
+            yield from settle(robot, self.arm, max_ticks=30, required=0.015)
+        except ActionFailed:
+            # Pushed during the approach, it may now lie where this approach cannot end: look again.
+            moved = float(np.linalg.norm(robot.frame.objects[self.args.obj].pos - self._seen_at))
+            if moved > MOVED_DURING_APPROACH:
+                raise GraspMissed(f"{self.args.obj} moved {100 * moved:.1f} cm during the approach") from None
+            if robot.ik.arms_close():
+                # The collision limit held this arm back from the other one (busy beside it): try again.
+                raise GraspMissed(f"the other arm was in the way of the grasp of {self.args.obj}") from None
+            raise
+        aimed = robot.commanded_pose(self.arm).pos.copy()
+        yield from grip(robot, self.arm, 1.0)
+        if not robot.frame.is_holding(self.arm, self.args.obj):
+            raise GraspMissed(f"fingers closed but {self.args.obj} is not held")
+        # Pushed while the fingers closed, it is held off-centre (a pour or a place would then miss):
+        # where the grasp point is now, seen from where the tool aimed, says so.
+        # (Not for a fallen or leaning object: the closing fingers turn it, which is the point.)
+        upright = tilt_deg(robot.frame.objects[self.args.obj].axis) <= UPRIGHT_TOLERANCE_DEG
+        off = 0.0
+        if self._taken_as == "top":
+            off = float(np.linalg.norm(self._top_frame(robot)[1] - aimed))
+        elif self._taken_as == "side" and upright and self._upright_at_start:
+            off = float(np.linalg.norm(self._side_point(robot, self._height_fraction) - aimed))
+        if off > OFF_CENTRE_TOLERANCE:
+            raise GraspMissed(f"{self.args.obj} is held {100 * off:.1f} cm off the grasp point")
+
+    def _side_rotation(self, robot: RobotController, point: np.ndarray) -> np.ndarray:
+        """The side-grasp tool frame: approach from the arm's base, or at the yaw asked for."""
+        if self.args.yaw is None:
+            return grasp_frame(point - robot.world.arm_base(self.arm))
+        yaw = np.radians(self.args.yaw)
+        return grasp_frame(np.array([np.cos(yaw), np.sin(yaw), 0.0]))
+
+    def _side_grasp(self, robot: RobotController) -> Iterator[None]:
+        arm = self.arm
+        pre, point, rotation = self._side_plan(robot)
+        if np.linalg.norm(robot.commanded_pose(arm).pos[:2] - pre[:2]) > 0.05:
+            yield from self._clear_from_below(robot, pre[2] + 0.08)
+        yield from approach(robot, arm, pose_from_matrix(pre, rotation))
+        # Re-observe: the object may have moved while the arm approached.
+        point = self._side_point(robot, self._height_fraction)
+        yield from move_to(robot, arm, pose_from_matrix(point, rotation), speed=0.15)
+        yield from self._close_and_check(robot)
+        lift = robot.commanded_pose(arm).pos + np.array([0.0, 0.0, self.args.lift])
+        yield from move_to(robot, arm, pose_from_matrix(lift, rotation), speed=0.15)
+
+    def _top_frame(self, robot: RobotController) -> tuple[np.ndarray, np.ndarray]:
+        """Tool rotation (approach down, fingers across the narrow side) and grasp point."""
+        feats = robot.frame.objects[self.args.obj]
+        rot = _matrix(feats.quat)
+        # The object's horizontal principal direction: its axis if lying, else its longer side.
+        if tilt_deg(feats.axis) >= self.FALLEN_DEG:
+            long_dir = feats.axis
+        else:
+            long_dir = rot[:, 0] if feats.extent[0] >= feats.extent[1] else rot[:, 1]
+        long_dir = np.array([long_dir[0], long_dir[1], 0.0])
+        if np.linalg.norm(long_dir) < 1e-6:
+            long_dir = np.array([1.0, 0.0, 0.0])
+        long_dir /= np.linalg.norm(long_dir)
+        # Of the two equivalent finger orientations, take the one facing away from the arm's base.
+        outward = feats.pos - robot.world.arm_base(self.arm)
+        if np.dot(long_dir[:2], outward[:2]) < 0:
+            long_dir = -long_dir
+        current = robot.rotation(self.arm)
+        if current[2, 0] < -0.7:
+            # Already top-down (a regrasp): the orientation nearer the tool's current one, unless
+            # that would drive the wrist-rotate joint past its range.
+            def turn(direction: np.ndarray) -> float:
+                diff = np.arctan2(direction[1], direction[0]) - np.arctan2(current[1, 2], current[0, 2])
+                return float((np.degrees(diff) + 180.0) % 360.0 - 180.0)
+
+            near, far = sorted((long_dir, -long_dir), key=lambda d: abs(turn(d)))
+            keep = _wrist_margin(robot, self.arm, turn(near), feats.pos)
+            long_dir = far if keep < 0.0 and _wrist_margin(robot, self.arm, turn(far), feats.pos) > keep else near
+        down = np.array([0.0, 0.0, -1.0])
+        rotation = np.column_stack([down, np.cross(long_dir, down), long_dir])
+        lying = tilt_deg(feats.axis) >= self.FALLEN_DEG
+        top_z = feats.pos[2] + 0.5 * feats.extent[0] if lying else max(feats.top[2], feats.bottom[2])
+        height = top_z - min(feats.bottom[2], feats.top[2]) if not lying else float(feats.extent[0])
+        # Finger tips go 70% down the object (at most 3 cm), never closer than 4 mm to the table.
+        tips_z = max(top_z - min(0.7 * height, 0.03), 0.004)
+        point = np.r_[feats.pos[:2], tips_z + self.FINGERTIP_REACH]
+        return rotation, point + self._offset(feats)
+
+    def _offset(self, feats) -> np.ndarray:
+        """The grasp offset in the world frame."""
+        offset = np.asarray(self.args.offset, dtype=float)
+        return _matrix(feats.quat) @ offset if self.args.offset_frame == "object" else offset
+
+    def _top_grasp(self, robot: RobotController) -> Iterator[None]:
+        arm = self.arm
+        rotation, point = self._top_frame(robot)
+        above = point + np.array([0.0, 0.0, self.args.pre_grasp_dis])
+        yield from self._clear_from_below(robot, above[2])
+        yield from approach(robot, arm, pose_from_matrix(above, rotation))
+        # A top-down tool often flips the forearm roll: let the IK converge before descending.
+        yield from settle(robot, arm, tolerance=0.003, max_ticks=60, required=0.015)
+        rotation, point = self._top_frame(robot)
+        yield from move_to(robot, arm, pose_from_matrix(point, rotation), speed=0.08)
+        yield from self._close_and_check(robot)
+        # lift 0 leaves the object on the table (two arms grasping one tray lift it together afterwards).
+        lift_by = 0.0 if self.args.lift == 0.0 else max(self.args.lift, 0.04)
+        lift = robot.commanded_pose(arm).pos + np.array([0.0, 0.0, lift_by])
+        yield from move_to(robot, arm, pose_from_matrix(lift, rotation), speed=0.15)
+
+    def _fallen_frame(self, robot: RobotController) -> tuple[np.ndarray, np.ndarray]:
+        """Tool rotation (approach down, fingers across the lying object's axis) and grasp point."""
+        feats = robot.frame.objects[self.args.obj]
+        top_dir = np.array([feats.axis[0], feats.axis[1], 0.0])
+        top_dir /= max(np.linalg.norm(top_dir), 1e-9)
+        down = np.array([0.0, 0.0, -1.0])
+        rotation = np.column_stack([down, np.cross(top_dir, down), top_dir])
+        radius = 0.5 * float(feats.extent[0])
+        # The finger tips reach ~4 cm past the tool centre: stay high enough to miss the table.
+        return rotation, np.r_[feats.pos[:2], max(feats.pos[2] + 0.35 * radius, self.FINGERTIP_REACH + 0.006)]
+
+    def _fallen_grasp(self, robot: RobotController) -> Iterator[None]:
+        arm = self.arm
+        feats = robot.frame.objects[self.args.obj]
+        rotation, point = self._fallen_frame(robot)
+        top_dir = rotation[:, 2]
+        yield from self._clear_from_below(robot, point[2] + self.args.pre_grasp_dis + 0.05)
+        yield from approach(robot, arm, pose_from_matrix(point + np.array([0, 0, self.args.pre_grasp_dis]), rotation))
+        # A top-down tool often flips the forearm roll: let the IK converge before descending.
+        yield from settle(robot, arm, tolerance=0.003, max_ticks=60, required=0.015)
+        feats = robot.frame.objects[self.args.obj]
+        point[:2] = feats.pos[:2]
+        yield from move_to(robot, arm, pose_from_matrix(point, rotation), speed=0.08)
+        yield from self._close_and_check(robot)
+        half_length = 0.5 * float(np.linalg.norm(feats.top - feats.bottom))
+        lifted = point + np.array([0.0, 0.0, half_length + 0.06])
+        yield from move_to(robot, arm, pose_from_matrix(lifted, rotation), speed=0.15)
+        # Swing the object's top to point away from the robot, then pitch it up: the tool
+        # ends in the usual side-grasp frame with the object upright between the fingers.
+        outward = grasp_frame(lifted - robot.world.arm_base(arm))[:, 0]
+        yaw = np.arctan2(np.cross(top_dir, outward)[2], float(np.dot(top_dir, outward)))
+        swung = Rotation.from_euler("z", yaw).as_matrix() @ rotation
+        yield from move_to(robot, arm, pose_from_matrix(lifted, swung))
+        upright = swung @ Rotation.from_euler("y", -90.0, degrees=True).as_matrix()
+        yield from move_to(robot, arm, pose_from_matrix(lifted, upright), speed=0.15)
+        yield from settle(robot, arm)

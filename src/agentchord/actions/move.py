@@ -1,0 +1,125 @@
+"""Tool moves: to an object, to a target, by an offset, a roll about the approach, back home."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from agentchord.actions import catalog
+from agentchord.actions.base import ArmAction
+from agentchord.actions.controller import RobotController
+from agentchord.actions.geometry import _level
+from agentchord.actions.motion import (
+    grasp_frame,
+    move_along_solved_path,
+    move_joints,
+    move_to,
+    pose_from_matrix,
+    settle,
+    wait_for_rest,
+)
+from agentchord.solvers.obstacles import held_spheres, lift_over, scene_spheres
+from agentchord.robot.aloha import HOME_Q
+
+
+def _avoid(robot: RobotController, arm: str, exclude: tuple[str, ...]):
+    """Obstacles (every object not held and not excluded) and what ``arm`` carries, from the latest frame."""
+    frame = robot.frame
+    return scene_spheres(frame, exclude=exclude), held_spheres(frame, arm)
+
+
+class MoveToObj(ArmAction):
+    """Move the tool (and what it holds) to an offset from an object's top point, upright."""
+
+    name = "move_to_obj"
+    args: catalog.MoveToObjArgs
+
+    def script(self, robot: RobotController) -> Iterator[None]:
+        arm = self.arm
+        # A pushed target may still be sliding: aim at where it stops.
+        yield from wait_for_rest(robot, self.args.obj)
+        if self.args.keep_orientation:
+            rotation = robot.rotation(arm)
+        elif self.args.yaw is None:
+            rotation = _level(robot.rotation(arm))
+        else:
+            yaw = np.radians(self.args.yaw)
+            rotation = grasp_frame(np.array([np.cos(yaw), np.sin(yaw), 0.0]))
+        target = robot.frame.objects[self.args.obj].top + np.asarray(self.args.offset)
+        if self.args.path == "solved":
+            # The object aimed at is the goal, not an obstacle.
+            yield from move_along_solved_path(robot, arm, pose_from_matrix(target, rotation), lambda: _avoid(robot, arm, (self.args.obj,)))
+        else:
+            # Straight, unless what the arm carries would be driven through another object on the way.
+            obstacles, carried = _avoid(robot, arm, ())
+            for waypoint in lift_over(robot.commanded_pose(arm).pos, target, obstacles, carried):
+                yield from move_to(robot, arm, pose_from_matrix(waypoint, rotation))
+        # Re-aim at the object's latest position (it may have been moved).
+        target = robot.frame.objects[self.args.obj].top + np.asarray(self.args.offset)
+        yield from move_to(robot, arm, pose_from_matrix(target, rotation), speed=0.15)
+        yield from settle(robot, arm)
+
+
+class RotateEef(ArmAction):
+    """Roll the tool about its approach axis: tilt-to-pour and back to upright."""
+
+    name = "rotate_eef"
+    args: catalog.RotateEefArgs
+
+    def script(self, robot: RobotController) -> Iterator[None]:
+        arm = self.arm
+        pose = robot.commanded_pose(arm)
+        goal = robot.rotation(arm) @ Rotation.from_euler("x", self.args.angle, degrees=True).as_matrix()
+        yield from move_to(robot, arm, pose_from_matrix(pose.pos, goal))
+        yield from settle(robot, arm, max_ticks=10)
+
+
+class MoveToTarget(ArmAction):
+    """Move the tool to an absolute position (extrinsic frame), clipped to the workspace."""
+
+    name = "move_to_target"
+    args: catalog.MoveToTargetArgs
+
+    def script(self, robot: RobotController) -> Iterator[None]:
+        if self.args.yaw is None:
+            rotation = robot.rotation(self.arm)
+        else:
+            yaw = np.radians(self.args.yaw)
+            rotation = grasp_frame(np.array([np.cos(yaw), np.sin(yaw), 0.0]))
+        goal = pose_from_matrix(np.asarray(self.args.pos, dtype=float), rotation)
+        if self.args.path == "solved":
+            yield from move_along_solved_path(robot, self.arm, goal, lambda: _avoid(robot, self.arm, ()))
+        else:
+            yield from move_to(robot, self.arm, goal)
+        yield from settle(robot, self.arm)
+
+
+class MoveByOffset(ArmAction):
+    """Displace the tool: a translation and roll/pitch/yaw in the world (extrinsic) or tool (intrinsic) frame."""
+
+    name = "move_by_offset"
+    args: catalog.MoveByOffsetArgs
+
+    def script(self, robot: RobotController) -> Iterator[None]:
+        pose = robot.commanded_pose(self.arm)
+        rotation = robot.rotation(self.arm)
+        turn = Rotation.from_euler("xyz", self.args.angles, degrees=True).as_matrix()
+        offset = np.asarray(self.args.offset, dtype=float)
+        if self.args.frame == "intrinsic":
+            goal_pos, goal_rot = pose.pos + rotation @ offset, rotation @ turn
+        else:
+            goal_pos, goal_rot = pose.pos + offset, turn @ rotation
+        yield from move_to(robot, self.arm, pose_from_matrix(goal_pos, goal_rot))
+        yield from settle(robot, self.arm, max_ticks=10)
+
+
+class Back(ArmAction):
+    """Return the arm to its home configuration (joint space)."""
+
+    name = "back"
+
+    def script(self, robot: RobotController) -> Iterator[None]:
+        yield from move_joints(robot, self.arm, HOME_Q)
+        robot.set_pose(self.arm, robot.ik.tcp_pose(self.arm))

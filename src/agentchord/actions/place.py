@@ -1,0 +1,160 @@
+"""The place action: carry the held object over its spot, stand it upright in hand, lower, release, retreat."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from agentchord.actions import catalog
+from agentchord.actions.base import ActionFailed, ArmAction
+from agentchord.actions.controller import RobotController
+from agentchord.actions.geometry import _level, _matrix, _yaw_turn
+from agentchord.actions.grasp import UPRIGHT_TOLERANCE_DEG, Grasp
+from agentchord.actions.motion import grip, move_to, pose_from_matrix, settle, wait_for_rest
+from agentchord.features.frame import tilt_deg
+from agentchord.solvers.exceptions import NoHandoffSpotError
+from agentchord.solvers.handoff import handoff_spot
+from agentchord.robot.aloha import FINGER_GAP_OFFSET, FINGER_RANGE
+
+#: Largest extent (m) of a point feature (a cloth corner) rather than a body.
+POINT_EXTENT = 0.01
+#: A tall object tilted more than this in the hand (deg) is turned upright before it is put down,
+#: with its bottom at least this high (m) while it turns.
+LEVEL_IN_HAND_DEG = 4.0
+LEVEL_CLEARANCE = 0.02
+#: Finger gap beyond the object's width (m) when releasing it inside a rim.
+RELEASE_MARGIN = 0.02
+#: Height (m) by which a placed object clears the top of the object it is placed relative to.
+RIM_CLEARANCE = 0.02
+
+
+def _long_axis(feats) -> np.ndarray:
+    """An object's long horizontal direction: its axis if lying, else its longer horizontal side."""
+    if tilt_deg(feats.axis) >= Grasp.FALLEN_DEG:
+        return feats.axis
+    rot = _matrix(feats.quat)
+    return rot[:, 0] if feats.extent[0] >= feats.extent[1] else rot[:, 1]
+
+
+class Place(ArmAction):
+    """Lower the held object onto the table, release it, retreat."""
+
+    name = "place"
+    args: catalog.PlaceArgs
+
+    #: Ticks to wait before failing on an object that is not held: one dropped as the previous
+    #: action ended is then reported by the edge's drop monitor (its persistence window) instead.
+    DROP_GRACE_TICKS = 8
+
+    def script(self, robot: RobotController) -> Iterator[None]:
+        arm = self.arm
+        if not robot.frame.is_holding(arm, self.args.obj):
+            if self.args.skip_if_placed and self._standing(robot):
+                yield from self._release_and_retreat(robot)
+                return
+            for _ in range(self.DROP_GRACE_TICKS):
+                yield
+                if robot.frame.is_holding(arm, self.args.obj):
+                    break  # finger contact flickered for a tick (a tray shifting in two grips): go on
+            else:
+                raise ActionFailed(f"{self.args.obj} is not held: nothing to place")
+        if self.args.relative_to is not None and self.args.within_reach is None:
+            # A pushed reference may still be sliding: aim at where it stops.
+            yield from wait_for_rest(robot, self.args.relative_to)
+        obj = robot.frame.objects[self.args.obj]
+        tool = robot.commanded_pose(arm)
+        rotation = _level(robot.rotation(arm))
+        above = tool.pos.copy()
+        target = None if self.args.target is None else np.asarray(self.args.target, dtype=float)
+        if target is not None and self.args.relative_to is not None:
+            target = target + robot.frame.objects[self.args.relative_to].pos[:2]
+        if self.args.within_reach is not None:
+            try:
+                target = handoff_spot(robot.frame, self.args.obj, arm, self.args.within_reach)
+            except NoHandoffSpotError as error:
+                raise ActionFailed(str(error)) from None
+        if self.args.yaw is not None:
+            # Turn the tool about the vertical so the object's long axis ends at the asked yaw
+            # (either direction), keeping the object's centre where it goes.
+            goal = target if target is not None else obj.pos[:2]
+            turn = _yaw_turn(robot, arm, _long_axis(obj), self.args.yaw, goal)
+            held = obj.pos[:2] - tool.pos[:2]
+            rotation = turn @ rotation
+            above[:2] = goal - turn[:2, :2] @ held
+        elif target is not None:
+            # Put the object's centre, not the tool, over the target.
+            above[:2] += target - obj.pos[:2]
+        above[2] = max(above[2], tool.pos[2])
+        if self.args.relative_to is not None and self.args.within_reach is None:
+            # Carry the object over the reference's rim (into a cup, onto a block), not through it.
+            host_top = robot.frame.objects[self.args.relative_to].top[2]
+            above[2] = max(above[2], tool.pos[2] + host_top + RIM_CLEARANCE - obj.bottom[2])
+        yield from move_to(robot, arm, pose_from_matrix(above, rotation))
+        rotation = yield from self._upright_in_hand(robot, rotation)
+        obj = robot.frame.objects[self.args.obj]
+        drop = obj.bottom[2] - (self.args.z_offset + 0.004)
+        down = robot.commanded_pose(arm).pos - np.array([0.0, 0.0, drop])
+        yield from move_to(robot, arm, pose_from_matrix(down, rotation), speed=0.12)
+        yield from settle(robot, arm, max_ticks=10)
+        yield from grip(robot, arm, self._release_grip(robot), ticks=8)
+        # Back off along the approach (straight up after a top grasp).
+        retreat = down - 0.08 * rotation[:, 0] + np.array([0.0, 0.0, 0.04 if rotation[2, 0] > -0.7 else 0.0])
+        yield from move_to(robot, arm, pose_from_matrix(retreat, rotation))
+        if robot.targets[arm].grip > 0.0:
+            yield from grip(robot, arm, 0.0, ticks=6)  # clear of the rim: open fully for the next grasp
+
+    def _upright_in_hand(self, robot: RobotController, rotation: np.ndarray) -> Iterator[None]:
+        """Over the spot, turn a tall object held askew (an off-centre regrasp) upright before lowering it.
+
+        Released at a tilt, a tall object leans or topples. Measured where the transport ended (a weak
+        hold may slip on the way): the smallest tool rotation that makes the object's axis vertical,
+        about the object's centre, slowly, lifted clear of the table first if it hangs low. Returns the
+        tool rotation to lower with.
+        """
+        obj = robot.frame.objects[self.args.obj]
+        if obj.extent[2] <= 1.5 * max(obj.extent[0], obj.extent[1]):
+            return rotation
+        angle = tilt_deg(obj.axis)
+        if angle < LEVEL_IN_HAND_DEG or angle > UPRIGHT_TOLERANCE_DEG:
+            return rotation
+        tool = robot.commanded_pose(self.arm).pos
+        lift = max(0.0, LEVEL_CLEARANCE - float(min(obj.bottom[2], obj.top[2])))
+        fix = Rotation.align_vectors([[0.0, 0.0, 1.0]], [obj.axis])[0].as_matrix()
+        centre = obj.pos + np.array([0.0, 0.0, lift])
+        turned = fix @ rotation
+        goal = centre - fix @ (obj.pos - tool)
+        yield from move_to(robot, self.arm, pose_from_matrix(goal, turned), speed=0.08)
+        yield from settle(robot, self.arm, max_ticks=10)
+        return turned
+
+    def _release_grip(self, robot: RobotController) -> float:
+        """Fully open, unless the object sits inside a rim (a cup): then just wider than the object,
+        so the fingers do not press on the walls and lift the container on the way out."""
+        if self.args.relative_to is None:
+            return 0.0
+        obj = robot.frame.objects[self.args.obj]
+        if robot.frame.objects[self.args.relative_to].top[2] < obj.bottom[2] + 0.01:
+            return 0.0
+        gap = float(min(obj.extent[0], obj.extent[1])) + RELEASE_MARGIN
+        lo, hi = FINGER_RANGE
+        q = 0.5 * (gap + FINGER_GAP_OFFSET)
+        return float(np.clip((hi - q) / (hi - lo), 0.0, 1.0))
+
+    def _standing(self, robot: RobotController) -> bool:
+        """Whether the object already stands upright on the table (an earlier place released it)."""
+        feats = robot.frame.objects[self.args.obj]
+        if float(np.max(feats.extent)) < POINT_EXTENT:
+            return True  # a point feature (a cloth's corner) released is placed wherever it lies
+        return tilt_deg(feats.axis) <= UPRIGHT_TOLERANCE_DEG and min(feats.bottom[2], feats.top[2]) < 0.01
+
+    def _release_and_retreat(self, robot: RobotController) -> Iterator[None]:
+        """Open (if still closed) and back off from where the tool is: the rest of an interrupted place."""
+        arm = self.arm
+        if robot.targets[arm].grip > 0.0:
+            yield from grip(robot, arm, 0.0, ticks=8)
+        rotation = _level(robot.rotation(arm))
+        tool = robot.commanded_pose(arm).pos
+        retreat = tool - 0.08 * rotation[:, 0] + np.array([0.0, 0.0, 0.04 if rotation[2, 0] > -0.7 else 0.0])
+        yield from move_to(robot, arm, pose_from_matrix(retreat, rotation))
