@@ -1,197 +1,395 @@
 """Ground an instruction in the scene: the offline composer's reading of English.
 
-A small, explicit grammar, not a language model: the instruction is split into
-clauses (``, then``, ``and then``, ``and``), each clause is matched against the
-patterns below, and every noun phrase is resolved to a scene object by its name
-or the words of its description (``the red block``). What no pattern matches, or
-a noun phrase that names no object (or several), is an
-:class:`~agentchord.agents.exceptions.InstructionNotGroundedError` that says which
-words failed and suggests a goal spec or ``--reasoner llm``.
+The words are parsed by the grammar of :mod:`agentchord.agents.rules.language` into
+clauses (a verb, its noun phrases, an arm, a place); this module decides what each noun
+phrase names in the scene and which goal predicates each clause states:
+
+- objects by name, category word or synonym (``mug`` for a cup), colour, size (``the tall
+  bottle``, ``the small block``), or a pronoun for the last one mentioned (``it``; ``both``,
+  ``them``: the objects of the instruction so far);
+- the table, which every scene has, and its regions (sides, edges, corners, centre), and
+  places relative to objects (in front of, behind, next to, left or right of, between);
+- the scene's named regions (``the target region``, ``forward``);
+- arms: ``left``, ``right``, ``both`` or unsaid (the planner chooses); an arm that picks an
+  object up is the arm that pours, places or hands it over later.
+
+What cannot be read is an :class:`~agentchord.agents.exceptions.InstructionNotGroundedError`
+naming the exact words, the closest instructions that would be understood in this scene,
+and the goal-spec alternative.
 """
 
 from __future__ import annotations
 
-import re
-from collections.abc import Callable
+import difflib
+from dataclasses import dataclass, field
 
 from agentchord.agents.exceptions import InstructionNotGroundedError
 from agentchord.agents.observe import COLOURS
-from agentchord.agents.reasoner import Scene
+from agentchord.agents.reasoner import Scene, SceneObject
+from agentchord.agents.rules import knowledge as kb
 from agentchord.agents.rules.goals import Folded, Goal, GoalSpec, HandedOver, Inside, On, Placed, Poured
-from agentchord.agents.rules.knowledge import BESIDE_DISTANCE, cloth_names
-from agentchord.agents.rules.knowledge import words as kb_words
+from agentchord.agents.rules.language import Clause, NounPhrase, ParseError, Where, parse
 
-_ARTICLES = re.compile(r"\b(the|a|an|its|it's|some|water|of)\b")
-_VERB = r"(?:pick|place|put|pour|hand|move|fold|stack|set|carry|bring|grasp|take|slide|insert|drop)\b"
-_CLAUSE_SPLIT = re.compile(
-    rf"\s*(?:,\s*and then|,\s*then|\band then\b|\bthen\b|;|,\s*and\b|\band\b(?= {_VERB})|,(?=\s*{_VERB}))\s*"
-)
-_ARM = r"(?:(?:with|using) (?:the )?(?P<arm>left|right) (?:arm|hand|gripper))"
+#: Size words: the candidate with the largest (True) or smallest (False) measure.
+_SIZE_WORDS = {
+    "tall": ("height", True), "taller": ("height", True), "tallest": ("height", True), "high": ("height", True),
+    "short": ("height", False), "shorter": ("height", False), "low": ("height", False),
+    "big": ("volume", True), "bigger": ("volume", True), "biggest": ("volume", True), "large": ("volume", True),
+    "larger": ("volume", True), "largest": ("volume", True), "wide": ("volume", True),
+    "small": ("volume", False), "smaller": ("volume", False), "smallest": ("volume", False), "little": ("volume", False),
+    "tiny": ("volume", False),
+}
+#: Words a noun phrase may carry that name nothing (``the bottle of water``, ``the empty cup``).
+_FILLER = frozenset({"water", "empty", "full", "coffee", "object", "thing", "item", "same", "original"})
+
+
+@dataclass
+class Reading:
+    """What the composer read: the clauses and the goal predicates each one states."""
+
+    instruction: str
+    clauses: list[Clause]
+    goals: list[list[Goal]] = field(default_factory=list)
+
+    @property
+    def goal(self) -> GoalSpec:
+        return GoalSpec(goals=[g for part in self.goals for g in part])
 
 
 class _Context:
-    """What the clauses of one instruction share: the scene and the last objects named."""
+    """What the clauses of one instruction share: the scene, the objects named so far, who holds what."""
 
     def __init__(self, scene: Scene, instruction: str) -> None:
         self.scene = scene
         self.instruction = instruction
+        self.objects = {o.name: o for o in scene.objects}
+        self.cloths = kb.cloth_names(self.objects)
+        self.corners = {f"{c}_{k}" for c in self.cloths for k in kb.CLOTH_CORNERS}
         self.mentioned: list[str] = []
         self.held_by: dict[str, str] = {}
 
-    def resolve(self, phrase: str) -> str:
-        """The scene object a noun phrase names (pronouns name the last object mentioned)."""
-        words = _ARTICLES.sub(" ", phrase.lower()).split()
-        if not words:
-            raise self.error(phrase, "names no object")
-        if words in (["it"], ["one"]):
+    def error(self, words: str, problem: str) -> InstructionNotGroundedError:
+        return InstructionNotGroundedError(self.instruction, f"{words.strip()!r} {problem}")
+
+    def mention(self, name: str) -> str:
+        if name in self.mentioned:
+            self.mentioned.remove(name)
+        self.mentioned.append(name)
+        return name
+
+    # --- noun phrases -------------------------------------------------------------------
+    def resolve_all(self, np: NounPhrase) -> list[str]:
+        """Scene objects a noun phrase names: one, or several for ``both``, ``them``, ``all``."""
+        if np.pronoun in ("all", "them", "they"):
             if not self.mentioned:
-                raise self.error(phrase, "'it' has nothing to refer to")
-            return self.mentioned[-1]
-        candidates = []
-        for obj in self.scene.objects:
-            if obj.name.lower() == "_".join(words) or all(w in kb_words(obj) for w in words):
-                candidates.append(obj.name)
-        if len(candidates) != 1:
-            # The head noun alone (the last word) may still be unique: "coffee capsule" -> capsule.
-            head = [o.name for o in self.scene.objects if words[-1] in kb_words(o)]
-            # A colour that does not match is a contradiction, not a modifier to ignore.
-            if len(candidates) == 0 and len(head) == 1 and not set(words[:-1]) & set(COLOURS):
+                raise self.error(np.text, "has nothing to refer to (name the objects)")
+            group = list(self.mentioned) if np.pronoun == "all" else self.mentioned[-2:]
+            return sorted(group, key=self.mentioned.index)
+        return [self.resolve(np)]
+
+    def resolve(self, np: NounPhrase, exclude: tuple[str, ...] = ()) -> str:
+        """The one scene object a noun phrase names (a pronoun: the last one mentioned, not in ``exclude``)."""
+        if np.pronoun:
+            if np.pronoun in ("all", "them", "they"):
+                raise self.error(np.text, "names several objects where one is wanted")
+            earlier = [m for m in self.mentioned if m not in exclude]
+            if not earlier:
+                raise self.error(np.text, "has nothing to refer to (no object was named before it)")
+            return earlier[-1]
+        if len(np.words) > 1 and np.words[-1] in ("back", "down"):  # "put the bottle back" read as one phrase
+            np = NounPhrase(words=np.words[:-1], of=np.of)
+        words = [kb.SYNONYMS.get(w, w) for w in np.words if w not in _FILLER] or list(np.words)
+        if np.of is not None and not words:
+            return self.resolve(np.of)
+        joined = "_".join(np.words)
+        if joined in self.objects:
+            return self.mention(joined)
+        sizes = [w for w in words if w in _SIZE_WORDS]
+        plain = [w for w in words if w not in _SIZE_WORDS]
+        pool = [o for o in self.scene.objects if o.name not in self.corners]
+        candidates = [o for o in pool if all(w in kb.words(o) for w in plain)]
+        if not candidates and plain:
+            # The head noun alone may still be unique ("coffee capsule" -> capsule); a colour that
+            # does not match is a contradiction, not a modifier to ignore.
+            head = [o for o in pool if plain[-1] in kb.words(o)]
+            if len(head) == 1 and not set(plain[:-1]) & set(COLOURS):
                 candidates = head
+        for word in sizes:
+            if len(candidates) > 1:
+                measure, largest = _SIZE_WORDS[word]
+                key = (lambda o: o.extent[2]) if measure == "height" else (lambda o: o.extent[0] * o.extent[1] * o.extent[2])
+                candidates = [(max if largest else min)(candidates, key=key)]
         if not candidates:
-            raise self.error(phrase, f"names no scene object (the scene has {', '.join(self.scene.object_names)})")
+            known = sorted({w for o in pool for w in kb.words(o)} | set(self.objects))
+            close = difflib.get_close_matches(plain[-1] if plain else np.text, known, n=2, cutoff=0.6)
+            hint = f"; did you mean {' or '.join(map(repr, close))}?" if close else ""
+            raise self.error(np.text, f"names no scene object (the scene has {', '.join(o.name for o in pool)}){hint}")
         if len(candidates) > 1:
-            raise self.error(phrase, f"is ambiguous: it could be {', '.join(candidates)}; name one by colour or name")
-        self.mentioned.append(candidates[0])
-        return candidates[0]
+            names = ", ".join(o.name for o in candidates)
+            raise self.error(np.text, f"is ambiguous: it could be {names}; name one by colour, size or name")
+        return self.mention(candidates[0].name)
 
-    def error(self, phrase: str, problem: str) -> InstructionNotGroundedError:
-        return InstructionNotGroundedError(self.instruction, f"{phrase.strip()!r} {problem}")
+    def table_place(self, np: NounPhrase) -> tuple[float, float] | None | bool:
+        """``False`` when ``np`` is not the table or a region of it; ``None`` for the table itself; else a point."""
+        words = list(np.words) + (list(np.of.words) if np.of is not None else [])
+        of_table = np.of is not None and set(np.of.words) & kb.TABLE_WORDS
+        if set(np.words) <= kb.TABLE_WORDS and np.words and np.of is None:
+            return None
+        region_words = set(words) & (kb.PART_WORDS | set(kb.DIRECTION_WORDS))
+        if of_table or (np.of is None and np.words and set(np.words) <= kb.PART_WORDS | set(kb.DIRECTION_WORDS) | kb.TABLE_WORDS and region_words):
+            return kb.table_point(words) or (kb.TABLE_CENTER if set(words) & {"center", "middle"} else None)
+        return False
+
+    def region(self, np: NounPhrase) -> str | None:
+        """The scene region a noun phrase names (``the target region``, ``the target``), if any."""
+        words = [w for w in np.words if w not in ("region", "area", "zone", "spot", "position", "place")]
+        if not words:
+            return None
+        for region in self.scene.regions:
+            vocabulary = set(region.name.lower().replace("_", " ").split()) | set(region.description.lower().split())
+            if region.name.lower() in words or (all(w in vocabulary for w in words) and set(np.words) & {"region", "area", "zone"}):
+                return region.name
+        return None
+
+    def arm_of(self, said: str | None, obj: str | None = None) -> str | None:
+        if said in ("left", "right"):
+            return said
+        if said == "other" and obj in self.held_by:
+            return "right" if self.held_by[obj] == "left" else "left"
+        return self.held_by.get(obj) if obj else None
 
 
-Rule = tuple[re.Pattern[str], Callable[[re.Match[str], _Context], list[Goal]]]
+def _other(arm: str) -> str:
+    return "right" if arm == "left" else "left"
 
 
-def _pour(m: re.Match[str], ctx: _Context) -> list[Goal]:
-    source, target = ctx.resolve(m["src"]), ctx.resolve(m["dst"])
-    both = bool(re.search(r"\b(both arms|both hands|two arms|bimanual)", ctx.instruction.lower()))
-    return [Poured(source=source, target=target, arm=m["arm"], hold_target=both)]
+# --- clauses -> goals ---------------------------------------------------------------------
 
 
-def _put_down(m: re.Match[str], ctx: _Context) -> list[Goal]:
-    phrase = m["obj"].strip().lower()
-    if phrase in ("both", "them", "both of them", "everything"):
-        objects = list(dict.fromkeys(ctx.mentioned[-2:]))
+def _pour(c: Clause, ctx: _Context) -> list[Goal]:
+    target = ctx.resolve(c.target)
+    if c.source is not None:
+        source = ctx.resolve(c.source)
     else:
-        objects = [ctx.resolve(phrase)]
-    return [Placed(obj=name) for name in objects]
+        held = [o for o in ctx.held_by if kb.is_pourable(ctx.objects[o])]
+        vessels = held or [o.name for o in ctx.scene.objects if kb.is_pourable(o) and o.name != target]
+        if len(vessels) != 1:
+            raise ctx.error(c.text, "does not say what to pour from (say 'from the bottle')")
+        source = ctx.mention(vessels[0])
+        ctx.mention(target)
+    hold_target = c.arm == "both" or target in ctx.held_by
+    arm = ctx.arm_of(c.arm, source)
+    return [Poured(source=source, target=target, arm=arm, hold_target=hold_target)]
 
 
-def _beside(m: re.Match[str], ctx: _Context) -> list[Goal]:
-    first, second, anchor = ctx.resolve(m["a"]), ctx.resolve(m["b"]), ctx.resolve(m["anchor"])
-    # Table-setting convention: the first utensil named goes on the anchor's left (-x), the second on its right.
-    return [
-        Placed(obj=first, relative_to=anchor, offset=(-BESIDE_DISTANCE, 0.0), yaw=90.0),
-        Placed(obj=second, relative_to=anchor, offset=(BESIDE_DISTANCE, 0.0), yaw=90.0),
-    ]
-
-
-def _pick(m: re.Match[str], ctx: _Context) -> list[Goal]:
-    obj = ctx.resolve(m["obj"])
-    if m["arm"]:
-        ctx.held_by[obj] = m["arm"]
+def _pick(c: Clause, ctx: _Context) -> list[Goal]:
+    for np, arm in zip(c.objects, c.arms or [c.arm] * len(c.objects), strict=False):
+        for name in ctx.resolve_all(np):
+            if arm in ("left", "right"):
+                ctx.held_by[name] = arm
     return []
 
 
-def _handover(m: re.Match[str], ctx: _Context) -> list[Goal]:
-    obj = ctx.resolve(m["obj"])
-    receiver = m["to"]
-    giver = ctx.held_by.get(obj, "left" if receiver == "right" else "right")
+def _handover(c: Clause, ctx: _Context) -> list[Goal]:
+    obj = ctx.resolve(c.objects[0])
+    obj_ = ctx.objects[obj]
+    giver = c.giver if c.giver in ("left", "right") else None
+    receiver = c.receiver if c.receiver in ("left", "right") else None
+    giver = giver or ctx.held_by.get(obj) or (_other(receiver) if receiver else kb.near_arm(obj_))
+    receiver = receiver or _other(giver)
+    if giver == receiver:
+        raise ctx.error(c.text, f"hands the {obj} from the {giver} arm to itself")
     ctx.held_by[obj] = receiver
     return [HandedOver(obj=obj, giver=giver, receiver=receiver)]
 
 
-def _into(m: re.Match[str], ctx: _Context) -> list[Goal]:
-    obj, container = ctx.resolve(m["obj"]), ctx.resolve(m["dst"])
-    return [Inside(obj=obj, container=container, arm=m["arm"] or ctx.held_by.get(obj))]
+def _fold(c: Clause, ctx: _Context) -> list[Goal]:
+    np = c.objects[0]
+    words = [kb.SYNONYMS.get(w, w) for w in np.words]
+    cloth = next((w for w in reversed(words) if w in ctx.cloths), None)
+    if cloth is None and len(ctx.cloths) == 1 and words and words[-1] == "towel":
+        cloth = ctx.cloths[0]
+    if cloth is None:
+        raise ctx.error(np.text, f"is not a cloth of the scene (cloths: {', '.join(ctx.cloths) or 'none'})")
+    for corner in kb.CLOTH_CORNERS:
+        ctx.mention(f"{cloth}_{corner}")
+    return [Folded(cloth=cloth)]
 
 
-def _in_region(m: re.Match[str], ctx: _Context) -> list[Goal]:
-    obj = ctx.resolve(m["obj"])
-    region = _region(m["region"], ctx)
-    return [Placed(obj=obj, region=region, arm=ctx.held_by.get(obj))]
+def _beside(obj: str, anchor: str, direction: tuple[float, float], ctx: _Context, arm: str | None) -> Placed:
+    o, a = ctx.objects[obj], ctx.objects[anchor]
+    d = kb.beside_distance(o, a)
+    long_flat = kb.is_flat(o) and max(o.extent[:2]) > 3 * min(o.extent[:2])
+    return Placed(obj=obj, relative_to=anchor, offset=(round(direction[0] * d, 4), round(direction[1] * d, 4)),
+                  yaw=90.0 if long_flat and kb.is_flat(a) else None, arm=arm)
 
 
-def _on(m: re.Match[str], ctx: _Context) -> list[Goal]:
-    obj, support = ctx.resolve(m["obj"]), ctx.resolve(m["dst"])
-    return [On(obj=obj, support=support, arm=m["arm"])]
+def _relation(where: Where | None, ctx: _Context) -> Where | None:
+    """``at`` a phrase like ``the left of the plate``, ``the front of the cup``, ``the top of it``: the relation it states."""
+    if where is None or where.relation != "at":
+        return where
+    np = where.phrases[0]
+    if np.of is None or not np.words or ctx.table_place(np) is not False:
+        return where
+    last = np.words[-1]
+    if last in ("left", "right"):
+        return Where("side_of", (np.of,), side=last)
+    if last == "front":
+        return Where("front_of", (np.of,))
+    if last in ("back", "rear"):
+        return Where("behind", (np.of,))
+    if last == "top":
+        return Where("on_top", (np.of,))
+    if last in ("side", "edge") and len(np.words) > 1 and np.words[-2] in ("left", "right"):
+        return Where("side_of", (np.of,), side=np.words[-2])
+    return where
 
 
-def _move_direction(m: re.Match[str], ctx: _Context) -> list[Goal]:
-    obj = ctx.resolve(m["obj"])
-    return [Placed(obj=obj, region=_region(m["dir"], ctx))]
+def _place_at(names: list[str], where: Where | None, c: Clause, ctx: _Context) -> list[Goal]:
+    where = _relation(where, ctx)
+    arms = {n: ctx.arm_of(c.arm, n) for n in names}
+    if where is None or where.relation == "back":
+        return [Placed(obj=n, arm=arms[n]) for n in names]
+    if where.relation in ("next_to", "side_of", "front_of", "behind"):
+        anchor_np = where.phrases[0]
+        if where.relation == "side_of" and ctx.table_place(anchor_np) is not False:
+            point = kb.table_point([where.side])
+            return [Placed(obj=n, at=point, arm=arms[n]) for n in names]
+        anchor = ctx.resolve(anchor_np, exclude=tuple(names))
+        if where.relation == "side_of":
+            directions = [kb.DIRECTION_WORDS[where.side]] * len(names)
+        elif where.relation == "front_of":
+            directions = [(0.0, -1.0)] * len(names)
+        elif where.relation == "behind":
+            directions = [(0.0, 1.0)] * len(names)
+        elif len(names) == 2:
+            directions = [(-1.0, 0.0), (1.0, 0.0)]  # table setting: the first named on the anchor's left
+        else:
+            side = -1.0 if ctx.objects[names[0]].pos[0] < ctx.objects[anchor].pos[0] else 1.0
+            directions = [(side, 0.0)] * len(names)
+        if len(names) > 2 or len(set(directions)) < len(names):
+            raise ctx.error(c.text, f"puts {len(names)} objects at one place beside the {anchor}")
+        return [_beside(n, anchor, d, ctx, arms[n]) for n, d in zip(names, directions, strict=True)]
+    if where.relation == "between":
+        a, b = (ctx.objects[ctx.resolve(p, exclude=tuple(names))] for p in where.phrases)
+        point = (round(0.5 * (a.pos[0] + b.pos[0]), 3), round(0.5 * (a.pos[1] + b.pos[1]), 3))
+        return [Placed(obj=n, at=point, arm=arms[n]) for n in names]
+    np = where.phrases[0]
+    if where.relation == "on_top":
+        if np.of is not None and np.words and np.words[-1] == "top":
+            np = np.of
+        support = ctx.resolve(np, exclude=tuple(names))
+        return [On(obj=n, support=support, arm=arms[n]) for n in names]
+    table = ctx.table_place(np)
+    if table is None:
+        return [Placed(obj=n, arm=arms[n]) for n in names]
+    if table is not False:
+        return [Placed(obj=n, at=table, arm=arms[n]) for n in names]
+    region = ctx.region(np)
+    if region is not None:
+        return [Placed(obj=n, region=region, arm=arms[n]) for n in names]
+    if set(np.words) & {"region", "area", "zone"}:
+        regions = ", ".join(r.name for r in ctx.scene.regions) or "none"
+        raise ctx.error(np.text, f"names no region of the scene (regions: {regions}; or a part of the table: its left side, front right corner, centre)")
+    host = ctx.resolve(np, exclude=tuple(names))
+    if where.prep == "in" or (where.prep == "at" and kb.is_container(ctx.objects[host])):
+        return [Inside(obj=n, container=host, arm=arms[n]) for n in names]
+    if where.prep == "on" and kb.is_container(ctx.objects[host]) and not kb.is_flat(ctx.objects[host]):
+        return [Inside(obj=n, container=host, arm=arms[n]) for n in names]
+    if where.prep == "on":
+        return [On(obj=n, support=host, arm=arms[n]) for n in names]
+    return [_beside(n, host, (-1.0 if ctx.objects[n].pos[0] < ctx.objects[host].pos[0] else 1.0, 0.0), ctx, arms[n]) for n in names]
 
 
-def _fold(m: re.Match[str], ctx: _Context) -> list[Goal]:
-    word = m["cloth"].strip().lower().split()[-1]
-    cloths = cloth_names(ctx.scene.object_names)
-    if word not in cloths:
-        raise ctx.error(m["cloth"], f"is not a cloth of the scene (cloths: {', '.join(cloths) or 'none'})")
-    ctx.mentioned += [f"{word}_{c}" for c in ("bl", "br", "tl", "tr")]
-    return [Folded(cloth=word)]
+def _place(c: Clause, ctx: _Context) -> list[Goal]:
+    names = [n for np in c.objects for n in ctx.resolve_all(np)]
+    return _place_at(list(dict.fromkeys(names)), c.where, c, ctx)
 
 
-def _region(phrase: str, ctx: _Context) -> str:
-    words = _ARTICLES.sub(" ", phrase.lower()).split()
-    for region in ctx.scene.regions:
-        vocabulary = set(region.name.lower().replace("_", " ").split()) | set(region.description.lower().split())
-        if all(w in vocabulary for w in words):
-            return region.name
-    names = ", ".join(r.name for r in ctx.scene.regions) or "none"
-    raise ctx.error(phrase, f"names no region of the scene (regions: {names})")
+def _move(c: Clause, ctx: _Context) -> list[Goal]:
+    names = [n for np in c.objects for n in ctx.resolve_all(np)]
+    if c.where is not None or not c.direction:
+        return _place_at(names, c.where, c, ctx)
+    goals: list[Goal] = []
+    for name in names:
+        # A scene region the direction names ("forward" in the coffee scene) is where it goes.
+        region = next((r.name for r in ctx.scene.regions if c.direction == r.name.lower() or c.direction in r.description.lower().split()), None)
+        if region is not None:
+            goals.append(Placed(obj=name, region=region, arm=ctx.arm_of(c.arm, name)))
+            continue
+        obj = ctx.objects[name]
+        ux, uy = kb.DIRECTION_WORDS[c.direction]
+        point = (round(obj.pos[0] + ux * kb.NUDGE, 3), round(obj.pos[1] + uy * kb.NUDGE, 3))
+        goals.append(Placed(obj=name, at=point, arm=ctx.arm_of(c.arm, name)))
+    return goals
 
 
-_NP = r"(?P<{}>[\w\s-]+?)"
-RULES: list[Rule] = [
-    (re.compile(rf"^pour (?:water |the water |.*? )?from {_NP.format('src')} into {_NP.format('dst')}(?: {_ARM}| using both arms| with both arms)?$"), _pour),
-    (re.compile(rf"^(?:put|set|place) {_NP.format('obj')} (?:back )?down$"), _put_down),
-    (re.compile(rf"^(?:put|set|place) down {_NP.format('obj')}$"), _put_down),
-    (re.compile(rf"^(?:rearrange|arrange|place|put|set) {_NP.format('a')} and {_NP.format('b')} (?:beside|next to|around|by) {_NP.format('anchor')}$"), _beside),
-    (re.compile(rf"^(?:pick up|grasp|take|grab) {_NP.format('obj')}(?: {_ARM})?$"), _pick),
-    (re.compile(rf"^hand {_NP.format('obj')} over to (?:the )?(?P<to>left|right) (?:arm|hand)$"), _handover),
-    (re.compile(rf"^hand over {_NP.format('obj')} to (?:the )?(?P<to>left|right) (?:arm|hand)$"), _handover),
-    (re.compile(rf"^(?:put|place|set) {_NP.format('obj')} (?:in|into|at|on) (?P<region>[\w\s]*region|[\w\s]*area|[\w\s]*zone)$"), _in_region),
-    (re.compile(rf"^(?:put|place|drop|insert) {_NP.format('obj')} (?:into|in|inside) {_NP.format('dst')}(?: {_ARM})?$"), _into),
-    (re.compile(rf"^(?:stack|put|place|set) {_NP.format('obj')} (?:on top of|onto|on) {_NP.format('dst')}(?: {_ARM})?$"), _on),
-    (re.compile(rf"^(?:move|slide|carry|push) {_NP.format('obj')} (?P<dir>forward|backward|back|left|right)$"), _move_direction),
-    (re.compile(r"^fold (?:the )?(?P<cloth>\w+)(?: in half)?(?:,? .*)?$"), _fold),
-]
+_BUILD = {"pour": _pour, "pick": _pick, "place": _place, "handover": _handover, "fold": _fold, "move": _move}
+
+
+def read_instruction(instruction: str, scene: Scene) -> Reading:
+    """The clauses of an instruction and the goal predicates each one states in ``scene``.
+
+    Raises:
+        InstructionNotGroundedError: Words the grammar cannot read, or a noun phrase that
+            names no scene object (or several); the message names the words, the closest
+            instructions understood in this scene, and the goal-spec alternative.
+    """
+    try:
+        clauses = parse(instruction)
+    except ParseError as exc:
+        raise InstructionNotGroundedError(instruction, _not_understood(exc, scene)) from None
+    ctx = _Context(scene, instruction)
+    reading = Reading(instruction, clauses)
+    for clause in clauses:
+        reading.goals.append(_BUILD[clause.verb](clause, ctx))
+    if not any(reading.goals):
+        raise InstructionNotGroundedError(instruction, "it states no goal (what should be true at the end? e.g. where to put what is picked up)")
+    try:
+        reading.goal  # noqa: B018 - a contradiction (a thing on itself) is a refusal, not a crash
+    except ValueError as exc:
+        problems = "; ".join(e.get("msg", "") for e in getattr(exc, "errors", lambda: [])()) or str(exc)
+        raise InstructionNotGroundedError(instruction, f"what it asks is contradictory: {problems}") from None
+    return reading
 
 
 def ground_instruction(instruction: str, scene: Scene) -> GoalSpec:
-    """The goal spec an instruction states about a scene.
+    """The goal spec an instruction states about a scene (see :func:`read_instruction`)."""
+    return read_instruction(instruction, scene).goal
 
-    Args:
-        instruction: English, e.g. ``Pour water from the bottle into the cup, then put the bottle down.``
-        scene: The first observation (objects with names and descriptions, named regions).
 
-    Raises:
-        InstructionNotGroundedError: A clause matches no pattern, or a noun phrase names
-            no scene object (or several); the message names the words and suggests
-            ``--goal`` or ``--reasoner llm``.
-    """
-    text = instruction.strip().rstrip(".!").lower()
-    text = re.sub(r"\s+", " ", text)
-    ctx = _Context(scene, instruction)
-    goals: list[Goal] = []
-    for clause in filter(None, (c.strip(" ,") for c in _CLAUSE_SPLIT.split(text))):
-        for pattern, build in RULES:
-            match = pattern.match(clause)
-            if match:
-                goals += build(match, ctx)
-                break
-        else:
-            raise InstructionNotGroundedError(instruction, f"no rule reads the clause {clause!r}")
-    if not goals:
-        raise InstructionNotGroundedError(instruction, "it states no goal (what should be true at the end?)")
-    return GoalSpec(goals=goals)
+# --- refusals that help ---------------------------------------------------------------------
 
+
+def examples(scene: Scene) -> list[str]:
+    """Instructions this reader understands in ``scene``, built from its objects (for refusals and docs)."""
+    objects = [o for o in scene.objects if not kb.is_cloth_corner(o.name)]
+    names = [o.name.replace("_", " ") for o in objects]
+    out: list[str] = []
+    vessels = [o.name for o in objects if kb.is_pourable(o)]
+    containers = [o.name for o in objects if kb.is_container(o)]
+    for v in vessels:
+        for c in containers:
+            out.append(f"pour water from the {v} into the {c}")
+    for c in kb.cloth_names(o.name for o in scene.objects):
+        out.append(f"fold the {c} in half")
+    for n in names:
+        out += [f"pick up the {n} with the left arm", f"put the {n} on the left side of the table",
+                f"hand the {n} over to the right arm", f"move the {n} forward"]
+    for r in scene.regions:
+        out += [f"place the {names[0]} in the {r.name} region"] if names else []
+    for c in containers:
+        out += [f"put the {n} into the {c.replace('_', ' ')}" for n in names if n != c.replace("_", " ")]
+    if len(names) >= 2:
+        out += [f"stack the {names[0]} on the {names[1]}", f"put the {names[0]} next to the {names[1]}"]
+    return out
+
+
+def _not_understood(exc: ParseError, scene: Scene) -> str:
+    words = exc.words
+    # The clause the unread words belong to: from the last separator before them to the next one.
+    start = max(exc.text.rfind(sep, 0, exc.column + 1) for sep in (" , ", " ; ", " then ", " and "))
+    clause = exc.text[start:].split(" , ")[0].split(" then ")[0].strip(" ,;") if start >= 0 else exc.text
+    clause = clause.removeprefix("then ").removeprefix("and ").strip() or words
+    close = difflib.get_close_matches(clause, examples(scene), n=2, cutoff=0.0)
+    return f"not understood: {words!r} (in {clause!r}); closest understood: " + "; ".join(repr(c) for c in close)

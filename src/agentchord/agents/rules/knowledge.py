@@ -151,3 +151,54 @@ def handle_offset(obj: SceneObject, arm: str) -> list[float]:
 def drift_tolerance(obj: SceneObject) -> float:
     """Drift (m) of ``obj`` that counts as moved: scaled to its footprint."""
     return round(max(DRIFT_MIN, DRIFT_FRACTION * min(obj.extent[0], obj.extent[1])), 3)
+
+
+# --- the table and its regions (every scene has it) ----------------------------------------
+
+#: The centre (x, y) of the table's reachable workspace (m). x grows to the robot's right;
+#: y grows away from the front edge (the near edge, where a cloth's bottom corners lie).
+TABLE_CENTER = (0.0, 0.52)
+#: Half-sizes (m) of the workspace: a side, an edge or a corner lies this far from the centre.
+TABLE_HALF = (0.12, 0.09)
+#: Words for the table itself.
+TABLE_WORDS = frozenset({"table", "tabletop", "surface", "desk", "counter", "workspace"})
+#: Words for a part of something (a region of the table, or a side of an object).
+PART_WORDS = frozenset({"side", "half", "edge", "end", "corner", "part", "area", "region", "zone", "spot", "portion", "center", "middle"})
+#: Direction words -> unit (dx, dy) on the table.
+DIRECTION_WORDS = {
+    "left": (-1.0, 0.0), "right": (1.0, 0.0),
+    "front": (0.0, -1.0), "near": (0.0, -1.0), "bottom": (0.0, -1.0), "backward": (0.0, -1.0),
+    "back": (0.0, 1.0), "far": (0.0, 1.0), "top": (0.0, 1.0), "rear": (0.0, 1.0), "forward": (0.0, 1.0),
+    "center": (0.0, 0.0), "middle": (0.0, 0.0),
+}
+#: Gap (m) between an object placed next to, in front of or behind another and that object.
+NEXT_TO_GAP = 0.04
+#: How far (m) ``move X forward|left|...`` moves an object when no region names the direction.
+NUDGE = 0.10
+#: Category synonyms: a word people use -> the word scene descriptions use.
+SYNONYMS = {
+    "mug": "cup", "glass": "cup", "beaker": "cup", "jug": "bottle", "flask": "bottle", "pitcher": "bottle",
+    "cube": "block", "brick": "block", "cloth": "towel", "napkin": "towel", "rag": "towel", "pod": "capsule",
+    "platter": "tray", "dish": "plate", "teaspoon": "spoon",
+}
+
+
+def table_point(words: Iterable[str]) -> tuple[float, float] | None:
+    """The table position (x, y) a region's words name (``left side``, ``front right corner``, ``centre``); ``None`` if none."""
+    dx = dy = 0.0
+    named = False
+    for word in words:
+        if word in DIRECTION_WORDS:
+            ux, uy = DIRECTION_WORDS[word]
+            dx, dy, named = dx or ux, dy or uy, True
+    if not named:
+        return None
+    return (round(TABLE_CENTER[0] + dx * TABLE_HALF[0], 3), round(TABLE_CENTER[1] + dy * TABLE_HALF[1], 3))
+
+
+def beside_distance(obj: SceneObject, anchor: SceneObject) -> float:
+    """Centre distance (m) of ``obj`` placed beside ``anchor``: the table-setting convention for a
+    utensil beside a plate, else the two half-sizes and a gap."""
+    if is_flat(obj) and is_flat(anchor):
+        return BESIDE_DISTANCE
+    return round(0.5 * max(obj.extent[:2]) + 0.5 * max(anchor.extent[:2]) + NEXT_TO_GAP, 3)

@@ -197,7 +197,8 @@ def ground(scene: Scene, goal: GoalSpec) -> list[Operator]:
             continue
         for arm in ARMS:
             # A handed-over object is first taken by its giver; a pour names its arm.
-            may_grasp = givers.get(name, arm) == arm and arm_of.get(name, arm) == arm
+            # (A handed-over object that is then poured is poured by its receiver: the giver takes it.)
+            may_grasp = givers[name] == arm if name in givers else arm_of.get(name, arm) == arm
             ops += _one_arm_ops(arm, obj, scene, destinations.get(name, []), may_grasp, name in givers)
     for cloth in cloths:
         ops += _fold_ops(cloth, objects)

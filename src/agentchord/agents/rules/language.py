@@ -1,0 +1,461 @@
+"""The offline composer's grammar of instructions: English -> clauses, before any scene.
+
+A `lark <https://github.com/lark-parser/lark>`_ Earley grammar over lower-cased words.
+An instruction is a sequence of steps (joined by ``then``, ``and``, ``after that``,
+``next``, ``finally``, ``;``, ``,`` or numbered ``1.`` ``2.``); a step is one verb phrase:
+
+- *pour*: ``pour|empty [water] [from NP] into NP``, ``pour NP into NP``;
+- *pick*: ``pick up|grasp|take|grab|hold|lift NP [ARM] [and NP [ARM]]``;
+- *place*: ``put|place|set|lay|stand|leave|drop|return NP [down|back] [WHERE] [ARM]``;
+- *hand over*: ``hand|pass|transfer|give|switch NP [over] [from ARM] [to ARM]``;
+- *fold*: ``fold NP [in half|in two]``;
+- *move*: ``move|push|slide|shift|carry|bring NP [DIRECTION] [WHERE] [ARM]``;
+- *stack*: ``stack NP on [top of] NP``; *arrange*: ``arrange NP and NP beside NP``.
+
+``ARM`` is ``with|using [the] left|right|other arm|hand|gripper`` or ``with both arms``;
+``use the left arm to ...`` and ``the left arm ...`` put the arm before the verb. ``WHERE``
+is a preposition and a noun phrase (``on the table``, ``into the cup``, ``in the front
+left corner of the table``, ``next to the cup``, ``to the left of the plate``, ``between the
+cup and the bottle``, ``in the target region``). A noun phrase is an optional determiner,
+modifiers (colours, sizes, sides, any word) and a head noun, optionally ``of NP``, or a
+pronoun (``it``, ``them``, ``both``). The grammar knows no scene: what a noun phrase names
+is decided by :mod:`agentchord.agents.rules.instructions`.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from functools import lru_cache
+
+from lark import Lark, Transformer, Tree
+from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
+
+GRAMMAR = r"""
+start: _sep? step (_sep step)* _sep?
+
+_sep: ","? "and"? "then" ","?
+    | ","? "and"? "after" "that" ","?
+    | ","? "and"? ("next" | "finally" | "afterwards" | "lastly") ","?
+    | ","? "and"
+    | ";" | "," | "." | ":"
+
+step: _first? core
+    | _first? "use" arm_np "to" core                       -> step_arm
+    | _first? arm_np ("should" | "must" | "will")? core   -> step_arm
+    | _first? arm ","? core                               -> step_arm
+_first: "first" ","?
+
+?core: pour | pick | place | handover | fold | move | stack | arrange
+
+// --- verbs -------------------------------------------------------------------------
+pour: _pour _liquid? "from" np _into np arm?                 -> pour_from
+    | _pour _liquid? "out"? "of" np _into np arm?           -> pour_from
+    | _pour _liquid? _into np ("from" np)? arm?             -> pour_into
+    | _pour np _into np arm?                                -> pour_from
+_pour: "pour" | "empty" | "tip"
+_liquid: "water" | "the" "water" | "some" "water" | "its" "contents" | "the" "contents" | "it" "out"
+_into: "into" | "in" | "in" "to" | "inside"
+
+pick: _pick "up"? held ("and" held)*
+    | "pick" np "up" arm?                                   -> pick_up
+held: np arm?
+_pick: "pick" | "grasp" | "grab" | "take" | "hold" | "lift" | "seize" | "get"
+
+place: _put placement ("and" placement)+                  -> place_each
+     | _put np_list "down"? where? arm?
+     | _put np_list arm where
+     | _put "down" np_list where? arm?
+     | _put np_list back "down"? arm? where?
+     | "return" np_list back? arm? where?                  -> place_return
+_put: "put" | "place" | "set" | "lay" | "stand" | "leave" | "drop" | "position" | "insert" | "deposit"
+back: "back"
+placement: np_list where arm?
+
+handover: _hand np "over"? from_arm? to_arm? arm?
+        | _hand "over" np from_arm? to_arm? arm?
+        | "handover" "of"? np from_arm? to_arm?
+        | "do" "a" "handover" "of" np from_arm? to_arm?
+_hand: "hand" | "pass" | "transfer" | "give" | "switch"
+
+fold: "fold" np _fold_how?
+_fold_how: "in" ("half" | "two") | "over" | "in" "half" "lengthwise"
+
+move: _move np_list direction? where? arm?
+    | _move np_list arm direction? where?
+_move: "move" | "push" | "slide" | "shift" | "carry" | "bring" | "transport" | "nudge" | "drag"
+direction: "forward" -> forward | "forwards" -> forward | "ahead" -> forward | "away" -> forward | "further" -> forward
+         | "backward" -> backward | "backwards" -> backward | "closer" -> backward | "back" -> backward
+         | "to"? "the" side                    -> to_side
+         | "towards"? "the"? "front"           -> backward
+         | "to" "the" "front"                  -> backward
+         | "to" "the" "back"                   -> forward
+         | side
+
+stack: "stack" np ("on" | "onto" | "on" "top" "of" | "upon") np arm?
+
+arrange: ("arrange" | "rearrange" | "lay" "out" | "set" "out") np_list where arm?
+
+// --- arms --------------------------------------------------------------------------
+arm: ("with" | "using" | "by") arm_np
+arm_np: ("the" | "your" | "its")? side _limb             -> one_arm
+      | ("the" | "your")? "other" _limb                   -> other_arm
+      | ("both" | "two" | "both" "the" | "both" "of" "the") _limbs  -> both_arms
+      | "bimanually"                                      -> both_arms
+from_arm: "from" arm_np
+to_arm: ("to" | "into" | "over" "to") arm_np
+_limb: "arm" | "hand" | "gripper"
+_limbs: "arms" | "hands" | "grippers"
+side: "left" -> left | "right" -> right
+
+// --- places ------------------------------------------------------------------------
+where: prep np                                         -> at
+     | "on" "top" "of" np                              -> on_top
+     | "in" "front" "of" np                            -> front_of
+     | ("to" | "on" | "at")? "the" side ("of" | "side" "of") np -> side_of
+     | ("next" "to" | "beside" | "by" | "near" | "around" | "alongside") np -> next_to
+     | ("behind" | "in" "back" "of") np                -> behind
+     | "between" np "and" np                           -> between
+     | "where" pronoun ("was" | "were") "before"?      -> back_where
+     | "in" "its" "place" | "in" "place"               -> back_where
+     | "to" "its" "original" ("spot" | "place" | "position")  -> back_where
+prep: "on" -> p_on | "onto" -> p_on | "upon" -> p_on | "over" -> p_on
+    | "in" -> p_in | "into" -> p_in | "inside" -> p_in
+    | "at" -> p_at | "to" -> p_at | "toward" -> p_at | "towards" -> p_at
+
+// --- noun phrases ------------------------------------------------------------------
+np_list: np ("," np)* (","? "and" np)?
+np: pronoun                                            -> it
+  | ("both" ("of" "them")? | "them" "both" | "all" ("of" "them")? | "everything")  -> all
+  | _det? word+ ("of" np)?                              -> noun
+!pronoun: "it" | "them" | "one" | "they"
+_det: "the" | "a" | "an" | "its" | "their" | "this" | "that" | "your"
+!word: WORD | side | "front" | "back" | "top" | "side" | "half" | "water" | "other"
+
+WORD: /[a-z][a-z0-9_'-]*/
+
+%ignore " "
+"""
+
+
+@dataclass(frozen=True)
+class NounPhrase:
+    """A noun phrase as written: ``words`` (modifiers then head), an ``of`` phrase, or a pronoun (``it``, ``all``)."""
+
+    words: tuple[str, ...] = ()
+    of: NounPhrase | None = None
+    pronoun: str = ""
+
+    @property
+    def text(self) -> str:
+        if self.pronoun:
+            return self.pronoun
+        return " ".join(self.words) + (f" of {self.of.text}" if self.of else "")
+
+
+@dataclass(frozen=True)
+class Where:
+    """Where something goes: ``relation`` (``at``, ``on_top``, ``front_of``, ``behind``, ``next_to``, ``side_of``, ``between``, ``back``) and its phrases."""
+
+    relation: str
+    phrases: tuple[NounPhrase, ...] = ()
+    side: str = ""
+    prep: str = ""
+
+
+@dataclass
+class Clause:
+    """One step of an instruction: a verb (``pour``, ``pick``, ``place``, ...) and what it names."""
+
+    verb: str
+    text: str = ""
+    objects: list[NounPhrase] = field(default_factory=list)
+    arms: list[str | None] = field(default_factory=list)
+    where: Where | None = None
+    source: NounPhrase | None = None
+    target: NounPhrase | None = None
+    arm: str | None = None
+    giver: str | None = None
+    receiver: str | None = None
+    direction: str = ""
+    back: bool = False
+
+
+class ParseError(ValueError):
+    """The words the grammar cannot read: ``words`` (from the first word it could not fit) and what it expected there."""
+
+    def __init__(self, text: str, column: int, expected: list[str]) -> None:
+        self.text, self.column, self.expected = text, column, expected
+        self.words = text[column:].strip() or "(the end of the instruction)"
+        super().__init__(f"cannot read {self.words!r}")
+
+
+#: Third-person verb forms ("the right arm pours ...") -> the imperative.
+_VERB_FORMS = re.compile(
+    r"\b(pour|put|place|set|pick|hand|move|fold|grasp|take|pass|transfer|push|slide|carry|return|stack|lift|grab|empty|hold|give|bring|drop|insert|arrange|rearrange|shift|use)(?:s|es)\b"
+)
+_PUNCT = re.compile(r"\s*([,;:.])\s*")
+
+
+def normalise(instruction: str) -> str:
+    """Lower case, numbered steps and punctuation as separators, the possessive ``'s`` dropped."""
+    text = instruction.lower().replace("\u2019", "'").replace("\n", " ; ")
+    text = re.sub(r"(?:^|(?<=\s))(?:step\s*)?\d+\s*[.):]\s+", " ; ", text)  # "1. pick ...", "step 2) ..."
+    text = re.sub(r"'s\b", "", text)
+    text = re.sub(r"\bcentre\b", "center", text)
+    text = re.sub(r",?\s*(?:bringing|laying|so that|matching|with its|putting its)\b[^,;.]*", "", text)  # fold_towel's how
+    text = _VERB_FORMS.sub(r"\1", text)
+    text = re.sub(r"\b(please|carefully|gently|slowly|now|just|again)\b", " ", text)
+    text = re.sub(r"\b(?:pick|take|lift) up\b", "pick up", text)
+    text = re.sub(r"\bset down\b", "put down", text)
+    text = re.sub(r"\bhand-?over\b", "handover", text)
+    text = re.sub(r"\bleft-hand\b|\bleft hand side\b", "left", text)
+    text = re.sub(r"\bright-hand\b|\bright hand side\b", "right", text)
+    text = re.sub(r"[!?\"()]", " ", text)
+    text = _PUNCT.sub(r" \1 ", text)
+    text = re.sub(r"(?:\s*[;.:]\s*)(?:[;.:,]\s*)*", " ; ", text)  # sentence ends: one separator
+    text = re.sub(r"(?:\s*,\s*)+", " , ", text)
+    return re.sub(r"\s+", " ", text).strip(" ;,.")
+
+
+@lru_cache(maxsize=1)
+def parser() -> Lark:
+    """The Earley parser of :data:`GRAMMAR` (built once)."""
+    return Lark(GRAMMAR, parser="earley", lexer="basic", ambiguity="resolve", propagate_positions=True)
+
+
+class _ToClauses(Transformer):
+    # words
+    def left(self, _):
+        return "left"
+
+    def right(self, _):
+        return "right"
+
+    def side(self, items):
+        return items[0]
+
+    def word(self, items):
+        return str(items[0])
+
+    def pronoun(self, items):
+        return str(items[0])
+
+    def p_on(self, _):
+        return "on"
+
+    def p_in(self, _):
+        return "in"
+
+    def p_at(self, _):
+        return "at"
+
+    def back(self, _):
+        return ("back", True)
+
+    # noun phrases
+    def it(self, items):
+        return NounPhrase(pronoun=items[0])
+
+    def all(self, _):
+        return NounPhrase(pronoun="all")
+
+    def noun(self, items):
+        words = tuple(w for w in items if isinstance(w, str))
+        of = next((i for i in items if isinstance(i, NounPhrase)), None)
+        return NounPhrase(words=words, of=of)
+
+    def np_list(self, items):
+        return list(items)
+
+    # arms
+    def one_arm(self, items):
+        return items[0]
+
+    def other_arm(self, _):
+        return "other"
+
+    def both_arms(self, _):
+        return "both"
+
+    def arm(self, items):
+        return ("arm", items[0])
+
+    def from_arm(self, items):
+        return ("from", items[0])
+
+    def to_arm(self, items):
+        return ("to", items[0])
+
+    # directions and places
+    def forward(self, _):
+        return ("direction", "forward")
+
+    def backward(self, _):
+        return ("direction", "backward")
+
+    def to_side(self, items):
+        return ("direction", items[0])
+
+    def direction(self, items):
+        return ("direction", items[0])
+
+    def at(self, items):
+        return Where("at", (items[1],), prep=items[0])
+
+    def on_top(self, items):
+        return Where("on_top", (items[0],))
+
+    def front_of(self, items):
+        return Where("front_of", (items[0],))
+
+    def behind(self, items):
+        return Where("behind", (items[0],))
+
+    def next_to(self, items):
+        return Where("next_to", (items[0],))
+
+    def between(self, items):
+        return Where("between", (items[0], items[1]))
+
+    def side_of(self, items):
+        return Where("side_of", (items[-1],), side=items[0])
+
+    def back_where(self, _):
+        return Where("back")
+
+    def held(self, items):
+        arm = next((i[1] for i in items if isinstance(i, tuple)), None)
+        return (items[0], arm)
+
+    # clauses
+    @staticmethod
+    def _clause(verb: str, items) -> Clause:
+        clause = Clause(verb=verb)
+        for item in items:
+            if isinstance(item, tuple) and item[0] == "arm":
+                clause.arm = item[1]
+            elif isinstance(item, tuple) and item[0] == "from":
+                clause.giver = item[1]
+            elif isinstance(item, tuple) and item[0] == "to":
+                clause.receiver = item[1]
+            elif isinstance(item, tuple) and item[0] == "direction":
+                clause.direction = item[1]
+            elif isinstance(item, tuple) and item[0] == "back":
+                clause.back = True
+            elif isinstance(item, Where):
+                clause.where = item
+            elif isinstance(item, list):
+                clause.objects += item
+            elif isinstance(item, NounPhrase):
+                clause.objects.append(item)
+        return clause
+
+    def pour_from(self, items):
+        c = self._clause("pour", items)
+        c.source, c.target = c.objects[0], c.objects[1]
+        return c
+
+    def pour_into(self, items):
+        c = self._clause("pour", items)
+        c.target = c.objects[0]
+        c.source = c.objects[1] if len(c.objects) > 1 else None
+        return c
+
+    def pick(self, items):
+        c = Clause(verb="pick")
+        for np, arm in items:
+            c.objects.append(np)
+            c.arms.append(arm)
+        return c
+
+    def pick_up(self, items):
+        c = self._clause("pick", items)
+        c.arms = [c.arm]
+        return c
+
+    def place(self, items):
+        return self._clause("place", items)
+
+    def placement(self, items):
+        return self._clause("place", items)
+
+    def place_each(self, items):
+        return list(items)
+
+    def place_return(self, items):
+        c = self._clause("place", items)
+        c.back = True
+        return c
+
+    def handover(self, items):
+        return self._clause("handover", items)
+
+    def fold(self, items):
+        return self._clause("fold", items)
+
+    def move(self, items):
+        return self._clause("move", items)
+
+    def stack(self, items):
+        c = self._clause("place", items)
+        c.where = Where("on_top", (c.objects.pop(),))
+        return c
+
+    def arrange(self, items):
+        return self._clause("place", items)
+
+    def step(self, items):
+        return items[0]
+
+    def step_arm(self, items):
+        arm, clause = items[0], items[1]
+        arm = arm[1] if isinstance(arm, tuple) else arm
+        if isinstance(clause, list):
+            return [self.step_arm([arm, c]) for c in clause]
+        clause.arm = clause.arm or arm
+        if clause.verb == "pick":
+            clause.arms = [a or arm for a in clause.arms]
+        if clause.verb == "handover" and not clause.giver:
+            clause.giver = arm
+        return clause
+
+    def start(self, items):
+        out = []
+        for item in items:
+            out += item if isinstance(item, list) else [item]
+        return out
+
+
+def parse(instruction: str) -> list[Clause]:
+    """The clauses of an instruction, in order.
+
+    Raises:
+        ParseError: Words the grammar cannot read (``words``) and what it expected there.
+    """
+    clauses: list[Clause] = []
+    for sentence in normalise(instruction).split(" ; "):
+        clauses += _parse_sentence(sentence.strip(" ;"))
+    return clauses
+
+
+def _parse_sentence(text: str) -> list[Clause]:
+    try:
+        tree = parser().parse(text)
+    except UnexpectedInput as exc:
+        column = max(0, getattr(exc, "column", 1) - 1) if not isinstance(exc, UnexpectedEOF) else len(text)
+        expected = sorted(getattr(exc, "expected", None) or getattr(exc, "allowed", None) or [])
+        if isinstance(exc, UnexpectedToken):
+            column = max(0, exc.token.start_pos if exc.token.start_pos is not None else column)
+        elif isinstance(exc, UnexpectedCharacters):
+            column = exc.pos_in_stream
+        raise ParseError(text, column, [str(e) for e in expected]) from None
+    clauses: list[Clause] = []
+    for child in tree.children:
+        step = _ToClauses().transform(child)
+        for clause in step if isinstance(step, list) else [step]:
+            # The words of each clause, for messages and --explain.
+            if getattr(child.meta, "start_pos", None) is not None:
+                clause.text = clause.text or text[child.meta.start_pos : child.meta.end_pos]
+            clauses.append(clause)
+    return clauses
