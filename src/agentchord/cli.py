@@ -17,11 +17,13 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from agentchord import __version__
 from agentchord.cli_support import BadInput, FiniteFloatRange, GuardedGroup, check_outputs
 from agentchord.cli_bench import bench_command
-from agentchord.cli_data import record_command
+from agentchord.cli_data import open_rerun, record_command
 from agentchord.cli_graph import graph_group, import_release_command, schema_command
 from agentchord.guard.outputs import atomic_write_text, finite_json
 
 STRATEGY_NAMES = ("agentchord", "agentchord-bt")
+#: Every method `run` and `demo` accept: AgentChord, its ablation and the four baselines (`bench` compares them).
+METHOD_NAMES = (*STRATEGY_NAMES, "inner-monologue", "doremi", "rekep", "code-as-monitor")
 REASONER_NAMES = ("rules", "llm")
 PERCEPTION_NAMES = ("oracle", "rgbd")
 DISTURB_HELP = "Disturbance kinds, comma-separated: drop, pull, perturb, shift, knock."
@@ -78,6 +80,7 @@ main.add_command(schema_command)
 main.add_command(graph_group)
 main.add_command(import_release_command)
 main.add_command(bench_command)
+main.add_command(record_command)
 
 
 @main.command()
@@ -200,7 +203,7 @@ def plan(instruction, task, seed, goal_path, reasoner, perception, output, rende
 
 @main.command()
 @click.argument("task")
-@click.option("--strategy", type=click.Choice(STRATEGY_NAMES), default="agentchord", show_default=True)
+@click.option("--strategy", type=click.Choice(METHOD_NAMES), default="agentchord", show_default=True)
 @click.option("--p", "p", type=FiniteFloatRange(0.0, 1.0), default=0.0, show_default=True, help="Disturbance probability per atomic action.")
 @click.option("--disturb", default="drop", show_default=True, callback=_kinds, help=DISTURB_HELP)
 @click.option("--protocol", type=click.Choice(PROTOCOL_NAMES), is_flag=False, flag_value="custom", default=None,
@@ -217,8 +220,9 @@ def plan(instruction, task, seed, goal_path, reasoner, perception, output, rende
 @click.option("--video", "video_path", type=click.Path(dir_okay=False), help="Write an MP4 of the episode.")
 @click.option("--camera", default="front", show_default=True, help="Scene camera for --video.")
 @click.option("--world", "world", callback=_world_address, help=WORLD_HELP)
+@click.option("--rerun", "rerun_path", type=click.Path(dir_okay=False), help="Write a Rerun recording (.rrd) of the episode (docs/data.md).")
 def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, instruction, goal_path, reasoner, repair,
-        trace_path, json_path, video_path, camera, world) -> None:
+        trace_path, json_path, video_path, camera, world, rerun_path) -> None:
     """Run one episode of TASK and print its path through the graph.
 
     Exit status 0 when the task succeeded, 1 when it failed, 2 on bad input.
@@ -228,8 +232,12 @@ def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, inst
     _task_name(task, "TASK")
     if world is not None and video_path is not None:
         raise click.UsageError("--video renders the simulator in this process: it cannot be used with --world")
-    check_outputs(("--trace", trace_path, ()), ("--json", json_path, ()), ("--video", video_path, (".mp4",)))
+    if world is not None and rerun_path is not None:
+        raise click.UsageError("--rerun records the simulator in this process: it cannot be used with --world")
+    check_outputs(("--trace", trace_path, ()), ("--json", json_path, ()), ("--video", video_path, (".mp4",)),
+                  ("--rerun", rerun_path, (".rrd",)))
     _check_camera(task, camera, video_path)
+    rerun_log = open_rerun(rerun_path, task)
     graph = _load_graph_option(graph_path)
     goal = _load_goal_option(goal_path)
     if graph is not None and (instruction or goal):
@@ -238,6 +246,8 @@ def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, inst
     recorder = {}
 
     def on_tick(executor) -> None:
+        if rerun_log is not None:
+            rerun_log(executor)
         if video_path is None:
             return
         if "video" not in recorder:
@@ -268,6 +278,7 @@ def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, inst
         ("trace", trace_path, lambda: result.trace.write(trace_path)),
         ("summary", json_path, lambda: atomic_write_text(json_path, finite_json(result.summary(), indent=2) + "\n")),
         ("video", video_path if "video" in recorder else None, lambda: _write_video(recorder["video"], video_path)),
+        ("rerun", rerun_path, lambda: rerun_log.close(result)),
     ])
     sys.exit(0 if result.success else 1)
 
@@ -412,6 +423,10 @@ def _print_episode(console: Console, result) -> None:
     console.print(f"{verdict}: {result.reason}")
     console.print(f"steps {result.steps}  robot time {result.time_s:.2f} s  wall {result.wall_s:.2f} s  "
                   f"failures detected {result.failures_detected}  recoveries {result.recoveries}")
+    if result.reasoning_calls:
+        calls = ", ".join(f"{n} {kind}" for kind, n in result.reasoning_calls.items())
+        console.print(f"execution time {result.exec_time_s:.2f} s = robot {result.time_s:.2f} + compute {result.compute_s:.2f} "
+                      f"+ reasoning {result.reasoning_s:.2f} s (modelled; calls: {calls}; re-plans {result.replans})")
     console.print("path: " + " -> ".join(result.path))
 
 
@@ -440,9 +455,9 @@ def demo(task, trials, first_seed, p, disturb, protocol, perception, strategies,
     from agentchord.worlds.remote import RemoteWorldError  # noqa: PLC0415
 
     names = [s.strip() for s in strategies.split(",") if s.strip()]
-    unknown = [s for s in names if s not in STRATEGY_NAMES]
+    unknown = [s for s in names if s not in METHOD_NAMES]
     if unknown or not names:
-        raise click.BadParameter(f"unknown strategy {unknown} (choose from {', '.join(STRATEGY_NAMES)})", param_hint="--strategies")
+        raise click.BadParameter(f"unknown strategy {unknown} (choose from {', '.join(METHOD_NAMES)})", param_hint="--strategies")
     _task_name(task, "--task")
     if world is not None and workers not in (None, 1):
         raise click.BadParameter("one remote world runs one episode at a time: use --workers 1 with --world", param_hint="--workers")
