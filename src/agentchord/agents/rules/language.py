@@ -38,6 +38,7 @@ _sep: ","? "and"? "then" ","?
     | ","? "and"? "after" "that" ","?
     | ","? "and"? ("next" | "finally" | "afterwards" | "lastly") ","?
     | ","? "and"
+    | ","? "which" | ","? "and" "it"
     | ";" | "," | "." | ":"
 
 step: _first? core
@@ -68,7 +69,7 @@ place: _put placement ("and" placement)+                  -> place_each
      | _put "down" np_list where? arm?
      | _put np_list back "down"? arm? where?
      | "return" np_list back? arm? where?                  -> place_return
-_put: "put" | "place" | "set" | "lay" | "stand" | "leave" | "drop" | "position" | "insert" | "deposit"
+_put: "put" | "place" | "set" | "lay" | "stand" | "leave" | "drop" | "insert" | "deposit"
 back: "back"
 placement: np_list where arm?
 
@@ -78,10 +79,11 @@ handover: _hand np "over"? from_arm? to_arm? arm?
         | "do" "a" "handover" "of" np from_arm? to_arm?
 _hand: "hand" | "pass" | "transfer" | "give" | "switch"
 
-fold: "fold" np _fold_how?
+fold: "fold" np _fold_how? arm?
 _fold_how: "in" ("half" | "two") | "over" | "in" "half" "lengthwise"
 
-move: _move np_list direction? where? arm?
+move: _move placement ("and" placement)+                    -> place_each
+    | _move np_list direction? where? arm?
     | _move np_list arm direction? where?
 _move: "move" | "push" | "slide" | "shift" | "carry" | "bring" | "transport" | "nudge" | "drag"
 direction: "forward" -> forward | "forwards" -> forward | "ahead" -> forward | "away" -> forward | "further" -> forward
@@ -100,7 +102,7 @@ arrange: ("arrange" | "rearrange" | "lay" "out" | "set" "out") np_list where arm
 arm: ("with" | "using" | "by") arm_np
 arm_np: ("the" | "your" | "its")? side _limb             -> one_arm
       | ("the" | "your")? "other" _limb                   -> other_arm
-      | ("both" | "two" | "both" "the" | "both" "of" "the") _limbs  -> both_arms
+      | ("both" | "two" | "both" "the" | "both" "of" "the" | "both" "of" "your" | "both" "your") (_limbs | _limb)  -> both_arms
       | "bimanually"                                      -> both_arms
 from_arm: "from" arm_np
 to_arm: ("to" | "into" | "over" "to") arm_np
@@ -112,13 +114,13 @@ side: "left" -> left | "right" -> right
 where: prep np                                         -> at
      | "on" "top" "of" np                              -> on_top
      | "in" "front" "of" np                            -> front_of
-     | ("to" | "on" | "at")? "the" side ("of" | "side" "of") np -> side_of
+     | ("to" | "on" | "at")? "the"? side ("of" | "side" "of") np -> side_of
      | ("next" "to" | "beside" | "by" | "near" | "around" | "alongside") np -> next_to
      | ("behind" | "in" "back" "of") np                -> behind
      | "between" np "and" np                           -> between
      | "where" pronoun ("was" | "were") "before"?      -> back_where
      | "in" "its" "place" | "in" "place"               -> back_where
-     | "to" "its" "original" ("spot" | "place" | "position")  -> back_where
+     | "to" "its" "original" (word | "place")             -> back_where
 prep: "on" -> p_on | "onto" -> p_on | "upon" -> p_on | "over" -> p_on
     | "in" -> p_in | "into" -> p_in | "inside" -> p_in
     | "at" -> p_at | "to" -> p_at | "toward" -> p_at | "towards" -> p_at
@@ -130,7 +132,7 @@ np: pronoun                                            -> it
   | _det? word+ ("of" np)?                              -> noun
 !pronoun: "it" | "them" | "one" | "they"
 _det: "the" | "a" | "an" | "its" | "their" | "this" | "that" | "your"
-!word: WORD | side | "front" | "back" | "top" | "side" | "half" | "water" | "other"
+!word: WORD | side | "front" | "back" | "top" | "side" | "half" | "water" | "other" | "forward"
 
 WORD: /[a-z][a-z0-9_'-]*/
 
