@@ -119,3 +119,14 @@ def test_a_sample_succeeds_when_run(task, instruction):
 
     result = run_episode(EpisodeSpec(task=task, p=0.0, seed=0, instruction=instruction))
     assert result.success, result.reason
+
+
+def test_explain_prints_clauses_goals_skills_and_graph():
+    from agentchord.agents.rules.explain import explain_plan  # noqa: PLC0415
+
+    text = explain_plan(ISSUE[2][1], scene("handover_block"))
+    assert "clauses -> goal predicates:" in text
+    assert "handed_over(obj=block, giver=left, receiver=right)" in text
+    assert "handover: handover(left->right, block)" in text
+    assert "graph (" in text and "e1: v0 -> v1" in text
+    assert "the grammar stops at 'juggle'" in explain_plan("pour water into the cup then juggle", scene("single_arm_pour_water"))

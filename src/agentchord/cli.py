@@ -153,7 +153,8 @@ def _load_graph_option(graph_path: str | None):
 @click.option("-o", "--output", type=click.Path(dir_okay=False), required=True, help="Where to write the augmented graph (.yaml/.json).")
 @click.option("--render", "render_path", type=click.Path(dir_okay=False), help="Also draw it (.svg, .png, .pdf, .dot, .mmd).")
 @click.option("--trace", "trace_path", type=click.Path(dir_okay=False), help="Write the agents' calls as JSON lines.")
-def plan(instruction, task, seed, goal_path, reasoner, perception, output, render_path, trace_path) -> None:
+@click.option("--explain", is_flag=True, help="Print the parse: clauses -> goal predicates -> skills -> graph (rules reasoner).")
+def plan(instruction, task, seed, goal_path, reasoner, perception, output, render_path, trace_path, explain) -> None:
     """Compose, arrange and conduct the graph for INSTRUCTION in TASK's scene; write it to --output.
 
     Exit status 0 when a valid graph was written, 2 when the instruction cannot be planned.
@@ -174,6 +175,10 @@ def plan(instruction, task, seed, goal_path, reasoner, perception, output, rende
     sim_task = SIM_TASKS[task]
     world = open_world(task, seed)
     scene = observe(world, task_regions(sim_task), perception)
+    if explain:
+        from agentchord.agents.rules.explain import explain_plan  # noqa: PLC0415
+
+        click.echo(explain_plan(instruction or "", scene, goal))
     try:
         agent = make_reasoner(reasoner, goal=goal, watch_visibility=perception == "rgbd")
         result = plan_task(instruction or "", scene, agent, task=task)
