@@ -132,3 +132,31 @@ def test_lerobot_loads_the_dataset(dataset: Path) -> None:
     assert int(last["episode_index"]) == 1
     recovery = [bool(ds.hf_dataset[i]["agentchord.recovery"]) for i in range(ds.num_frames)]
     assert any(recovery)
+
+
+def test_record_refuses_an_existing_directory_and_unknown_cameras(tmp_path: Path) -> None:
+    from click.testing import CliRunner
+
+    from agentchord.cli import main
+
+    runner = CliRunner()
+    result = runner.invoke(main, ["record", TASK, "--episodes", "1", "--out", str(tmp_path)])
+    assert result.exit_code == 2 and "already exists" in result.output
+    result = runner.invoke(main, ["record", TASK, "--out", str(tmp_path / "x"), "--camera", "ceiling"])
+    assert result.exit_code == 2 and "no camera 'ceiling'" in result.output
+    result = runner.invoke(main, ["record", "fold_laundry", "--out", str(tmp_path / "y")])
+    assert result.exit_code == 2
+    assert not (tmp_path / "x").exists() and not (tmp_path / "y").exists()
+
+
+def test_record_writes_nothing_but_metadata_when_no_episode_qualifies(tmp_path: Path) -> None:
+    from click.testing import CliRunner
+
+    from agentchord.cli import main
+
+    # Undisturbed, nothing recovers: --only-recovered writes no episode (exit 1), a valid empty dataset.
+    result = CliRunner().invoke(main, ["record", TASK, "--episodes", "1", "--max-tries", "1", "--only-recovered",
+                                       "--camera", "none", "--out", str(tmp_path / "d")])
+    assert result.exit_code == 1, result.output
+    assert "seed 0: not written (no recovery)" in result.output
+    assert _info(tmp_path / "d")["total_episodes"] == 0

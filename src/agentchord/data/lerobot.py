@@ -167,6 +167,7 @@ class DatasetWriter:
 
         self.discard_episode()
         shutil.rmtree(self.root / "tmp", ignore_errors=True)
+        (self.root / "meta").mkdir(exist_ok=True)
         features = {**self.features, **DEFAULT_FEATURES}
         if self.episodes:
             arrays = {key: _arrow_column(self.columns[key], features[key]) for key in self.columns}
@@ -181,7 +182,6 @@ class DatasetWriter:
         stats = {key: _stats(self.columns[key], features[key]) for key in self.columns}
         for key in self.video_keys:
             stats[key] = _video_stats(self._samples[key])
-        (self.root / "meta").mkdir(exist_ok=True)
         _write_json(self.root / "meta/stats.json", {k: v for k, v in stats.items() if v})
         info = {
             "codebase_version": CODEBASE_VERSION,
