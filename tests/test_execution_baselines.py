@@ -1,0 +1,91 @@
+"""The four baselines in the shared executor: what each detects, what it does then, what it is charged."""
+
+import numpy as np
+import pytest
+
+from agentchord.execution.baselines.vqa import SimulatedVqa
+from agentchord.execution.episode import EpisodeSpec, run_episode
+from agentchord.execution.reasoning import LatencyModel, ReasoningConfig
+
+TASK = "single_arm_pour_water"
+
+
+class _Const:
+    def __init__(self, value: float) -> None:
+        self.value = value
+
+    def scalar(self, frame) -> float:
+        return self.value
+
+
+def _events(result, kind: str) -> list[dict]:
+    return [e for e in result.trace.events if e["event"] == kind]
+
+
+def _run(method: str, seed: int, p: float = 0.05):
+    return run_episode(EpisodeSpec(TASK, strategy=method, p=p, seed=seed, reasoning=ReasoningConfig()))
+
+
+def test_simulated_vqa_answers_the_truth_then_flips_with_its_rates():
+    holds, violated = [_Const(-1.0)], [_Const(0.5)]
+    exact = SimulatedVqa(seed=0)
+    assert exact.holds(holds, None) and not exact.holds(violated, None)
+    blind = SimulatedVqa(seed=0, miss=1.0)
+    assert blind.holds(violated, None)  # every failure missed
+    nervous = SimulatedVqa(seed=0, false_alarm=1.0)
+    assert not nervous.holds(holds, None)
+    half = SimulatedVqa(seed=3, miss=0.5)
+    answers = [half.holds(violated, None) for _ in range(400)]
+    assert 0.4 < np.mean(answers) < 0.6 and half.errors == sum(answers)
+    again = SimulatedVqa(seed=3, miss=0.5)
+    assert [again.holds(violated, None) for _ in range(400)] == answers  # seeded
+
+
+def test_latency_model_parses_and_refuses():
+    model = LatencyModel.parse("plan=20, vqa=2")
+    assert (model.plan, model.vqa, model.vlm) == (20.0, 2.0, 3.5)
+    for bad in ("plan", "think=3", "vqa=-1", "plan=nan", "plan=abc"):
+        with pytest.raises(ValueError):
+            LatencyModel.parse(bad)
+    with pytest.raises(ValueError):
+        ReasoningConfig(vqa_miss=1.5)
+
+
+def test_agentchord_is_charged_its_three_agents_and_the_ablation_two():
+    ac = _run("agentchord", 0)
+    bt = _run("agentchord-bt", 0)
+    assert ac.reasoning_calls == {"plan": 3} and ac.reasoning_s == pytest.approx(21.0)
+    assert bt.reasoning_calls == {"plan": 2}
+    assert ac.exec_time_s == pytest.approx(ac.time_s + ac.compute_s + 21.0)
+    plain = run_episode(EpisodeSpec(TASK, seed=0))  # `run` and `demo`: robot time only
+    assert plain.reasoning_calls == {} and plain.steps == ac.steps
+
+
+def test_inner_monologue_queries_at_each_subgoal_and_replans_on_a_no():
+    result = _run("inner-monologue", 10)
+    assert result.replans >= 1 and _events(result, "replan")
+    # One success query per sub-goal reached, never during motion.
+    ends = len(_events(result, "edge_end"))
+    assert result.reasoning_calls["vqa"] <= ends
+    assert all(e["event"] != "recovery_switch" or e["strategy"] == "inner-monologue" for e in result.trace.events)
+
+
+def test_doremi_queries_during_motion_and_replans():
+    result = _run("doremi", 6)
+    im = _run("inner-monologue", 6)
+    assert result.success and result.replans == 1
+    assert result.reasoning_calls["vqa"] > im.reasoning_calls["vqa"]  # periodic queries on top of the sub-goal ones
+
+
+def test_rekep_backtracks_and_never_reasons_again():
+    result = _run("rekep", 4)
+    assert result.success
+    assert _events(result, "backtrack")
+    assert result.reasoning_calls == {"plan": 1} and result.replans == 0
+
+
+def test_code_as_monitor_replans_with_the_vlm_on_a_detection():
+    result = _run("code-as-monitor", 6)
+    assert result.success and result.replans >= 1
+    assert set(result.reasoning_calls) == {"vlm"}
+    assert _events(result, "failure_detected")  # the compiled monitors fired
