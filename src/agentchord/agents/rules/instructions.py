@@ -167,6 +167,8 @@ def _other(arm: str) -> str:
 
 
 def _pour(c: Clause, ctx: _Context) -> list[Goal]:
+    if c.target is None:
+        raise ctx.error(c.text, "does not say what to pour into (say 'into the cup')")
     target = ctx.resolve(c.target)
     if c.source is not None:
         source = ctx.resolve(c.source)

@@ -50,10 +50,10 @@ _first: "first" ","?
 ?core: pour | pick | place | handover | fold | move | stack | arrange
 
 // --- verbs -------------------------------------------------------------------------
-pour: _pour _liquid? "from" np _into np arm?                 -> pour_from
-    | _pour _liquid? "out"? "of" np _into np arm?           -> pour_from
-    | _pour _liquid? _into np ("from" np)? arm?             -> pour_into
-    | _pour np _into np arm?                                -> pour_from
+pour: _pour (np | _liquid)? _pour_part+
+_pour_part: src | dst | arm | "out"
+src: "from" np | "out"? "of" np
+dst: _into np
 _pour: "pour" | "empty" | "tip"
 _liquid: "water" | "the" "water" | "some" "water" | "its" "contents" | "the" "contents" | "it" "out"
 _into: "into" | "in" | "in" "to" | "inside"
@@ -64,27 +64,24 @@ held: np arm?
 _pick: "pick" | "grasp" | "grab" | "take" | "hold" | "lift" | "seize" | "get"
 
 place: _put placement ("and" placement)+                  -> place_each
-     | _put np_list "down"? where? arm?
-     | _put np_list arm where
-     | _put "down" np_list where? arm?
-     | _put np_list back "down"? arm? where?
-     | "return" np_list back? arm? where?                  -> place_return
+     | _put "down"? np_list _place_part*
+     | "return" np_list _place_part*                        -> place_return
+_place_part: where | arm | back | "down"
 _put: "put" | "place" | "set" | "lay" | "stand" | "leave" | "drop" | "insert" | "deposit"
 back: "back"
 placement: np_list where arm?
 
-handover: _hand np "over"? from_arm? to_arm? arm?
-        | _hand "over" np from_arm? to_arm? arm?
-        | "handover" "of"? np from_arm? to_arm?
-        | "do" "a" "handover" "of" np from_arm? to_arm?
+handover: _hand "over"? np _hand_part*
+        | "handover" "of"? np _hand_part*
+        | "do" "a" "handover" "of" np _hand_part*
+_hand_part: "over" | from_arm | to_arm | arm
 _hand: "hand" | "pass" | "transfer" | "give" | "switch"
 
-fold: "fold" np _fold_how? arm?
+fold: "fold" np (_fold_how | arm)*
 _fold_how: "in" ("half" | "two") | "over" | "in" "half" "lengthwise"
 
 move: _move placement ("and" placement)+                    -> place_each
-    | _move np_list direction? where? arm?
-    | _move np_list arm direction? where?
+    | _move np_list (direction | where | arm)*
 _move: "move" | "push" | "slide" | "shift" | "carry" | "bring" | "transport" | "nudge" | "drag"
 direction: "forward" -> forward | "forwards" -> forward | "ahead" -> forward | "away" -> forward | "further" -> forward
          | "backward" -> backward | "backwards" -> backward | "closer" -> backward | "back" -> backward
@@ -181,6 +178,10 @@ class Clause:
     receiver: str | None = None
     direction: str = ""
     back: bool = False
+
+
+#: A direction word that ends a noun phrase of a move -> the direction.
+_DIRECTIONS = {"forward": "forward", "forwards": "forward", "ahead": "forward", "left": "left", "right": "right", "back": "backward"}
 
 
 class ParseError(ValueError):
@@ -353,15 +354,24 @@ class _ToClauses(Transformer):
                 clause.objects.append(item)
         return clause
 
-    def pour_from(self, items):
-        c = self._clause("pour", items)
-        c.source, c.target = c.objects[0], c.objects[1]
-        return c
+    def src(self, items):
+        return ("src", items[0])
 
-    def pour_into(self, items):
-        c = self._clause("pour", items)
-        c.target = c.objects[0]
-        c.source = c.objects[1] if len(c.objects) > 1 else None
+    def dst(self, items):
+        return ("dst", items[0])
+
+    def pour(self, items):
+        c = self._clause("pour", [i for i in items if not (isinstance(i, tuple) and i[0] in ("src", "dst"))])
+        direct = c.objects[0] if c.objects else None
+        if direct is not None and set(direct.words) <= {"water", "contents", "some", "all"}:
+            direct = None  # "pour water ...": the liquid, not an object
+        c.source = next((i[1] for i in items if isinstance(i, tuple) and i[0] == "src"), None)
+        c.target = next((i[1] for i in items if isinstance(i, tuple) and i[0] == "dst"), None)
+        if c.source is None and c.target is not None and direct is not None:
+            c.source = direct  # "pour the bottle into the cup"
+        elif c.target is None and direct is not None:
+            c.target = direct  # "pour it from the bottle" (the target named first)
+        c.objects = [o for o in (c.source, c.target) if o is not None]
         return c
 
     def pick(self, items):
@@ -397,7 +407,13 @@ class _ToClauses(Transformer):
         return self._clause("fold", items)
 
     def move(self, items):
-        return self._clause("move", items)
+        c = self._clause("move", items)
+        last = c.objects[-1] if c.objects else None
+        # "move the tray forward" read as one phrase "tray forward": the last word is the direction.
+        if not c.direction and last is not None and len(last.words) > 1 and last.of is None and last.words[-1] in _DIRECTIONS:
+            c.objects[-1] = NounPhrase(words=last.words[:-1])
+            c.direction = _DIRECTIONS[last.words[-1]]
+        return c
 
     def stack(self, items):
         c = self._clause("place", items)
@@ -436,8 +452,13 @@ def parse(instruction: str) -> list[Clause]:
         ParseError: Words the grammar cannot read (``words``) and what it expected there.
     """
     clauses: list[Clause] = []
+    # Sentences, and the steps a "then" starts, are parsed one at a time: Earley parsing
+    # costs more than linearly in the length, and "then" never joins anything else.
     for sentence in normalise(instruction).split(" ; "):
-        clauses += _parse_sentence(sentence.strip(" ;"))
+        for piece in re.split(r"(?:\s*,)?(?:\s+and)?\s+then\s+(?:,\s*)?", f" {sentence} "):
+            piece = re.sub(r"^(?:\s*,|\s*(?:and|then)\b)+|(?:\s*,|\s+and)+\s*$", "", f" {piece.strip()}").strip()
+            if piece:
+                clauses += _parse_sentence(piece)
     return clauses
 
 
