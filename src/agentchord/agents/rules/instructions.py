@@ -389,4 +389,4 @@ def _not_understood(exc: ParseError, scene: Scene) -> str:
     clause = exc.text[start:].split(" , ")[0].split(" then ")[0].strip(" ,;") if start >= 0 else exc.text
     clause = clause.removeprefix("then ").removeprefix("and ").strip() or words
     close = difflib.get_close_matches(clause, examples(scene), n=2, cutoff=0.0)
-    return f"not understood: {words!r} (in {clause!r}); closest understood: " + "; ".join(repr(c) for c in close)
+    return f"no rule reads the clause {clause!r}: not understood: {words!r}; closest understood: " + "; ".join(repr(c) for c in close)
