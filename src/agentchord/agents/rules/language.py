@@ -38,13 +38,14 @@ _sep: ","? "and"? "then" ","?
     | ","? "and"? "after" "that" ","?
     | ","? "and"? ("next" | "finally" | "afterwards" | "lastly") ","?
     | ","? "and"
-    | ","? "which" | ","? "and" "it"
+    | ","? "which" | ","? "and" "it" | ","? "while"
     | ";" | "," | "." | ":"
 
 step: _first? core
     | _first? "use" arm_np "to" core                       -> step_arm
     | _first? arm_np ("should" | "must" | "will")? core   -> step_arm
     | _first? arm ","? core                               -> step_arm
+    | _first? ("have" | "let") arm_np core                -> step_arm
 _first: "first" ","?
 
 ?core: pour | pick | place | handover | fold | move | stack | arrange
@@ -78,7 +79,7 @@ _hand_part: "over" | from_arm | to_arm | arm
 _hand: "hand" | "pass" | "transfer" | "give" | "switch"
 
 fold: "fold" np (_fold_how | arm)*
-_fold_how: "in" ("half" | "two") | "over" | "in" "half" "lengthwise"
+_fold_how: "in" ("half" | "two") | "over" | "in" "half" "lengthwise" | "from" word "to" word
 
 move: _move placement ("and" placement)+                    -> place_each
     | _move np_list (direction | where | arm)*
@@ -208,6 +209,10 @@ def normalise(instruction: str) -> str:
     text = re.sub(r"\bcentre\b", "center", text)
     text = re.sub(r",?\s*(?:bringing|laying|so that|matching|with its|putting its)\b[^,;.]*", "", text)  # fold_towel's how
     text = _VERB_FORMS.sub(r"\1", text)
+    text = re.sub(r"^(?:could|can|would|will) you\s+|^(?:i want|i'd like|i would like) you to\s+|^(?:please\s+)", "", text.strip())
+    text = re.sub(r"(?:^|(?<=[;.]\s))(?:the\s+)?(left|right|both)\s+(arm|hand|gripper)s?\s*:", lambda m: f"with both {m[2]}s ," if m[1] == "both" else f"with the {m[1]} {m[2]} ,", text)
+    text = re.sub(r"\b(on|to|at) its (left|right)\b", r"\1 the \2 of it", text)
+    text = re.sub(r"\b(upright|steady|steadily|firmly|securely|safely|upside up)\b", " ", text)
     text = re.sub(r"\b(please|carefully|gently|slowly|now|just|again)\b", " ", text)
     text = re.sub(r"\b(?:pick|take|lift) up\b", "pick up", text)
     text = re.sub(r"\bset down\b", "put down", text)
