@@ -88,8 +88,8 @@ def record_command(task, episodes, out, p, disturb, protocol, only_recovered, ke
                         progress=progress)
     except OSError as exc:
         raise BadInput(f"--out {out}: {exc}") from exc
-    frames = sum(e["steps"] for e in report.written)
-    console.print(f"dataset: {report.root} ({len(report.written)} episodes, about {frames} frames, "
+    frames = sum(e["frames"] for e in report.written)
+    console.print(f"dataset: {report.root} ({len(report.written)} episodes, {frames} frames, "
                   f"{len(report.skipped)} seeds not written)")
     sys.exit(0 if len(report.written) >= episodes else 1)
 

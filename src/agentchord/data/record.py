@@ -177,7 +177,8 @@ def record(task: str, episodes: int, out: str | Path, *, p: float = 0.0, disturb
             writer.discard_episode()
             report.skipped.append((current, why))
         else:
-            entry = {"seed": current, "success": result.success, "steps": result.steps, "recoveries": result.recoveries,
+            entry = {"seed": current, "success": result.success, "steps": result.steps, "frames": writer.episode_frames,
+                     "recoveries": result.recoveries,
                      "recovery_frames": recorder.recovery_frames,
                      "disturbances": ",".join(e["kind"] for e in result.trace.of("disturbance"))}
             writer.save_episode(instruction, extra=entry)
