@@ -23,6 +23,7 @@ import yaml
 from rich.console import Console
 from rich.table import Table
 
+from agentchord.agents.exceptions import ReasonerError
 from agentchord.agents.observe import observe, task_regions
 from agentchord.agents.rules.composer import compose
 from agentchord.agents.rules.instructions import read_instruction
@@ -43,6 +44,7 @@ def main() -> None:
     parser()
     build_ms = 1000.0 * (time.perf_counter() - start)
     scenes = {}
+    refused: list[str] = []
     rows: dict[str, list[tuple[float, float, float, float]]] = defaultdict(list)
     for case in cases:
         task = case["task"]
@@ -50,6 +52,11 @@ def main() -> None:
             sim = SIM_TASKS[task]
             scenes[task] = observe(SimWorld(sim.sample_scene(np.random.default_rng([0, 0x5CE7E]))), task_regions(sim))
         best = None
+        try:
+            read_instruction(case["instruction"], scenes[task])
+        except ReasonerError:
+            refused.append(case["instruction"])  # timed only where it reads (the suite's misses are refused)
+            continue
         for _ in range(args.repeats):
             t0 = time.perf_counter()
             parse(case["instruction"])
@@ -64,7 +71,7 @@ def main() -> None:
                 best = (parse_ms, max(0.0, ground_ms), compose_ms, total)
         rows[task].append(best)
     table = Table(title=f"Reading instructions (rules reasoner), best of {args.repeats}; target <= {TARGET_MS:.0f} ms per instruction")
-    for column in ("task", "instructions", "parse ms", "ground ms", "compose ms", "total ms (median)", "total ms (max)", "ok"):
+    for column in ("task", "instructions", "parse ms", "ground ms (beyond parse)", "compose ms", "total ms (median)", "total ms (max)", "ok"):
         table.add_column(column, justify="left" if column == "task" else "right")
     worst = 0.0
     for task, values in rows.items():
@@ -80,7 +87,7 @@ def main() -> None:
                   "PASS" if worst <= TARGET_MS else "FAIL")
     console = Console()
     console.print(table)
-    console.print(f"grammar built once per process: {build_ms:.0f} ms")
+    console.print(f"grammar built once per process: {build_ms:.0f} ms; not timed (refused): {len(refused)}")
 
 
 if __name__ == "__main__":
