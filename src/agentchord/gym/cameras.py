@@ -6,28 +6,10 @@ policy and a dataset want plain RGB frames: one ``mujoco.Renderer`` per camera h
 
 from __future__ import annotations
 
-import atexit
-import weakref
-
 import mujoco
 import numpy as np
 
-_OPEN: weakref.WeakSet = weakref.WeakSet()
-_HOOKED = False
-
-
-def _close_open() -> None:
-    # Renderers still open at exit would be freed by their finalisers after EGL shut down.
-    for cameras in list(_OPEN):
-        cameras.close()
-
-
-def _track(cameras: RgbCameras) -> None:
-    global _HOOKED
-    if not _HOOKED:  # registered after EGL's own exit handler: runs before it
-        atexit.register(_close_open)
-        _HOOKED = True
-    _OPEN.add(cameras)
+from agentchord.worlds.sim.renderers import close_at_exit, closed
 
 
 class RgbCameras:
@@ -50,7 +32,7 @@ class RgbCameras:
         self.cameras = tuple(cameras)
         self.size = size
         self._renderer = mujoco.Renderer(world.model, height=size[0], width=size[1]) if cameras else None
-        _track(self)
+        close_at_exit(self)
 
     def render(self) -> dict[str, np.ndarray]:
         """One (H, W, 3) uint8 image per camera of the state now."""
@@ -65,3 +47,4 @@ class RgbCameras:
         if self._renderer is not None:
             self._renderer.close()
             self._renderer = None
+        closed(self)

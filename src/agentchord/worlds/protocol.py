@@ -96,12 +96,22 @@ class ObjectInfo:
     @property
     def height(self) -> float:
         """Full height (m) standing upright."""
-        return 2.0 * (self.size[1] if self.shape == "cylinder" else self.size[2])
+        return upright_height(self.shape, self.size)
 
     @property
     def width(self) -> float:
         """Smallest horizontal width (m): what a gripper closes on."""
-        return 2.0 * self.size[0] if self.shape == "cylinder" else 2.0 * min(self.size[0], self.size[1])
+        return grip_width(self.shape, self.size)
+
+
+def upright_height(shape: str, size: tuple[float, ...]) -> float:
+    """Full height (m) of a ``cylinder`` (radius, half-height) or ``box`` (half-sizes) standing upright."""
+    return 2.0 * (size[1] if shape == "cylinder" else size[2])
+
+
+def grip_width(shape: str, size: tuple[float, ...]) -> float:
+    """Smallest horizontal width (m) of a shape standing upright: what a gripper closes on."""
+    return 2.0 * size[0] if shape == "cylinder" else 2.0 * min(size[0], size[1])
 
 
 @dataclass

@@ -7,33 +7,11 @@ camera's geometry, and per-pixel object labels (the simulator's own segmentation
 
 from __future__ import annotations
 
-import atexit
-import weakref
-
 import mujoco
 import numpy as np
 
 from agentchord.worlds.protocol import CameraFrame
-
-_OPEN_CAMERAS: weakref.WeakSet = weakref.WeakSet()
-_EXIT_HOOK = False
-
-
-def _close_open_cameras() -> None:
-    # Renderers still open at exit would be freed by their finalisers after EGL shut down.
-    for camera in list(_OPEN_CAMERAS):
-        camera.close()
-
-
-def _track(camera: DepthCamera) -> None:
-    global _EXIT_HOOK
-    if not _EXIT_HOOK:
-        # Registered after the renderer created its GL context (so after the EGL module set up
-        # its own exit handler): exit handlers run last-in first-out, so this one runs first.
-        atexit.register(_close_open_cameras)
-        _EXIT_HOOK = True
-    _OPEN_CAMERAS.add(camera)
-
+from agentchord.worlds.sim.renderers import close_at_exit, closed
 
 class DepthCamera:
     """A scene camera that renders depth and segmentation with its own ``mujoco.Renderer``
@@ -82,7 +60,7 @@ class DepthCamera:
         self.single_pass = all(hasattr(r, a) for a in ("_rect", "_mjr_context", "_gl_context"))
         self._rgb = np.empty((height, width, 3), dtype=np.uint8)
         self._zbuf = np.empty((height, width), dtype=np.float32)
-        _track(self)
+        close_at_exit(self)
 
     def render(self, data: mujoco.MjData | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Depth (H, W) float32 and MuJoCo's segmentation (H, W, 2) int32 (object id, object type;
@@ -154,4 +132,4 @@ class DepthCamera:
         if self.renderer is not None:
             self.renderer.close()
             self.renderer = None
-        _OPEN_CAMERAS.discard(self)
+        closed(self)

@@ -25,6 +25,7 @@ from agentchord.robot.aloha import (  # noqa: F401  (the robot's numbers, re-exp
 )
 from agentchord.robot.exceptions import RobotModelError
 from agentchord.robot.model import add_collision_proxies, edit_robot, robot_xml
+from agentchord.worlds.protocol import grip_width, upright_height
 from agentchord.worlds.sim.exceptions import SceneError
 
 #: Sliding friction of the table top (MuJoCo takes the larger of two touching geoms' coefficients).
@@ -65,12 +66,12 @@ class ObjectSpec:
     @property
     def height(self) -> float:
         """Full height of the object standing upright."""
-        return 2.0 * (self.size[1] if self.shape == "cylinder" else self.size[2])
+        return upright_height(self.shape, self.size)
 
     @property
     def width(self) -> float:
         """Smallest horizontal width (what a gripper closes on)."""
-        return 2.0 * self.size[0] if self.shape == "cylinder" else 2.0 * min(self.size[0], self.size[1])
+        return grip_width(self.shape, self.size)
 
 
 @dataclass
