@@ -126,16 +126,6 @@ def run_record(key: EpisodeKey, config: SweepConfig) -> dict:
     }
 
 
-def record_fields() -> list[str]:
-    """The fields of a record, in order (the CSV export's columns)."""
-    return [
-        "id", "version", "task", "method", "condition", "p", "protocol", "seed", "success", "reason", "steps",
-        "exec_time_s", "robot_time_s", "compute_s", "reasoning_s", "reasoning_calls", "replans", "failures_detected",
-        "recoveries", "drops_injected", "drops_detected", "drops_recovered", "disturbances", "reaction_latency_ticks",
-        "reaction_latency_s", "unrecoverable", "path", "disturbances_injected", "wall_s",
-    ]
-
-
 def describe(config: SweepConfig) -> str:
     """One line for every table's caption: the latency model and the VQA's error rates."""
     reasoning = config.reasoning
