@@ -163,6 +163,28 @@ class GoalSpec(BaseModel):
             names += [n for n in goal.objects() if n not in names]
         return names
 
+    def outcome(self) -> frozenset[tuple]:
+        """What the goals leave behind, whoever does it and in whatever order.
+
+        Arms and ``home`` are left out: two specs with the same outcome ask for the same end
+        state and events (the same pour, the same place to the centimetre), so one success
+        check judges both.
+        """
+        keys = set()
+        for goal in self.goals:
+            fields = goal.model_dump(exclude={"arm"})
+            keys.add(tuple(sorted((k, _rounded(v)) for k, v in fields.items())))
+        return frozenset(keys)
+
+
+def _rounded(value: object) -> object:
+    # Places stated in metres compare to the centimetre; yaws to the degree.
+    if isinstance(value, float):
+        return round(value, 2)
+    if isinstance(value, (tuple, list)):
+        return tuple(_rounded(v) for v in value)
+    return value
+
 
 def _rests_on(goal: _Goal) -> tuple[str, str, str] | None:
     # (object, what it ends up resting on or in, the relation in words)

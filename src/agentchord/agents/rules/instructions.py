@@ -5,7 +5,8 @@ clauses (a verb, its noun phrases, an arm, a place); this module decides what ea
 phrase names in the scene and which goal predicates each clause states:
 
 - objects by name, category word or synonym (``mug`` for a cup), colour, size (``the tall
-  bottle``, ``the small block``), or a pronoun for the last one mentioned (``it``; ``both``,
+  bottle``, ``the small block``, ``the big one``: of the kind last named), or a pronoun for the
+  last one mentioned (``it``; in ``put it down``, the object last taken in hand; ``both``,
   ``them``: the objects of the instruction so far);
 - the table, which every scene has, and its regions (sides, edges, corners, centre), and
   places relative to objects (in front of, behind, next to, left or right of, between);
@@ -67,9 +68,25 @@ class _Context:
         self.corners = {f"{c}_{k}" for c in self.cloths for k in kb.CLOTH_CORNERS}
         self.mentioned: list[str] = []
         self.held_by: dict[str, str] = {}
+        #: Objects picked up, poured from or handed over and not yet put down, last taken last:
+        #: what ``put it down`` puts down.
+        self.in_hand: list[str] = []
+        #: The head noun last named (``block``): what ``the big one`` is one of.
+        self.last_kind: str | None = None
 
     def error(self, words: str, problem: str) -> InstructionNotGroundedError:
         return InstructionNotGroundedError(self.instruction, f"{words.strip()!r} {problem}")
+
+    def take(self, name: str) -> None:
+        if name in self.in_hand:
+            self.in_hand.remove(name)
+        self.in_hand.append(name)
+
+    def resolve_put_down(self, np: NounPhrase) -> list[str]:
+        """What a place clause names: ``it`` is the object last taken in hand, else as :meth:`resolve_all`."""
+        if np.pronoun == "it" and self.in_hand:
+            return [self.mention(self.in_hand[-1])]
+        return self.resolve_all(np)
 
     def mention(self, name: str) -> str:
         if name in self.mentioned:
@@ -99,6 +116,10 @@ class _Context:
         if len(np.words) > 1 and np.words[-1] in ("back", "down"):  # "put the bottle back" read as one phrase
             np = NounPhrase(words=np.words[:-1], of=np.of)
         words = [kb.SYNONYMS.get(w, w) for w in np.words if w not in _FILLER] or list(np.words)
+        if words[-1] == "one":
+            if self.last_kind is None:
+                raise self.error(np.text, "has nothing to refer to (name the object)")
+            words[-1] = self.last_kind
         if np.of is not None and not words:
             return self.resolve(np.of)
         joined = "_".join(np.words)
@@ -127,6 +148,8 @@ class _Context:
         if len(candidates) > 1:
             names = ", ".join(o.name for o in candidates)
             raise self.error(np.text, f"is ambiguous: it could be {names}; name one by colour, size or name")
+        if plain:
+            self.last_kind = plain[-1]
         return self.mention(candidates[0].name)
 
     def table_place(self, np: NounPhrase) -> tuple[float, float] | None | bool:
@@ -181,6 +204,7 @@ def _pour(c: Clause, ctx: _Context) -> list[Goal]:
         ctx.mention(target)
     hold_target = c.arm == "both" or target in ctx.held_by
     arm = ctx.arm_of(c.arm, source)
+    ctx.take(source)
     return [Poured(source=source, target=target, arm=arm, hold_target=hold_target)]
 
 
@@ -189,6 +213,7 @@ def _pick(c: Clause, ctx: _Context) -> list[Goal]:
         for name in ctx.resolve_all(np):
             if arm in ("left", "right"):
                 ctx.held_by[name] = arm
+            ctx.take(name)
     return []
 
 
@@ -202,6 +227,7 @@ def _handover(c: Clause, ctx: _Context) -> list[Goal]:
     if giver == receiver:
         raise ctx.error(c.text, f"hands the {obj} from the {giver} arm to itself")
     ctx.held_by[obj] = receiver
+    ctx.take(obj)
     return [HandedOver(obj=obj, giver=giver, receiver=receiver)]
 
 
@@ -304,12 +330,14 @@ def _place_at(names: list[str], where: Where | None, c: Clause, ctx: _Context) -
 
 
 def _place(c: Clause, ctx: _Context) -> list[Goal]:
-    names = [n for np in c.objects for n in ctx.resolve_all(np)]
-    return _place_at(list(dict.fromkeys(names)), c.where, c, ctx)
+    names = list(dict.fromkeys(n for np in c.objects for n in ctx.resolve_put_down(np)))
+    ctx.in_hand = [n for n in ctx.in_hand if n not in names]
+    return _place_at(names, c.where, c, ctx)
 
 
 def _move(c: Clause, ctx: _Context) -> list[Goal]:
-    names = [n for np in c.objects for n in ctx.resolve_all(np)]
+    names = [n for np in c.objects for n in ctx.resolve_put_down(np)]
+    ctx.in_hand = [n for n in ctx.in_hand if n not in names]
     if c.where is not None or not c.direction:
         return _place_at(names, c.where, c, ctx)
     goals: list[Goal] = []

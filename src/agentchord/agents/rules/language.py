@@ -4,7 +4,7 @@ A `lark <https://github.com/lark-parser/lark>`_ Earley grammar over lower-cased 
 An instruction is a sequence of steps (joined by ``then``, ``and``, ``after that``,
 ``next``, ``finally``, ``;``, ``,`` or numbered ``1.`` ``2.``); a step is one verb phrase:
 
-- *pour*: ``pour|empty [water] [from NP] into NP``, ``pour NP into NP``;
+- *pour*: ``pour|empty [water] [from NP] into NP``, ``pour NP into NP``, ``fill NP [with water] from NP``;
 - *pick*: ``pick up|grasp|take|grab|hold|lift NP [ARM] [and NP [ARM]]``;
 - *place*: ``put|place|set|lay|stand|leave|drop|return NP [down|back] [WHERE] [ARM]``;
 - *hand over*: ``hand|pass|transfer|give|switch NP [over] [from ARM] [to ARM]``;
@@ -18,7 +18,8 @@ is a preposition and a noun phrase (``on the table``, ``into the cup``, ``in the
 left corner of the table``, ``next to the cup``, ``to the left of the plate``, ``between the
 cup and the bottle``, ``in the target region``). A noun phrase is an optional determiner,
 modifiers (colours, sizes, sides, any word) and a head noun, optionally ``of NP``, or a
-pronoun (``it``, ``them``, ``both``). The grammar knows no scene: what a noun phrase names
+pronoun (``it``, ``them``, ``both``), or ``the big one`` (an object of the kind last named). A step
+may leave its verb out after the first (``fork on the left of the plate, spoon on its right``). The grammar knows no scene: what a noun phrase names
 is decided by :mod:`agentchord.agents.rules.instructions`.
 """
 
@@ -32,7 +33,9 @@ from lark import Lark, Transformer
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
 GRAMMAR = r"""
-start: _sep? step (_sep step)* _sep?
+start: _sep? step (_sep _later)* _sep?
+// A later step may leave the verb out: "put the fork left of the plate, the spoon right of it".
+_later: step | placement
 
 _sep: ","? "and"? "then" ","?
     | ","? "and"? "after" "that" ","?
@@ -48,7 +51,7 @@ step: _first? core
     | _first? ("have" | "let") arm_np core                -> step_arm
 _first: "first" ","?
 
-?core: pour | pick | place | handover | fold | move | stack | arrange
+?core: pour | fill | pick | place | handover | fold | move | stack | arrange
 
 // --- verbs -------------------------------------------------------------------------
 pour: _pour (np | _liquid)? _pour_part+
@@ -56,6 +59,7 @@ _pour_part: src | dst | arm | "out"
 src: "from" np | "out"? "of" np
 dst: _into np
 _pour: "pour" | "empty" | "tip"
+fill: "fill" "up"? np "up"? ("with" ("water" | "it" | "some" "water"))? _pour_part*
 _liquid: "water" | "the" "water" | "some" "water" | "its" "contents" | "the" "contents" | "it" "out"
 _into: "into" | "in" | "in" "to" | "inside"
 
@@ -128,6 +132,7 @@ np_list: np ("," np)* (","? "and" np)?
 np: pronoun                                            -> it
   | ("both" ("of" "them")? | "them" "both" | "all" ("of" "them")? | "everything")  -> all
   | _det? word+ ("of" np)?                              -> noun
+  | _det? word+ "one"                                   -> one_of_kind
 !pronoun: "it" | "them" | "one" | "they"
 _det: "the" | "a" | "an" | "its" | "their" | "this" | "that" | "your"
 !word: WORD | side | "front" | "back" | "top" | "side" | "half" | "water" | "other" | "forward"
@@ -207,7 +212,9 @@ def normalise(instruction: str) -> str:
     text = re.sub(r"(?:^|(?<=\s))(?:step\s*)?\d+\s*[.):]\s+", " ; ", text)  # "1. pick ...", "step 2) ..."
     text = re.sub(r"'s\b", "", text)
     text = re.sub(r"\bcentre\b", "center", text)
-    text = re.sub(r",?\s*(?:bringing|laying|so that|matching|with its|putting its)\b[^,;.]*", "", text)  # fold_towel's how
+    text = re.sub(r",?\s*(?:bringing|laying|so that|so|matching|with its|putting its)\b[^,;.]*", "", text)  # fold_towel's how
+    # "Set the table: fork left of the plate, ...": the title is the verb of the steps that follow.
+    text = re.sub(r"^(?:set|lay) the table\s*[:,;-]\s*(?=(\w+))", lambda m: "" if _VERB_FORMS.match(m[1] + "s") else "put ", text.strip())
     text = _VERB_FORMS.sub(r"\1", text)
     text = re.sub(r"^(?:could|can|would|will) you\s+|^(?:i want|i'd like|i would like) you to\s+|^(?:please\s+)", "", text.strip())
     text = re.sub(r"(?:^|(?<=[;.]\s))(?:the\s+)?(left|right|both)\s+(arm|hand|gripper)s?\s*:", lambda m: f"with both {m[2]}s ," if m[1] == "both" else f"with the {m[1]} {m[2]} ,", text)
@@ -272,6 +279,10 @@ class _ToClauses(Transformer):
         words = tuple(w for w in items if isinstance(w, str))
         of = next((i for i in items if isinstance(i, NounPhrase)), None)
         return NounPhrase(words=words, of=of)
+
+    def one_of_kind(self, items):
+        # "the big one": modifiers of an object of the kind last named.
+        return NounPhrase(words=(*(w for w in items if isinstance(w, str)), "one"))
 
     def np_list(self, items):
         return list(items)
@@ -376,6 +387,14 @@ class _ToClauses(Transformer):
             c.source = direct  # "pour the bottle into the cup"
         elif c.target is None and direct is not None:
             c.target = direct  # "pour it from the bottle" (the target named first)
+        c.objects = [o for o in (c.source, c.target) if o is not None]
+        return c
+
+    def fill(self, items):
+        # "fill the cup with water from the bottle": the filled object is the target.
+        c = self._clause("pour", [i for i in items if not (isinstance(i, tuple) and i[0] in ("src", "dst"))])
+        c.target = c.objects[0] if c.objects else None
+        c.source = next((i[1] for i in items if isinstance(i, tuple) and i[0] == "src"), None)
         c.objects = [o for o in (c.source, c.target) if o is not None]
         return c
 

@@ -3,8 +3,12 @@
 The judge reads the world (not the planner's constraints): an object is *inside* a
 container when it rests, released, within the container's footprint and below its rim;
 *on* a support when its bottom rests on the support's top within its footprint; *placed*
-when it rests released at the stated place. Predicates it cannot judge physically
-(poured, handed over, folded) fall back to the planned graph's goal-node constraints.
+when it rests released at the stated place (a named region, a table point, or beside an
+anchor where the anchor is at the end) with the stated yaw. Two predicates are events during
+the episode, watched frame by frame: *poured* (the source, held, tilted to pour with its
+mouth over the target, as the pouring tasks judge it) and *handed over* (both arms held the
+object, then the receiver alone, off the table). A predicate it cannot judge physically
+(folded) falls back to the planned graph's goal-node constraints.
 """
 
 from __future__ import annotations
@@ -14,11 +18,19 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from agentchord.features.frame import FeatureFrame
-from agentchord.worlds.sim.tasks.base import Verdict, resting_on_table
+from agentchord.worlds.sim.tasks.base import Verdict, pouring, resting_on_table
+from agentchord.worlds.sim.tasks.rearrange_table import yaw_error_deg
 from agentchord.worlds.sim.world import SimWorld
 
 #: Largest speed (m/s) of an object at rest.
 REST_SPEED = 0.02
+#: How far (m) a placed object's centre may lie from a stated table point (the handover
+#: task's target region has the same radius).
+POINT_TOLERANCE = 0.04
+#: How far (m) from its place beside an anchor (the rearrange task's tolerance).
+BESIDE_TOLERANCE = 0.03
+#: How far (deg) a placed object's long axis may be from a stated yaw (as rearrange table).
+YAW_TOLERANCE_DEG = 20.0
 
 
 @dataclass
@@ -34,13 +46,28 @@ class GoalTracker:
     goal: object | None = None
     constraints: list[str] = field(default_factory=list)
     regions: dict = field(default_factory=dict)
+    #: Events seen so far: ("poured", source, target) and ("handed_over", obj) when they happened,
+    #: ("both_held", obj) once both arms held it.
+    events: set = field(default_factory=set)
 
     def expect(self, goal: object | None, constraints: list[str], regions: dict | None = None) -> None:
         """Tell the tracker what the episode was planned to achieve."""
         self.goal, self.constraints, self.regions = goal, list(constraints), dict(regions or {})
 
     def observe(self, frame: FeatureFrame) -> None:
-        """Nothing to watch during the episode."""
+        """Watch one tick for the goal's events: a pour, a handover."""
+        for goal in getattr(self.goal, "goals", []):
+            kind = getattr(goal, "kind", "")
+            if kind == "poured" and ("poured", goal.source, goal.target) not in self.events:
+                held = any(name == goal.source and (goal.arm is None or arm == goal.arm) for arm, name in frame.holding)
+                if held and pouring(frame.objects[goal.source], frame.objects[goal.target]):
+                    self.events.add(("poured", goal.source, goal.target))
+            elif kind == "handed_over" and ("handed_over", goal.obj) not in self.events:
+                giver, receiver = frame.is_holding(goal.giver, goal.obj), frame.is_holding(goal.receiver, goal.obj)
+                if giver and receiver:
+                    self.events.add(("both_held", goal.obj))
+                elif receiver and ("both_held", goal.obj) in self.events and frame.objects[goal.obj].bottom[2] > 0.02:
+                    self.events.add(("handed_over", goal.obj))
 
     def verdict(self, frame: FeatureFrame, world: SimWorld) -> Verdict:
         """Judge every goal predicate on the end state."""
@@ -63,6 +90,13 @@ class GoalTracker:
     def _judge(self, goal, frame: FeatureFrame, world: SimWorld) -> str | None:
         """'' when the predicate holds, a reason when not, None when it cannot be judged here."""
         kind = getattr(goal, "kind", "")
+        if kind == "poured":
+            seen = ("poured", goal.source, goal.target) in self.events
+            return "" if seen else f"the {goal.source} never reached a pouring orientation above the {goal.target}"
+        if kind == "handed_over":
+            if ("handed_over", goal.obj) in self.events:
+                return ""
+            return f"the {goal.obj} was never handed over from the {goal.giver} arm to the {goal.receiver} arm"
         if kind not in ("inside", "on_top_of", "placed"):
             return None
         obj = frame.objects[goal.obj]
@@ -87,7 +121,22 @@ class GoalTracker:
             centre, radius = self.regions[goal.region][:2]
             error = float(np.linalg.norm(obj.pos[:2] - np.asarray(centre)))
             if error > radius:
-                return f"the {goal.obj} is {100 * error:.1f} cm from the {goal.region} region"
+                return f"the {goal.obj} is {100 * error:.1f} cm from the {goal.region} region (radius {100 * radius:.0f} cm)"
+        elif goal.at is not None:
+            error = float(np.linalg.norm(obj.pos[:2] - np.asarray(goal.at)))
+            if error > POINT_TOLERANCE:
+                return (f"the {goal.obj} is {100 * error:.1f} cm from its place ({goal.at[0]:.2f}, {goal.at[1]:.2f}) "
+                        f"(tolerance {100 * POINT_TOLERANCE:.0f} cm)")
+        elif goal.relative_to is not None:
+            place = frame.objects[goal.relative_to].pos[:2] + np.asarray(goal.offset)
+            error = float(np.linalg.norm(obj.pos[:2] - place))
+            if error > BESIDE_TOLERANCE:
+                return (f"the {goal.obj} is {100 * error:.1f} cm from its place beside the {goal.relative_to} "
+                        f"(tolerance {100 * BESIDE_TOLERANCE:.0f} cm)")
+        if goal.yaw is not None:
+            yaw_error = yaw_error_deg(obj.quat, goal.yaw)
+            if yaw_error > YAW_TOLERANCE_DEG:
+                return f"the {goal.obj} is {yaw_error:.0f} deg off its stated yaw {goal.yaw:.0f} deg"
         if not resting_on_table(world, goal.obj, frame):
             return f"the {goal.obj} is not resting on the table"
         return ""
