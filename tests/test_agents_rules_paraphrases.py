@@ -113,7 +113,7 @@ def test_the_issue_instructions_plan_end_to_end(task, instruction):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize(("task", "instruction"), ISSUE[:6], ids=[f"{t}: {i[:40]}" for t, i in ISSUE[:6]])
+@pytest.mark.parametrize(("task", "instruction"), ISSUE, ids=[f"{t}: {i[:40]}" for t, i in ISSUE])
 def test_a_sample_succeeds_when_run(task, instruction):
     from agentchord.execution.episode import EpisodeSpec, run_episode  # noqa: PLC0415
 

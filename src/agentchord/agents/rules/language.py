@@ -33,9 +33,9 @@ from lark import Lark, Transformer
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
 GRAMMAR = r"""
-start: _sep? step (_sep _later)* _sep?
-// A later step may leave the verb out: "put the fork left of the plate, the spoon right of it".
-_later: step | placement
+start: _sep? step (_sep step | "," placement)* _sep?
+// A later step after a comma may leave the verb out: "put the fork left of the plate, the spoon
+// right of it" (after "and", "the fork and the spoon beside the plate" is one list).
 
 _sep: ","? "and"? "then" ","?
     | ","? "and"? "after" "that" ","?
