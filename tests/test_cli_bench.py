@@ -50,3 +50,44 @@ def test_a_sweep_killed_midway_loses_and_repeats_nothing(tmp_path):
     assert sorted(after) == sorted(set(after)) and len(after) == 3  # nothing repeated
     assert f"{len(before)} already in" in " ".join(result.stdout.split())
     assert (out / "tables" / "table1.md").exists()
+
+
+def test_an_llm_sweep_needs_the_llm_settings_before_any_episode(tmp_path, monkeypatch):
+    for name in [k for k in os.environ if k.startswith("AGENTCHORD_LLM_")]:
+        monkeypatch.delenv(name)
+    result = CliRunner().invoke(main, ["bench", "--reasoner", "llm", "--p", "0", "--out", str(tmp_path / "sweep")])
+    assert result.exit_code == 2
+    assert "AGENTCHORD_LLM_BASE_URL" in result.output and not (tmp_path / "sweep" / "records.jsonl").exists()
+
+
+def test_an_llm_sweep_plans_every_episode_and_charges_what_the_calls_measured(tmp_path, monkeypatch):
+    # The replies an LLM would give (what the rules answer for the same scene), from a local replay server.
+    from replay_server import Completion, ReplayServer
+
+    from agentchord.agents.observe import observe, task_regions
+    from agentchord.agents.pipeline import plan_task
+    from agentchord.agents.rules import RulesReasoner
+    from agentchord.tasks import load_task_graph
+    from agentchord.worlds.sim.tasks import SIM_TASKS
+    from agentchord.worlds.sim.trial import open_world
+
+    task = "single_arm_pour_water"
+    rules = RulesReasoner()
+    plan_task(load_task_graph(task).instruction, observe(open_world(task, 0), task_regions(SIM_TASKS[task])), rules, task)
+    out = tmp_path / "sweep"
+    with ReplayServer() as server:
+        for call in rules.calls:
+            server.push(Completion(json.dumps(call.reply), delay_s=0.2))
+        monkeypatch.setenv("AGENTCHORD_LLM_BASE_URL", server.base_url)
+        monkeypatch.setenv("AGENTCHORD_LLM_MODEL", "replay-model")
+        monkeypatch.setenv("AGENTCHORD_LLM_API_KEY", "test-key")
+        result = CliRunner().invoke(main, ["bench", "--reasoner", "llm", "--tasks", task, "--methods", "agentchord",
+                                           "--p", "0", "--trials", "1", "--workers", "1", "--out", str(out)])
+        assert result.exit_code == 0, result.output
+        assert len(server.requests) == 3  # composer, arranger, conductor
+    (record,) = [json.loads(line) for line in (out / "records.jsonl").read_text().splitlines()]
+    assert record["success"], record["reason"]
+    # Three measured calls of about 0.2 s each, not three modelled 7 s ones.
+    assert 0.5 <= record["reasoning_s"] < 5.0, record["reasoning_s"]
+    assert json.loads((out / "sweep.json").read_text())["reasoner"] == "llm"
+    assert "planning calls measured" in " ".join(result.output.split())

@@ -61,8 +61,11 @@ def _latency(ctx, param, value: str | None):
 @click.option("--vqa-miss", type=click.FloatRange(0.0, 1.0), default=0.0, show_default=True, help="Probability a VQA query misses a failure.")
 @click.option("--vqa-false-alarm", type=click.FloatRange(0.0, 1.0), default=0.0, show_default=True, help="Probability a VQA query reports a failure that is not there.")
 @click.option("--doremi-every", type=click.IntRange(1, 10000), default=75, show_default=True, help="DoReMi's VQA period in control ticks (50 Hz).")
+@click.option("--reasoner", type=click.Choice(("rules", "llm")), default="rules", show_default=True,
+              help="rules: the library graphs, planning calls charged the modelled latency; llm: every method plans "
+                   "from the instruction with the LLM of AGENTCHORD_LLM_* and is charged what its calls measured.")
 def bench_command(tasks, methods, ps, protocol, trials, first_seed, out_dir, backend, ray_address, workers, latency, vqa_miss,
-                  vqa_false_alarm, doremi_every) -> None:
+                  vqa_false_alarm, doremi_every, reasoner) -> None:
     """Every method on the same seeded episodes; records as they finish, then tables and figures.
 
     \b
@@ -93,8 +96,16 @@ def bench_command(tasks, methods, ps, protocol, trials, first_seed, out_dir, bac
     if ray_address and backend != "ray":
         raise click.BadParameter("--ray-address needs --backend ray", param_hint="--ray-address")
     conditions = [Condition(protocol=protocol)] if protocol else [Condition(p=p) for p in (ps or [0.05, 0.10])]
+    if reasoner == "llm":
+        from agentchord.agents.exceptions import ReasonerConfigError  # noqa: PLC0415
+        from agentchord.agents.llm import LlmConfig  # noqa: PLC0415
+
+        try:
+            LlmConfig.from_env()  # the settings are checked before any episode runs
+        except ReasonerConfigError as error:
+            raise BadInput(f"--reasoner llm: {error}") from None
     config = SweepConfig(reasoning=ReasoningConfig(latency=latency, vqa_miss=vqa_miss, vqa_false_alarm=vqa_false_alarm,
-                                                   doremi_every=doremi_every))
+                                                   doremi_every=doremi_every), reasoner=reasoner)
     try:
         store = RecordStore(out_dir, config)  # checks the output directory before any episode runs
     except BenchError as error:

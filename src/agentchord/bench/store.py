@@ -53,6 +53,8 @@ class RecordStore:
                 found = json.loads(manifest.read_text())
             except (OSError, ValueError) as error:
                 raise SweepStoreError(f"{manifest}: not a sweep manifest ({error})") from None
+            if isinstance(found, dict):
+                found.setdefault("reasoner", "rules")  # sweeps written before --reasoner were rules sweeps
             if found != wanted:
                 changed = sorted(k for k in set(found) | set(wanted) if found.get(k) != wanted.get(k))
                 raise SweepStoreError(

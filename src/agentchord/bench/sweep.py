@@ -64,21 +64,27 @@ class SweepConfig:
     Attributes:
         reasoning: The latency model, the simulated VQA's error rates, DoReMi's period.
         perception: ``oracle`` or ``rgbd`` features.
+        reasoner: ``rules``: every method runs the task library's graph and each planning call is
+            charged the modelled latency; ``llm``: every method plans from the task's instruction
+            with the LLM of ``AGENTCHORD_LLM_*`` at the episode's start (re-plans too), and each
+            planning call is charged the latency it measured.
     """
 
     reasoning: ReasoningConfig = field(default_factory=ReasoningConfig)
     perception: str = "oracle"
+    reasoner: str = "rules"
 
     def to_dict(self) -> dict:
         """JSON-ready (the sweep's manifest)."""
-        return {"record_version": RECORD_VERSION, "reasoning": self.reasoning.to_dict(), "perception": self.perception}
+        return {"record_version": RECORD_VERSION, "reasoning": self.reasoning.to_dict(), "perception": self.perception,
+                "reasoner": self.reasoner}
 
     @classmethod
     def from_dict(cls, data: dict) -> SweepConfig:
         """The config a manifest holds."""
         reasoning = dict(data["reasoning"])
         reasoning["latency"] = LatencyModel(**reasoning["latency"])
-        return cls(reasoning=ReasoningConfig(**reasoning), perception=data["perception"])
+        return cls(reasoning=ReasoningConfig(**reasoning), perception=data["perception"], reasoner=data.get("reasoner", "rules"))
 
 
 def sweep_keys(tasks: list[str], methods: list[str], conditions: list[Condition], trials: int, first_seed: int = 0) -> list[EpisodeKey]:
@@ -94,11 +100,17 @@ def episode_spec(key: EpisodeKey, config: SweepConfig) -> EpisodeSpec:
     """The episode a key names, under the sweep's config."""
     from agentchord.worlds.sim.disturbances import PRESETS  # noqa: PLC0415
 
+    from agentchord.tasks import load_task_graph  # noqa: PLC0415
+
     condition = key.condition
     disturb = PRESETS[condition.protocol] if condition.protocol else ("drop",)
+    # With an LLM the plan is made (and timed) in the episode, from the instruction of the graph
+    # the rules run; the rules' graph is the task library's (their calls are modelled).
+    instruction = load_task_graph(key.task).instruction if config.reasoner == "llm" else None
     return EpisodeSpec(
         task=key.task, strategy=key.method, p=condition.p, seed=key.seed, disturb=disturb,
         protocol=condition.protocol is not None, perception=config.perception, reasoning=config.reasoning,
+        instruction=instruction, reasoner=config.reasoner,
     )
 
 
@@ -129,6 +141,11 @@ def run_record(key: EpisodeKey, config: SweepConfig) -> dict:
 def describe(config: SweepConfig) -> str:
     """One line for every table's caption: the latency model and the VQA's error rates."""
     reasoning = config.reasoning
-    return (f"reasoning latency per call: {reasoning.latency.describe()} (modelled; see docs/results.md); "
+    if config.reasoner == "llm":
+        latency = (f"planning calls measured (LLM reasoner), VQA {reasoning.latency.vqa:g} s and VLM "
+                   f"{reasoning.latency.vlm:g} s per call modelled (see docs/results.md)")
+    else:
+        latency = f"reasoning latency per call: {reasoning.latency.describe()} (modelled; see docs/results.md)"
+    return (f"{latency}; "
             f"VQA miss {reasoning.vqa_miss:g}, false alarm {reasoning.vqa_false_alarm:g}; "
             f"DoReMi query every {reasoning.doremi_every} ticks; perception {config.perception}")
