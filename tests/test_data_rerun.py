@@ -77,3 +77,24 @@ def test_rerun_with_a_remote_world_is_refused() -> None:
     result = CliRunner().invoke(main, ["run", "single_arm_pour_water", "--world", "tcp://127.0.0.1:5555",
                                        "--rerun", "x.rrd"])
     assert result.exit_code == 2 and "--rerun" in result.output
+
+
+def test_rgbd_mode_logs_the_point_clouds_the_perception_saw(tmp_path) -> None:
+    path = tmp_path / "rgbd.rrd"
+    result = CliRunner().invoke(main, ["run", "single_arm_pour_water", "--perception", "rgbd", "--rerun", str(path)])
+    assert result.exit_code == 0, result.output
+    recording = read_recording(path)
+    for name in ("bottle", "cup"):
+        points = [p for batch in recording[f"/world/points/{name}"] for p in batch.column("Points3D:positions").to_pylist()]
+        cloud = np.array(points[0])
+        assert cloud.ndim == 2 and len(cloud) > 50
+        # Points on the table's objects: above the tabletop, within the workspace.
+        assert np.all(np.isfinite(cloud)) and cloud[:, 2].min() > -0.01 and np.abs(cloud[:, 0]).max() < 0.6
+    assert "/world/points/bottle" not in _oracle_recording(tmp_path)
+
+
+def _oracle_recording(tmp_path) -> dict:
+    path = tmp_path / "oracle.rrd"
+    result = CliRunner().invoke(main, ["run", "single_arm_pour_water", "--rerun", str(path)])
+    assert result.exit_code == 0, result.output
+    return read_recording(path)

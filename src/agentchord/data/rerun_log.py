@@ -6,6 +6,8 @@ One timeline, ``tick`` (50 Hz; ``time`` alongside in seconds), with:
   ``robot/q/{arm}``: its 6 joint positions and gripper opening (0 closed, 1 open);
 - ``world/objects/{name}``: each object's pose (a transform) and its box (static);
 - ``cameras/{camera}``: RGB images (JPEG) every few ticks;
+- ``world/points/{name}``: in RGB-D mode (``--perception rgbd``), each object's fused point cloud
+  from the depth cameras, as the perception saw it, every few ticks;
 - ``monitors/{edge}/{failure}/value`` against ``.../margin`` while its edge is armed, and
   ``.../streak`` against ``.../window`` (the persistence window of Eq. 12), at the tick of the
   frame they were evaluated on;
@@ -128,6 +130,9 @@ class RerunLogger:
                 self._renderer = RgbCameras(world, self.cameras, self.image_size)
             for camera, image in self._renderer.render().items():
                 rec.log(f"cameras/{camera}", rr.Image(image).compress(jpeg_quality=80))
+        if tick % self.image_every == 0:
+            for name, cloud in getattr(executor.extractor, "clouds", {}).items():
+                rec.log(f"world/points/{name}", rr.Points3D(cloud, radii=0.002))
 
     def _log_monitors(self, executor) -> None:
         armed = executor.armed

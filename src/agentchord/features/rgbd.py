@@ -109,6 +109,9 @@ class RgbdExtractor:
             self.close()
             raise
         self.frame = FeatureFrame(objects={}, arms={})
+        #: Each object's fused point cloud (world frame, m) from the last camera frame that saw it
+        #: (for viewers: ``run --perception rgbd --rerun``).
+        self.clouds: dict[str, np.ndarray] = {}
         self._priors: dict[str, tuple[str, np.ndarray]] = {}
         self._rot: dict[str, np.ndarray] = {}
         self.estimated: dict[str, bool] = {}
@@ -229,6 +232,7 @@ class RgbdExtractor:
             feats.points = float(count)
             if count < self.min_points:
                 continue  # occluded or out of view: keep the last estimate
+            self.clouds[name] = self.fuse(views, origins)[0]
             try:
                 fit = self.fit(name, views, origins)
             except np.linalg.LinAlgError:
