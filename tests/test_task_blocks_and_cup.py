@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from agentchord.agents.rules.goals import GoalSpec, Inside, On, Poured
+from agentchord.agents.rules.goals import Folded, GoalSpec, Inside, On, Poured
 from agentchord.features.oracle import OracleExtractor
 from agentchord.worlds.sim.tasks import SIM_TASKS
 from agentchord.worlds.sim.world import SimWorld
@@ -55,6 +55,15 @@ def test_a_met_goal_passes():
 def test_a_predicate_it_cannot_judge_falls_back_to_the_graph_constraints():
     world, frame = world_and_frame()
     tracker = TASK.success_tracker()
-    tracker.expect(GoalSpec(goals=[Poured(source="red_block", target="cup")]), ["70 - tilt(red_block)"])
+    # A fold is not judged on the world: the planned graph's goal constraints are.
+    tracker.expect(GoalSpec(goals=[Folded(cloth="towel")]), ["70 - tilt(red_block)"])
     verdict = tracker.verdict(frame, world)
     assert not verdict.success and "70 - tilt(red_block)" in verdict.reason
+
+
+def test_a_pour_is_an_event_that_must_have_been_seen():
+    world, frame = world_and_frame()
+    tracker = TASK.success_tracker()
+    tracker.expect(GoalSpec(goals=[Poured(source="red_block", target="cup")]), [])
+    verdict = tracker.verdict(frame, world)
+    assert not verdict.success and "the red_block never reached a pouring orientation above the cup" in verdict.reason

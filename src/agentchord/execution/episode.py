@@ -12,6 +12,7 @@ from agentchord.agents.rules.goals import GoalSpec
 from agentchord.execution.baselines.progress import GoalEvents
 from agentchord.execution.baselines.strategies import BaselineContext
 from agentchord.execution.executor import EpisodeResult, Executor, ExecutorConfig
+from agentchord.execution.harness import SuccessTracker
 from agentchord.execution.methods import is_baseline, make_method
 from agentchord.execution.reasoning import ReasoningConfig
 from agentchord.execution.repair import Repairer
@@ -21,9 +22,7 @@ from agentchord.tasks import load_task_graph
 from agentchord.worlds.protocol import World
 from agentchord.worlds.remote import RemoteWorld
 from agentchord.worlds.sim.disturbances import Disturbance, ProtocolDisturbances, RandomDisturbances
-from agentchord.worlds.sim.tasks import SIM_TASKS
-from agentchord.worlds.sim.tasks.base import SuccessTracker
-from agentchord.worlds.sim.tasks.goal_tracker import GoalTracker
+from agentchord.worlds.sim.tasks import SIM_TASKS, judge_by_goal
 from agentchord.worlds.sim.trial import open_world
 
 
@@ -171,9 +170,7 @@ def planned_goal_tracker(task_name: str, goal: GoalSpec | None, graph: TaskGraph
         return tracker
     if goal is None or goal.outcome() == _own_goal_outcome(task_name, scene):
         return tracker
-    judge = GoalTracker()
-    judge.expect(goal, constraints, regions)
-    return judge
+    return judge_by_goal(goal, constraints, regions)
 
 
 def _own_goal_outcome(task_name: str, scene: Scene) -> frozenset | None:

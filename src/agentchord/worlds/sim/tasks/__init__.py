@@ -10,12 +10,13 @@ import importlib
 import pkgutil
 
 from agentchord.worlds.sim.tasks.base import SimTask, SuccessTracker, Verdict
+from agentchord.worlds.sim.tasks.goal_tracker import GoalTracker
 
 
 def _discover() -> dict[str, SimTask]:
     tasks: dict[str, SimTask] = {}
     for module_info in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
-        if module_info.name == "base":
+        if module_info.name in ("base", "goal_tracker"):
             continue
         module = importlib.import_module(f"{__name__}.{module_info.name}")
         task = getattr(module, "TASK", None)
@@ -27,4 +28,12 @@ def _discover() -> dict[str, SimTask]:
 #: Every simulated task by name.
 SIM_TASKS: dict[str, SimTask] = _discover()
 
-__all__ = ["SIM_TASKS", "SimTask", "SuccessTracker", "Verdict"]
+
+def judge_by_goal(goal: object | None, constraints: list[str], regions: dict | None = None) -> GoalTracker:
+    """A success check that judges ``goal`` (a planned goal spec) on the world, in any task's scene."""
+    tracker = GoalTracker()
+    tracker.expect(goal, constraints, regions)
+    return tracker
+
+
+__all__ = ["SIM_TASKS", "GoalTracker", "SimTask", "SuccessTracker", "Verdict", "judge_by_goal"]
