@@ -29,7 +29,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import os
 import sys
 import time
@@ -345,18 +344,9 @@ def stage_eval(out: Path, which: str, trials: int, disturb: str | None, threads:
 
 
 # ----------------------------------------------------------------------------------------- report
-def wilson(k: int, n: int, z: float = 1.959963984540054) -> tuple[float, float]:
-    """Wilson score 95% interval of k successes in n trials."""
-    if n == 0:
-        return (0.0, 1.0)
-    p = k / n
-    denom = 1 + z * z / n
-    centre = (p + z * z / (2 * n)) / denom
-    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / denom
-    return (max(0.0, centre - half), min(1.0, centre + half))
-
-
 def stage_report(out: Path, trials: int) -> str:
+    from agentchord.bench.report import wilson_interval  # noqa: PLC0415
+
     rows, data = [], {}
     names = {"A": "ACT, nominal demos only", "B": "ACT, nominal + AgentChord recovery demos"}
     demos = {"A": "40 nominal", "B": "20 nominal + 20 recovery"}
@@ -368,7 +358,7 @@ def stage_report(out: Path, trials: int) -> str:
         results = [json.loads(line) for line in eval_path.read_text().splitlines()]
         results = [r for r in results if EVAL_SEED <= r["seed"] < EVAL_SEED + trials]
         n, k = len(results), sum(r["success"] for r in results)
-        lo, hi = wilson(k, n)
+        lo, hi = wilson_interval(k, n)
         eval_s = sum(r["wall_s"] for r in results)
         cup_moved = sum(any(d["obj"] == "cup" for d in r["disturbances"]) for r in results)
         other = sorted({d["obj"] for r in results for d in r["disturbances"] if d["obj"] != "cup"})
