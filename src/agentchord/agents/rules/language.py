@@ -376,27 +376,34 @@ class _ToClauses(Transformer):
     def dst(self, items):
         return ("dst", items[0])
 
-    def pour(self, items):
+    def _pour_parts(self, items) -> tuple[Clause, NounPhrase | None, NounPhrase | None]:
+        """The clause without its ``from`` / ``into`` phrases, and those phrases."""
         c = self._clause("pour", [i for i in items if not (isinstance(i, tuple) and i[0] in ("src", "dst"))])
+        src = next((i[1] for i in items if isinstance(i, tuple) and i[0] == "src"), None)
+        dst = next((i[1] for i in items if isinstance(i, tuple) and i[0] == "dst"), None)
+        return c, src, dst
+
+    @staticmethod
+    def _poured(c: Clause, source: NounPhrase | None, target: NounPhrase | None) -> Clause:
+        c.source, c.target = source, target
+        c.objects = [o for o in (source, target) if o is not None]
+        return c
+
+    def pour(self, items):
+        c, source, target = self._pour_parts(items)
         direct = c.objects[0] if c.objects else None
         if direct is not None and set(direct.words) <= {"water", "contents", "some", "all"}:
             direct = None  # "pour water ...": the liquid, not an object
-        c.source = next((i[1] for i in items if isinstance(i, tuple) and i[0] == "src"), None)
-        c.target = next((i[1] for i in items if isinstance(i, tuple) and i[0] == "dst"), None)
-        if c.source is None and c.target is not None and direct is not None:
-            c.source = direct  # "pour the bottle into the cup"
-        elif c.target is None and direct is not None:
-            c.target = direct  # "pour it from the bottle" (the target named first)
-        c.objects = [o for o in (c.source, c.target) if o is not None]
-        return c
+        if source is None and target is not None and direct is not None:
+            source = direct  # "pour the bottle into the cup"
+        elif target is None and direct is not None:
+            target = direct  # "pour it from the bottle" (the target named first)
+        return self._poured(c, source, target)
 
     def fill(self, items):
         # "fill the cup with water from the bottle": the filled object is the target.
-        c = self._clause("pour", [i for i in items if not (isinstance(i, tuple) and i[0] in ("src", "dst"))])
-        c.target = c.objects[0] if c.objects else None
-        c.source = next((i[1] for i in items if isinstance(i, tuple) and i[0] == "src"), None)
-        c.objects = [o for o in (c.source, c.target) if o is not None]
-        return c
+        c, source, target = self._pour_parts(items)
+        return self._poured(c, source, target or (c.objects[0] if c.objects else None))
 
     def pick(self, items):
         c = Clause(verb="pick")
