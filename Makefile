@@ -1,42 +1,67 @@
 # Two commands set everything up on a fresh machine:
 #   make demo   installs AgentChord and runs the main job (offline, CPU, embedded defaults)
-#   make test   installs AgentChord with its test tools and runs the test suite
+#   make test   installs AgentChord with its test tools and the learning stack, and runs the test suite
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
+STAMP_TEST := $(VENV)/.installed-test
 PYTEST_ARGS ?= -n 2 -m "not slow"
+# lerobot 0.4.x (the last release for Python 3.11) pins torch<2.11, torchvision<0.26 and torchcodec<0.11;
+# its dataset and policy code runs on the newer releases the `learn` extra installs, so it goes in
+# without its own pins (pip install --no-deps). See docs/data.md.
+LEROBOT ?= lerobot==0.4.4
+# torchcodec (lerobot's video decoder) loads Debian's FFmpeg 5 libraries.
+FFMPEG_LIBS := libavutil57 libavcodec59 libavformat59 libavdevice59 libavfilter8 libswscale6 libswresample4
 
-.PHONY: install system-deps demo test test-all bench clean
+.PHONY: install install-test system-deps system-deps-learn demo test test-all bench clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install -q --upgrade pip
-	$(BIN)/pip install -q -e ".[test]"
+	$(BIN)/pip install -q -e ".[data]"
 	touch $(STAMP)
+
+# The test tools and the learning stack (torch, lerobot: several GB) only for the tests, so `make demo` stays light.
+$(STAMP_TEST): $(STAMP) pyproject.toml
+	$(BIN)/pip install -q -e ".[test,learn]"
+	$(BIN)/pip install -q --no-deps "$(LEROBOT)"
+	touch $(STAMP_TEST)
 
 # Debian packages: graphviz draws graph figures (.svg/.png), libegl1 + libgl1-mesa-dri render videos headless.
 system-deps:
 	@missing=""; \
 	command -v dot >/dev/null 2>&1 || missing="$$missing graphviz"; \
 	ldconfig -p 2>/dev/null | grep -q libEGL.so.1 || missing="$$missing libegl1 libgl1-mesa-dri"; \
-	if [ -n "$$missing" ]; then \
-	  echo "AgentChord needs the Debian package(s):$$missing (graph figures, headless video). Installing with apt-get..."; \
+	$(call apt_install,$$missing,graph figures and headless video)
+
+system-deps-learn:
+	@missing=""; \
+	ldconfig -p 2>/dev/null | grep -q libavdevice.so.59 || missing="$(FFMPEG_LIBS)"; \
+	$(call apt_install,$$missing,lerobot's video decoding through torchcodec)
+
+# $(call apt_install,PACKAGES,WHY): install the missing Debian packages with a clear message, or say what to do.
+define apt_install
+	if [ -n "$(1)" ]; then \
+	  echo "AgentChord needs the Debian package(s): $(1) ($(2)). Installing with apt-get..."; \
 	  SUDO=""; [ "$$(id -u)" -eq 0 ] || SUDO="sudo"; \
-	  $$SUDO apt-get update -qq && $$SUDO apt-get install -y -qq $$missing >/dev/null \
-	    || { echo "error: could not install$$missing; install them yourself (apt-get install$$missing)"; exit 1; }; \
+	  $$SUDO apt-get update -qq && $$SUDO apt-get install -y -qq $(1) >/dev/null \
+	    || { echo "error: could not install $(1); install them yourself (apt-get install $(1))"; exit 1; }; \
 	fi
+endef
 
 install: $(STAMP) system-deps
+
+install-test: $(STAMP_TEST) system-deps system-deps-learn
 
 demo: install
 	$(BIN)/agentchord demo
 
-test: install
-	$(BIN)/pytest $(PYTEST_ARGS)
+test: install-test
+	AGENTCHORD_REQUIRE_LEROBOT=1 $(BIN)/pytest $(PYTEST_ARGS)
 
-test-all: install
-	$(BIN)/pytest -n 2
+test-all: install-test
+	AGENTCHORD_REQUIRE_LEROBOT=1 $(BIN)/pytest -n 2
 
 bench: install
 	$(BIN)/python benchmarks/bench_disturbances.py
