@@ -46,7 +46,7 @@ def test_a_busy_other_arm_sets_its_object_down_hands_over_and_takes_its_object_a
     alt = arm_switch_alternative(entry, ["bottle", "cup"], {("left", "cup"): {"height": 0.4}})
     assert alt is not None and alt.id == "e3_r_via_left"
     steps = [{arm: (call.fn, call.args) for arm, call in step.items() if call is not None} for step in alt.steps]
-    assert steps[0] == {"right": ("open_gripper", {}), "left": ("place", {"obj": "cup"})}
+    assert steps[0] == {"right": ("open_gripper", {}), "left": ("place", {"obj": "cup", "free_hand": True})}
     assert steps[1] == {"left": ("grasp", {"obj": "bottle"}), "right": ("back", {})}
     assert steps[2] == {"left": ("place", {"obj": "bottle", "within_reach": "right"})}
     assert steps[3] == {"left": ("grasp", {"obj": "cup", "height": 0.4})}
@@ -69,8 +69,11 @@ def test_no_alternative_for_a_cloth_point_or_a_two_arm_grasp():
 @pytest.mark.parametrize("task", LIBRARY)
 def test_library_graphs_carry_their_alternatives_and_stay_valid(task):
     graph = load_task_graph(task)
-    # Up to date: the rule adds nothing the file does not already have.
+    # Up to date: the rule adds nothing the file does not already have, and rebuilt from the graph
+    # without them it writes them as the file has them.
     assert add_arm_switch_alternatives(graph, _rigid(task)) == graph
+    bare = graph.model_copy(update={"edges": [e for e in graph.edges if e.alternative_to is None]})
+    assert add_arm_switch_alternatives(bare, _rigid(task)).edges == graph.edges
     assert check_graph(graph) == []
     alternatives = [e for e in graph.edges if e.alternative_to]
     kept = {e.id for e in forward_filter(graph).graph.edges}

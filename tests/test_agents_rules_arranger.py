@@ -106,3 +106,19 @@ def test_online_repair_with_nothing_to_explain_is_a_reasoner_error():
     with pytest.raises(ReasonerError, match="no rule explains"):
         RulesReasoner().arrange(ArrangeRequest(graph=graph, scene=now, failure=failure))
 
+
+
+def test_a_tall_object_carried_upright_gets_a_slipped_grasp_branch():
+    out = Arranger(scene_of("single_arm_pour_water")).arrange(nominal_only("single_arm_pour_water"))
+    modes = {f.name: f for f in out.edge("e2").failures}
+    # e2 carries the bottle under the path constraint tilt(bottle) - 20: leaving it means the hold slipped.
+    assert modes["bottle_slipped"].monitor == "holding(right, bottle) * tipped(bottle, 20)"
+    recovery = out.edge(modes["bottle_slipped"].recovery)
+    assert [c.fn for _, c in recovery.calls] == ["place", "grasp", "move_to_obj"]
+    assert (recovery.source, recovery.target) == ("v1", "v2")
+    # The pour tilts the bottle on purpose (no upright path constraint): no slipped branch there.
+    assert not any(f.intent == "reseat" for f in out.edge("e3").failures)
+    # Dual-arm pour: the cup carried to its receiving pose, the bottle to the cup.
+    dual = Arranger(scene_of("dual_arm_pour_water")).arrange(nominal_only("dual_arm_pour_water"))
+    assert "cup_slipped" in {f.name for f in dual.edge("e2").failures}
+    assert "bottle_slipped" in {f.name for f in dual.edge("e3").failures}

@@ -27,10 +27,12 @@ FRAME = FeatureFrame(objects={}, arms={})
 
 
 def unanticipated_graph() -> TaskGraph:
-    """The library graph without e2's bottle_dropped mode: no monitor anticipates the drop on e2."""
+    """The library graph without e2's bottle_dropped and bottle_slipped modes: no monitor anticipates
+    the drop on e2, nor the tilted hold it leaves."""
     graph = load_task_graph(TASK)
     e2 = graph.edge("e2")
-    e2.failures = [f for f in e2.failures if f.name != "bottle_dropped"]
+    e2.failures = [f for f in e2.failures if f.name not in ("bottle_dropped", "bottle_slipped")]
+    graph.edges = [e for e in graph.edges if e.id != "e2_r_bottle_slipped"]
     return graph
 
 

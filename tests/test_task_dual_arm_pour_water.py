@@ -162,6 +162,11 @@ def test_skip_if_held_keeps_a_finished_grasp_and_skip_if_placed_only_retreats():
     status, _ = _run(robot, extractor, make_action("place", "right", {"obj": "bottle", "skip_if_placed": True}))
     assert status == Status.SUCCESS
     assert robot.commanded_pose("right").pos[2] > before[2]
+    # free_hand (an arm-switch emptying the busy hand): the bottle is not held, so the hand is free already.
+    before = robot.commanded_pose("right").pos
+    status, _ = _run(robot, extractor, make_action("place", "right", {"obj": "bottle", "free_hand": True}))
+    assert status == Status.SUCCESS and robot.targets["right"].grip == 0.0
+    assert robot.commanded_pose("right").pos[2] > before[2]
 
 
 def test_reseat_turns_a_fallen_bottle_into_a_nominal_side_grasp():

@@ -59,6 +59,10 @@ class Place(ArmAction):
                 if robot.frame.is_holding(arm, self.args.obj):
                     break  # finger contact flickered for a tick (a tray shifting in two grips): go on
             else:
+                if self.args.free_hand:
+                    # Only a free hand was asked for, and the hand is free: the object fell on its own.
+                    yield from self._release_and_retreat(robot)
+                    return
                 raise ActionFailed(f"{self.args.obj} is not held: nothing to place")
         if self.args.relative_to is not None and self.args.within_reach is None:
             # A pushed reference may still be sliding: aim at where it stops.

@@ -85,6 +85,10 @@ class PlaceArgs(_Args):
         False,
         description="If obj is not held but already stands upright on the table, only open and retreat (finish an interrupted synchronous place).",
     )
+    free_hand: bool = Field(
+        False,
+        description="The place only empties the hand: if obj is no longer held (it fell), open and retreat instead of failing.",
+    )
     within_reach: Literal["left", "right"] | None = Field(
         None,
         description="Set obj down at the nearest free spot this (other) arm reaches, chosen when the action runs: "

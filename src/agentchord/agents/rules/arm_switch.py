@@ -92,8 +92,9 @@ def arm_switch_alternative(entry: Edge, rigid: Iterable[str], regrasp: dict[tupl
         again = {"obj": held, **(regrasp or {}).get((other, held), {})}
         rest = list(entry.steps)  # the other arm holds its object again: the entry runs as written
         hand_off = [
-            # The busy arm sets its object down where it is, to have a free hand.
-            {arm: ActionCall(fn="open_gripper"), other: ActionCall(fn="place", args={"obj": held})},
+            # The busy arm sets its object down where it is, to have a free hand (if that object
+            # fell too, the hand is already free).
+            {arm: ActionCall(fn="open_gripper"), other: ActionCall(fn="place", args={"obj": held, "free_hand": True})},
             {other: ActionCall(fn="grasp", args=args), arm: ActionCall(fn="back")},
             {other: ActionCall(fn="place", args={"obj": obj, "within_reach": arm})},
             {other: ActionCall(fn="grasp", args=again)},
@@ -113,13 +114,22 @@ def arm_switch_alternative(entry: Edge, rigid: Iterable[str], regrasp: dict[tupl
 
 
 def _regrasp_args(graph: TaskGraph) -> dict[tuple[str, str], dict]:
-    """The graph's first grasp of each object by each arm: how a set-down object is taken again."""
+    """The graph's first grasp of each object by each arm: how a set-down object is taken again.
+
+    The object may have fallen instead of being set down (both were dropped): where the graph
+    re-seats the object after any grasp of it by that arm (a pour needs the nominal hold), so does
+    the taking-again.
+    """
     found: dict[tuple[str, str], dict] = {}
+    reseated: set[tuple[str, str]] = set()
     for edge in graph.edges:
         for arm, call in edge.calls:
             if call.fn == "grasp" and "obj" in call.args:
-                found.setdefault((arm, call.args["obj"]), {k: v for k, v in call.args.items() if k != "obj"})
-    return found
+                key = (arm, call.args["obj"])
+                found.setdefault(key, {k: v for k, v in call.args.items() if k not in ("obj", "reseat")})
+                if call.args.get("reseat"):
+                    reseated.add(key)
+    return {key: {**args, "reseat": True} if key in reseated else args for key, args in found.items()}
 
 
 def add_arm_switch_alternatives(graph: TaskGraph, rigid: Iterable[str]) -> TaskGraph:

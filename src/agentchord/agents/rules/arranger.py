@@ -7,6 +7,8 @@ motions since the last grasp, what each arm's pose is relative to). For each nom
 
 - a held object can drop or slip (Eq. 16-17): ``regrasp`` where it fell, restore the arm's
   relative motions since the grasp, then finish ``e``;
+- a tall object carried under an upright path constraint can tilt in the hand (taken askew):
+  ``reseat``: set it down, take it again with the nominal hold, then ``e`` again;
 - an object the edge aims at (or places relative to) can drift (Eq. 14): ``re-approach``,
   run ``e`` again on its new pose; if it must stand upright it can tip (Eq. 15): ``set upright``
   with a free arm while the busy arm parks, then ``e`` again;
@@ -24,6 +26,7 @@ and recovery places skip an object already placed (an interrupted two-arm step).
 from __future__ import annotations
 
 import copy
+import re
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
@@ -61,6 +64,10 @@ class ArmAccount:
 
 
 Account = dict[str, ArmAccount]
+
+
+#: An upright path constraint, ``tilt(obj) - X`` (X in degrees).
+_UPRIGHT_PATH = re.compile(r"tilt\((\w+)\) - (\d+(?:\.\d+)?)")
 
 
 def _apply(account: Account, step: Step) -> Account:
@@ -228,6 +235,7 @@ class Arranger:
             out.append((FailureMode(name=f"{obj}_shifted", monitor=f"drift({obj}, {kb.drift_tolerance(obj_info):g})", window=kb.WINDOW, intent="re-approach", recovery=replay.id), replay))
             if self.watch_visibility:
                 out.append((FailureMode(name=f"{obj}_lost", monitor=f"lost_view({obj}, {kb.MIN_POINTS})", window=kb.WINDOW, intent="re-observe", recovery=replay.id), None))
+        out += self._upright_in_hand(edge, account, after)
         out += self._relations(graph, edge, account, after)
         out += self._misplaced(graph, edge, account)
         return out
@@ -308,6 +316,36 @@ class Arranger:
         recovery = Edge(id=f"{edge.id}_r_{obj}_dropped", source=edge.source, target=edge.target, kind="recovery", actions=steps)
         mode = FailureMode(name=f"{obj}_dropped", monitor=monitor, window=kb.WINDOW, intent="regrasp", recovery=recovery.id)
         return mode, recovery
+
+    def _slipped(self, edge: Edge, before: Account, arm: str, obj: str, limit_deg: float) -> tuple[FailureMode, Edge]:
+        """A tall object tilted in the hand (pushed while it was taken, knocked in the hand): set it
+        down, take it again with the nominal hold, redo the edge. A pour or an upright place from
+        an askew hold fails however the rest of the task goes."""
+        steps: list[Step] = [{arm: ActionCall(fn="place", args={"obj": obj})}, {arm: _regrasp(before, arm, obj)}]
+        steps += _replay_then_edge(before, edge, {arm})
+        recovery = Edge(id=f"{edge.id}_r_{obj}_slipped", source=edge.source, target=edge.target, kind="recovery", actions=steps)
+        mode = FailureMode(name=f"{obj}_slipped", monitor=f"holding({arm}, {obj}) * tipped({obj}, {limit_deg:g})",
+                           window=kb.WINDOW, intent="reseat", recovery=recovery.id)
+        return mode, recovery
+
+    def _upright_in_hand(self, edge: Edge, before: Account, after: Account) -> list[tuple[FailureMode, Edge]]:
+        """Slipped-grasp branches for the tall objects an edge carries under an upright path constraint.
+
+        The path constraint ``tilt(obj) - X`` says the object must stay within X degrees of upright
+        while the edge runs; held throughout by one arm, leaving that bound means the hold slipped.
+        """
+        out = []
+        for constraint in edge.path_constraints:
+            match = _UPRIGHT_PATH.fullmatch(" ".join(constraint.split()))
+            if match is None:
+                continue
+            obj, limit = match.group(1), float(match.group(2))
+            info = self.objects.get(obj)
+            holders = _holders(before, obj)
+            if info is None or not kb.is_tall(info) or len(holders) != 1 or _holders(after, obj) != holders:
+                continue
+            out.append(self._slipped(edge, before, holders[0], obj, limit))
+        return out
 
     def _aimed_at(self, graph: TaskGraph, edge: Edge, account: Account, held: list[str]) -> list[str]:
         """Objects the edge aims at (or keeps a pose relative to) whose pose its target constrains."""
@@ -452,11 +490,7 @@ class Arranger:
                 entry = f"{edge.id}_r_{obj}_lost_unforeseen"
                 branch = (mode.model_copy(update={"name": f"{obj}_lost_unforeseen", "recovery": entry}), recovery.model_copy(update={"id": entry}))
             elif info is not None and kb.is_tall(info) and tilt_deg(current[obj].axis) > 15.0 and before[arm].holding == obj:
-                steps: list[Step] = [{arm: ActionCall(fn="place", args={"obj": obj})}, {arm: _regrasp(before, arm, obj)}]
-                steps += _replay_then_edge(before, edge, {arm})
-                recovery = Edge(id=f"{edge.id}_r_{obj}_slipped", source=edge.source, target=edge.target, kind="recovery", actions=steps)
-                mode = FailureMode(name=f"{obj}_slipped", monitor=f"holding({arm}, {obj}) * tipped({obj}, 15)", window=kb.WINDOW, intent="reseat", recovery=recovery.id)
-                branch = (mode, recovery)
+                branch = self._slipped(edge, before, arm, obj, 15.0)
             if branch:
                 break
         if branch is None:
