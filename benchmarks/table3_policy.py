@@ -14,8 +14,8 @@ Both train the same lerobot ACT policy (inputs ``observation.state`` + ``observa
 no images) for the same number of steps, and each is evaluated over 50 trials (seeds 5000..5049,
 disjoint from the training seeds) in ``agentchord/SingleArmPourWater-v0`` with ``disturb="shift"``.
 
-Runs in a side virtual environment with lerobot 0.4.x and a CPU torch (docs/data.md, "The Table III
-experiment"); stage by stage, each stage skipping what is already on disk:
+Needs the learning stack (``make install-test``: torch and lerobot 0.4.x in ``.venv``; docs/data.md,
+"The Table III experiment"); stage by stage, each stage skipping what is already on disk:
 
     python benchmarks/table3_policy.py record --out OUT
     python benchmarks/table3_policy.py train --set A --out OUT      (and --set B)
