@@ -118,6 +118,13 @@ def test_a_tall_object_carried_upright_gets_a_slipped_grasp_branch():
     assert (recovery.source, recovery.target) == ("v1", "v2")
     # The pour tilts the bottle on purpose (no upright path constraint): no slipped branch there.
     assert not any(f.intent == "reseat" for f in out.edge("e3").failures)
+    # However the constraint is spaced (an LLM's graph), and only while the object is held throughout.
+    spaced = nominal_only("single_arm_pour_water")
+    spaced.edge("e2").path_constraints = ["tilt( bottle )-20.5"]
+    spaced.edge("e1").path_constraints = ["tilt(bottle) - 20"]
+    again = Arranger(scene_of("single_arm_pour_water")).arrange(spaced)
+    assert {f.name: f.monitor for f in again.edge("e2").failures}["bottle_slipped"].endswith("tipped(bottle, 20.5)")
+    assert not any(f.intent == "reseat" for f in again.edge("e1").failures)  # grasped during e1: not held throughout
     # Dual-arm pour: the cup carried to its receiving pose, the bottle to the cup.
     dual = Arranger(scene_of("dual_arm_pour_water")).arrange(nominal_only("dual_arm_pour_water"))
     assert "cup_slipped" in {f.name for f in dual.edge("e2").failures}

@@ -66,8 +66,8 @@ class ArmAccount:
 Account = dict[str, ArmAccount]
 
 
-#: An upright path constraint, ``tilt(obj) - X`` (X in degrees).
-_UPRIGHT_PATH = re.compile(r"tilt\((\w+)\) - (\d+(?:\.\d+)?)")
+#: An upright path constraint, ``tilt(obj) - X`` (X in degrees), matched with its spaces removed.
+_UPRIGHT_PATH = re.compile(r"tilt\((\w+)\)-(\d+(?:\.\d+)?)")
 
 
 def _apply(account: Account, step: Step) -> Account:
@@ -336,7 +336,7 @@ class Arranger:
         """
         out = []
         for constraint in edge.path_constraints:
-            match = _UPRIGHT_PATH.fullmatch(" ".join(constraint.split()))
+            match = _UPRIGHT_PATH.fullmatch("".join(constraint.split()))
             if match is None:
                 continue
             obj, limit = match.group(1), float(match.group(2))
