@@ -107,3 +107,27 @@ def test_a_side_grasp_beside_the_arms_own_base_backs_off_less_and_still_holds(po
     assert backed_off < 0.079 or pre[2] > point[2] + 0.02  # a shorter or a higher pre-grasp than the asked one
     status, _ = _run(robot, extractor, grasp)
     assert status == Status.SUCCESS and world.holding("left", "cup")
+
+
+def _placing(frame_objects, **args):
+    from types import SimpleNamespace
+
+    from agentchord.features.frame import make_static_frame
+
+    place = make_action("place", "right", {"obj": "spoon", "target": [0.17, 0.0], "relative_to": "plate", "yaw": 90, **args})
+    frame = make_static_frame(objects={"plate": {"pos": (0.0, 0.5, 0.01), "extent": (0.2, 0.2, 0.02)}, **frame_objects})
+    return place, SimpleNamespace(frame=frame)
+
+
+@pytest.mark.parametrize("spoon,placed", [
+    ({"pos": (0.18, 0.51, 0.01)}, True),                            # 1.4 cm off, along y: placed
+    ({"pos": (0.22, 0.5, 0.01)}, False),                            # 5 cm off
+    ({"pos": (0.17, 0.5, 0.15)}, False),                            # over the spot, in mid-air
+    ({"pos": (0.17, 0.5, 0.01), "axis": (1.0, 0.0, 0.0)}, False),   # on the spot, along x: wrong yaw
+])
+def test_a_place_knows_when_its_object_already_lies_at_the_target(spoon, placed):
+    spoon = {"axis": (0.0, 1.0, 0.0), "extent": (0.005, 0.15, 0.02), **spoon}
+    place, robot = _placing({"spoon": spoon})
+    assert place.lies_at_target(robot) is placed
+    robot.frame.holding = {("right", "spoon")}
+    assert place.lies_at_target(robot) is False  # still in the hand: not placed yet

@@ -65,6 +65,16 @@ def test_a_synchronous_place_finishes_the_other_arm_and_skips_what_is_placed():
     fork = out.edge(next(f.recovery for f in out.edge("e3").failures if f.name == "fork_dropped"))
     last = fork.steps[-1]
     assert last["left"].fn == "place" and last["right"].args.get("skip_if_placed") is True
+    # A fork that fell where it was being put is only let go of: the regrasp and the place may skip.
+    assert fork.steps[0]["left"].args.get("skip_if_placed") is True
+    assert last["left"].args.get("skip_if_placed") is True
+
+
+def test_only_a_regrasp_before_a_place_at_a_target_may_skip_as_placed():
+    out = Arranger(scene_of("single_arm_pour_water")).arrange(nominal_only("single_arm_pour_water"))
+    regrasps = {e.id: e.steps[0]["right"] for e in out.recovery_edges() if e.id.endswith("_bottle_dropped")}
+    assert regrasps["e5_r_bottle_dropped"].args.get("skip_if_placed") is True
+    assert all("skip_if_placed" not in call.args for edge_id, call in regrasps.items() if edge_id != "e5_r_bottle_dropped")
 
 
 def test_a_capsule_carried_in_the_tray_is_watched():

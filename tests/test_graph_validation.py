@@ -183,6 +183,26 @@ def test_action_args_failing_the_catalogue_model() -> None:
     ]
 
 
+def test_a_grasp_skipping_as_placed_needs_a_later_place_at_a_target() -> None:
+    def lone(d: Data) -> None:  # e1 grasps and nothing places the bottle after it
+        _edge(d, "e1")["actions"]["right"]["args"]["skip_if_placed"] = True
+
+    assert _check(lone) == [
+        Problem(
+            "edges[0].actions.right.args.skip_if_placed",
+            "no later place of bottle by the right arm with a target in this edge to tell where it would lie placed",
+        )
+    ]
+
+    def placed(d: Data) -> None:
+        _edge(d, "e5")["actions"] = [
+            {"right": {"fn": "grasp", "args": {"obj": "bottle", "skip_if_placed": True}}},
+            {"right": {"fn": "place", "args": {"obj": "bottle", "target": [0.1, 0.42], "skip_if_placed": True}}},
+        ]
+
+    assert _check(placed) == []
+
+
 def test_empty_steps() -> None:
     def edit(d: Data) -> None:
         _edge(d, "e4")["actions"] = []

@@ -116,10 +116,11 @@ def test_forced_drop_is_recovered_forward(action, after, entry):
     assert result.drops_injected == result.drops_detected == result.drops_recovered == 1
     switch = result.trace.of("recovery_switch")[0]
     assert switch["to"] == entry
-    # Forward-moving: the start node is never revisited; the recovery merges at the failure context.
+    # Forward-moving: the start node is never revisited; the recovery merges at the failure context
+    # (the place's recovery places the block itself and merges after it).
     after_switch = result.path[result.path.index(entry):]
     assert "v0" not in after_switch
-    assert after_switch[1] == {"e2_r_block_dropped": "v1", "e4_r_block_dropped": "v3"}[entry]
+    assert after_switch[1] == {"e2_r_block_dropped": "v1", "e4_r_block_dropped": "v4"}[entry]
 
 
 def test_a_fallen_bar_regrasped_by_its_middle_is_stood_up_and_grasped_high():

@@ -40,3 +40,14 @@ def test_an_arm_switch_whose_busy_hand_already_lost_its_object_goes_on():
     result = run_episode(EpisodeSpec("dual_arm_pour_water", seed=8, protocol=True, disturb=KINDS))
     assert result.success, result.reason
     assert "e3_r_cup_dropped_via_right" in result.path
+
+
+def test_a_recovery_whose_scene_changed_under_it_is_bound_once_more():
+    # Stress protocol, seed 2: the cup drops at its spot and lands placed (the regrasp only opens the
+    # hand); then it is knocked over before the place step, which finds it neither held nor placed.
+    # The recovery is bound again from there and this time takes the cup again.
+    result = run_episode(EpisodeSpec("dual_arm_pour_water", seed=2, protocol=True, disturb=KINDS))
+    assert result.success, result.reason
+    failed = result.trace.of("recovery_failed")
+    assert [f["edge"] for f in failed] == ["e6_r_cup_dropped"]
+    assert result.path.count("e6_r_cup_dropped") == 2

@@ -266,6 +266,8 @@ def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, inst
                 video.announce(f"FAILURE {event['failure']} on {event['edge']}")
             elif event["event"] == "recovery_switch":
                 video.announce(f"RECOVERY -> {event['to']}")
+            elif event["event"] == "failure_cleared":
+                video.announce(f"CLEARED: {', '.join(event['objects'])} held again, {event['edge']} goes on")
             elif event["event"] == "disturbance":
                 video.announce(f"DISTURBANCE: {event['kind']} {event['obj']}", ticks=25)
         recorder["seen"] = len(executor.trace.events)
@@ -412,6 +414,9 @@ def _print_episode(console: Console, result) -> None:
             refused = "".join(f"; not {r['edge']}: {r['reason']}" for r in event["refused"])
             console.print(f"{tick}  [magenta]recovery bound[/magenta] to {event['edge']} ({'+'.join(event['arms'])} arm, "
                           f"waited {event['waited_ticks']} ticks for it to come to rest{refused})")
+        elif kind == "failure_cleared":
+            console.print(f"{tick}  [green]failure cleared[/green]: {event['failure']} on {event['edge']}: "
+                          f"{', '.join(event['objects'])} held again as before, after {event['waited_ticks']} ticks; the edge goes on")
         elif kind == "recovery_failed":
             console.print(f"{tick}  [red]recovery failed[/red]: {event['edge']}: {event['reason']}; trying the next candidate")
         elif kind == "unrecoverable":

@@ -31,6 +31,11 @@ class ActionFailed(Exception):
     """Raised inside a script when the action cannot go on (e.g. nothing to grasp)."""
 
 
+class ObjectGone(ActionFailed):
+    """The object is not where the edge's earlier steps left it (not in the hand to place): the scene
+    changed under the action, rather than the action being unable to do its part."""
+
+
 class ArmAction:
     """One arm's atomic action.
 
@@ -48,12 +53,15 @@ class ArmAction:
         self.args = args
         self.status = Status.INVALID
         self.failure_reason: str | None = None
+        #: Whether it failed with :class:`ObjectGone`.
+        self.object_gone = False
         self._script: Iterator[None] | None = None
 
     def initialise(self, robot: RobotController) -> None:
         """Start (or restart) the action from the robot's current state."""
         self.status = Status.RUNNING
         self.failure_reason = None
+        self.object_gone = False
         self._script = self.script(robot)
 
     def update(self, robot: RobotController) -> Status:
@@ -66,6 +74,7 @@ class ArmAction:
             self.status = Status.SUCCESS
         except ActionFailed as exc:
             self.failure_reason = str(exc)
+            self.object_gone = isinstance(exc, ObjectGone)
             self.status = Status.FAILURE
         return self.status
 

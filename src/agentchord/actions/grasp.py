@@ -7,6 +7,7 @@ robot's current commanded state, so a recovery edge begins wherever the failure 
 from __future__ import annotations
 
 from collections.abc import Iterator
+from typing import Protocol
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -37,6 +38,13 @@ UPRIGHT_TOLERANCE_DEG = 25.0
 MOVED_DURING_APPROACH = 0.01
 #: A closed grasp whose grasp point is farther than this (m) from where the tool aimed is off-centre.
 OFF_CENTRE_TOLERANCE = 0.025
+
+
+class PlacedCheck(Protocol):
+    """What a grasp asks of the place it precedes (:class:`~agentchord.actions.place.Place`)."""
+
+    def lies_at_target(self, robot: RobotController) -> bool:
+        """Whether the object already lies released at the place's target."""
 
 
 class GraspMissed(ActionFailed):
@@ -73,10 +81,19 @@ class Grasp(ArmAction):
     #: None for the asked one; a higher one is only ever taken).
     SIDE_VARIANTS = ((1.0, 0.0, None), (1.0, 0.03, None), (0.5, 0.0, None), (0.5, 0.03, None), (0.5, 0.03, 0.8))
 
+    #: The place of the same object by the same arm later in the edge (set when the edge is compiled):
+    #: with ``skip_if_placed``, a grasp of an object already lying where that place puts it is not made.
+    placed_by: PlacedCheck | None = None
+
     def script(self, robot: RobotController) -> Iterator[None]:
         held = robot.targets[self.arm].grip_closed_settled and robot.frame.is_holding(self.arm, self.args.obj)
         if self.args.skip_if_held and held:
             return  # already grasped (an interrupted synchronous grasp whose other half failed)
+        if self.args.skip_if_placed and self.placed_by is not None and self.placed_by.lies_at_target(robot):
+            # It fell where it was being put: open the hand (the place then only retreats).
+            if robot.targets[self.arm].grip > 0.0:
+                yield from grip(robot, self.arm, 0.0, ticks=8)
+            return
         for attempt in range(self.ATTEMPTS):
             try:
                 yield from self._let_go(robot)

@@ -8,7 +8,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from agentchord.actions import catalog
-from agentchord.actions.base import ActionFailed, ArmAction
+from agentchord.actions.base import ActionFailed, ArmAction, ObjectGone
 from agentchord.actions.controller import RobotController
 from agentchord.actions.geometry import _level, _matrix, _yaw_turn
 from agentchord.actions.grasp import UPRIGHT_TOLERANCE_DEG, Grasp
@@ -28,6 +28,12 @@ LEVEL_CLEARANCE = 0.02
 RELEASE_MARGIN = 0.02
 #: Height (m) by which a placed object clears the top of the object it is placed relative to.
 RIM_CLEARANCE = 0.02
+#: A released object whose centre is within this (m, horizontally) of the place's target, and whose
+#: long axis is within PLACED_YAW_DEG of the asked yaw, lies placed (the task graphs' sub-goal tolerances).
+PLACED_TOLERANCE = 0.03
+PLACED_YAW_DEG = 20.0
+#: ... resting: its lower end below this height (m) (on the table, or on a tray or plate).
+PLACED_HEIGHT = 0.05
 
 
 def _long_axis(feats) -> np.ndarray:
@@ -51,7 +57,7 @@ class Place(ArmAction):
     def script(self, robot: RobotController) -> Iterator[None]:
         arm = self.arm
         if not robot.frame.is_holding(arm, self.args.obj):
-            if self.args.skip_if_placed and self._standing(robot):
+            if self.args.skip_if_placed and (self._standing(robot) or self.lies_at_target(robot)):
                 yield from self._release_and_retreat(robot)
                 return
             for _ in range(self.DROP_GRACE_TICKS):
@@ -63,7 +69,7 @@ class Place(ArmAction):
                     # Only a free hand was asked for, and the hand is free: the object fell on its own.
                     yield from self._release_and_retreat(robot)
                     return
-                raise ActionFailed(f"{self.args.obj} is not held: nothing to place")
+                raise ObjectGone(f"{self.args.obj} is not held: nothing to place")
         if self.args.relative_to is not None and self.args.within_reach is None:
             # A pushed reference may still be sliding: aim at where it stops.
             yield from wait_for_rest(robot, self.args.relative_to)
@@ -152,6 +158,36 @@ class Place(ArmAction):
         if float(np.max(feats.extent)) < POINT_EXTENT:
             return True  # a point feature (a cloth's corner) released is placed wherever it lies
         return tilt_deg(feats.axis) <= UPRIGHT_TOLERANCE_DEG and min(feats.bottom[2], feats.top[2]) < 0.01
+
+    def lies_at_target(self, robot: RobotController) -> bool:
+        """Whether the object already lies released where this place puts it (a drop that finished it).
+
+        At rest low on the table (or on the object it is placed on), its centre within
+        :data:`PLACED_TOLERANCE` of the target, its long axis at the asked yaw, and a tall object upright.
+        """
+        args = self.args
+        if args.target is None or args.within_reach is not None:
+            return False
+        frame = robot.frame
+        if any(frame.is_holding(arm, args.obj) for arm in frame.arms):
+            return False
+        feats = frame.objects[args.obj]
+        target = np.asarray(args.target, dtype=float)
+        if args.relative_to is not None:
+            target = target + frame.objects[args.relative_to].pos[:2]
+        if float(np.linalg.norm(feats.pos[:2] - target)) > PLACED_TOLERANCE:
+            return False
+        if min(feats.bottom[2], feats.top[2]) > PLACED_HEIGHT:
+            return False
+        tall = float(np.linalg.norm(feats.top - feats.bottom)) >= Grasp.SIDE_MIN_HEIGHT
+        if tall and tilt_deg(feats.axis) > UPRIGHT_TOLERANCE_DEG:
+            return False
+        if args.yaw is not None:
+            axis = _long_axis(feats)
+            off = (np.degrees(np.arctan2(axis[1], axis[0])) - args.yaw) % 180.0
+            if min(off, 180.0 - off) > PLACED_YAW_DEG:
+                return False
+        return True
 
     def _release_and_retreat(self, robot: RobotController) -> Iterator[None]:
         """Open (if still closed) and back off from where the tool is: the rest of an interrupted place."""

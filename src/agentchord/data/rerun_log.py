@@ -32,6 +32,7 @@ EVENT_LEVELS = {
     "failure_detected": "ERROR",
     "recovery_switch": "WARN",
     "recovery_merged": "INFO",
+    "failure_cleared": "INFO",
     "recovery_failed": "ERROR",
     "repair": "INFO",
     "unrecoverable": "CRITICAL",

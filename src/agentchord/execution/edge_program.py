@@ -37,6 +37,10 @@ class EdgeProgram:
         self.kind = kind
         self.step_index = 0
         self.failure_reason: str | None = None
+        #: 1 for a program's first run; a recovery bound again after the scene changed under it is its 2nd.
+        self.attempt = 1
+        #: Whether it failed because an object was not where an earlier step left it (:class:`ObjectGone`).
+        self.scene_changed = False
         self.on_action_start: ActionHook = lambda arm, action: None
         self.on_action_end: ActionHook = lambda arm, action: None
 
@@ -44,6 +48,7 @@ class EdgeProgram:
     def from_edge(cls, edge: Edge) -> EdgeProgram:
         """Compile a graph edge's steps into arm actions."""
         steps = [[make_action(call.fn, arm, call.args) for arm, call in step.items() if call is not None] for step in edge.steps]
+        _link_grasps_to_places(steps)
         return cls(edge.id, edge.target, steps, edge.kind)
 
     @property
@@ -74,6 +79,7 @@ class EdgeProgram:
             if Status.FAILURE in statuses:
                 failed = next(a for a in self.running if a.status == Status.FAILURE)
                 self.failure_reason = f"{failed.describe()}: {failed.failure_reason}"
+                self.scene_changed = failed.object_gone
                 self.terminate(Status.INVALID)
                 return Status.FAILURE
             if Status.RUNNING in statuses:
@@ -90,6 +96,17 @@ class EdgeProgram:
             if action.status == Status.RUNNING:
                 action.terminate(new_status)
                 self.on_action_end(action.arm, action)
+
+
+def _link_grasps_to_places(steps: list[list[ArmAction]]) -> None:
+    """Give each grasp the later place of its object by its arm (for ``skip_if_placed``)."""
+    for i, step in enumerate(steps):
+        for action in step:
+            if action.name != "grasp":
+                continue
+            later = (a for s in steps[i + 1:] for a in s
+                     if a.name == "place" and a.arm == action.arm and a.args.obj == action.args.obj)
+            action.placed_by = next(later, None)
 
 
 class ReturnToKeyframe(ArmAction):

@@ -24,6 +24,7 @@ from agentchord.actions.catalog import ACTIONS
 from agentchord.actions.controller import RobotController
 from agentchord.agents.exceptions import ReasonerError
 from agentchord.agents.reasoner import UnanticipatedFailure
+from agentchord.execution.binding import Binding, HoldMemory
 from agentchord.execution.edge_program import EdgeProgram
 from agentchord.execution.feasibility import FeasibilityChecker, first_grasps, off_table
 from agentchord.execution.harness import Disturbance, DisturbanceEvent, SuccessTracker
@@ -61,32 +62,6 @@ class ExecutorConfig:
 
 #: Prefix of the reason of an episode that ended because no arm can take an object any more.
 UNRECOVERABLE = "unrecoverable"
-#: Object speed (m/s) under which it counts as at rest, and for how many ticks in a row.
-REST_SPEED = 0.03
-REST_TICKS = 10
-#: Height (m) under which an object's lower axis end must be to count as resting on the table.
-RESTING_HEIGHT = 0.05
-
-
-@dataclass
-class Binding:
-    """A recovery waiting to bind its arm: the candidates (entry edge, then its alternatives).
-
-    Attributes:
-        candidates: Programs to try in order.
-        objects: What their first grasps take: bound once these are at rest.
-        since: Tick the recovery began.
-        previous: Object positions at the last tick (for their speed).
-        still: Ticks in a row every object has been at rest.
-    """
-
-    candidates: list[EdgeProgram]
-    objects: list[str]
-    since: int
-    previous: dict[str, np.ndarray] = field(default_factory=dict)
-    still: int = 0
-
-
 @dataclass
 class EpisodeResult:
     """What an episode did: the metrics of DESIGN section 7.
@@ -211,6 +186,8 @@ class Executor:
         self.path: list[str] = []
         self.program: EdgeProgram | None = None
         self.binding: Binding | None = None
+        # Where each held object sits in its hand: a hold that comes back the same clears a drop.
+        self.holds = HoldMemory()
         # Candidates after the bound recovery, tried if it fails outright; cleared when another edge starts.
         self._fallbacks: list[EdgeProgram] = []
         self._off_table_since: dict[str, int] = {}
@@ -308,7 +285,7 @@ class Executor:
             wall_s=time.perf_counter() - wall0,
             path=self.path,
             failures_detected=len(self.trace.of("failure_detected")),
-            recoveries=len(self.trace.of("recovery_switch")),
+            recoveries=len(self.trace.of("recovery_switch")) - len(self.trace.of("failure_cleared")),
             repairs=sum(e["accepted"] for e in self.trace.of("repair")),
             drops_injected=sum(e.kind == "drop" for e in injected),
             drops_detected=sum(e.kind == "drop" for e in self._detected),
@@ -332,6 +309,7 @@ class Executor:
     def _tick(self) -> tuple[bool, str] | None:
         frame = self.extractor.update()
         self.tracker.observe(frame)
+        self.holds.observe(frame)
         if self.disturbance is not None:
             event = self.disturbance.apply(self.world, frame)
             if event is not None:
@@ -364,6 +342,13 @@ class Executor:
         if self.program is not None:
             status = self.program.update(self.robot)
             if status == Status.FAILURE:
+                program = self.program
+                if program.kind == "recovery" and program.attempt == 1 and program.scene_changed:
+                    # What it had found done was undone under it (a cup found placed, then knocked over
+                    # before its place step): bound once more from where things are, then the rest.
+                    again = EdgeProgram.from_edge(self.graph.edge(program.edge_id))
+                    again.attempt = 2
+                    self._fallbacks.insert(0, again)
                 detection = None if self._fallbacks else self.strategy.on_program_failure(self, self.program)
                 if detection is not None:
                     # The skill reported failure: a strategy that re-plans takes it as a detected failure.
@@ -427,17 +412,15 @@ class Executor:
     def _bind(self, frame: FeatureFrame) -> tuple[bool, str] | None:
         """One tick of a binding recovery: wait for rest, then start the first feasible candidate."""
         binding = self.binding
-        speeds = [np.linalg.norm(frame.objects[o].pos - binding.previous[o]) * CONTROL_HZ
-                  for o in binding.objects if o in binding.previous]
-        binding.previous = {o: frame.objects[o].pos.copy() for o in binding.objects}
-        # At rest on the table: still, and low (a hand pausing mid-air is not a resting place).
-        low = all(min(frame.objects[o].bottom[2], frame.objects[o].top[2]) < RESTING_HEIGHT for o in binding.objects)
-        at_rest = len(speeds) == len(binding.objects) and max(speeds) < REST_SPEED and low
-        binding.still = binding.still + 1 if at_rest else 0
         waited = self.world.tick - binding.since
-        if binding.still < REST_TICKS and waited < self.config.bind_wait_ticks:
+        if binding.holds_back(frame):
+            self._resume(binding)
+            return None
+        if not binding.at_rest(frame, CONTROL_HZ) and waited < self.config.bind_wait_ticks:
             return None
         self.binding = None
+        if binding.suspended is not None:
+            binding.suspended.terminate(Status.INVALID)
         refused = []
         for k, candidate in enumerate(binding.candidates):
             problems = self.feasibility.check_program(candidate)
@@ -454,6 +437,25 @@ class Executor:
             if outcome is not None:
                 return outcome
         return False, f"no feasible recovery for {', '.join(binding.objects)} at {self.feasibility.where(binding.objects[0])}: {summary}"
+
+    def _resume(self, binding: Binding) -> None:
+        """The lost holds came back as they were: the failure cleared, the interrupted edge goes on."""
+        self.binding = None
+        program = binding.suspended
+        self.program = program
+        edge_monitors = self.monitors.get(program.edge_id)
+        self.armed = edge_monitors if edge_monitors is not None and edge_monitors.monitors else None
+        if self.armed is not None:
+            self.armed.reset()
+        self.recovering_from = binding.recovering_from
+        # A cleared failure cost nothing: it does not count against the mode's failure budget.
+        self.fire_counts[(program.edge_id, binding.failure)] -= 1
+        if self.recovering_from is None:  # nothing else is being recovered: this disturbance is over
+            self._recovered.extend(self._unmerged)
+            self._unmerged = []
+        self.trace.add(self.world.tick, "failure_cleared", edge=program.edge_id, failure=binding.failure,
+                       waited_ticks=self.world.tick - binding.since,
+                       objects=[h.obj for h in binding.lost])
 
     # ------------------------------------------------------- transitions
     def _arrive(self, node_id: str) -> tuple[bool, str] | None:
@@ -561,21 +563,35 @@ class Executor:
             self._open_disturbance = None
         if self.fire_counts[key] > self.config.failure_budget:
             return False, f"failure budget exhausted: {detection.failure.name} on {detection.edge_id} fired {self.fire_counts[key]} times"
-        if self.program is not None:  # None after an online repair: the failed edge had ended
-            self.program.terminate(Status.INVALID)
-            self.program = None
+        interrupted, self.program = self.program, None  # None after an online repair: the failed edge had ended
+        resumable = interrupted is not None and self.strategy.resumes_cleared_failures
+        if interrupted is not None and not resumable:
+            interrupted.terminate(Status.INVALID)
         failed_nominal = self.recovering_from or detection.edge_id
         candidates = self.strategy.recover(self, detection)
+        lost = None
+        if resumable:
+            # A hold lost by the interrupted edge's arms may come back while the recovery waits.
+            objects = sorted({g.args.obj for c in candidates for g in first_grasps(c)})
+            lost = self.holds.lost(self.frame, {a.arm for a in interrupted.running}, objects) if objects else None
+            if lost is None:
+                interrupted.terminate(Status.INVALID)
         if not candidates:
             return False, f"no recovery for {detection.failure.name} on {detection.edge_id}"
-        self.recovering_from = failed_nominal
+        previous_context, self.recovering_from = self.recovering_from, failed_nominal
         if disturbance is not None:
             # Seconds from the disturbance to this switch: robot time plus the reasoning charged since.
             self._reaction_s.append((self.world.tick - disturbance.tick) / CONTROL_HZ + self.reasoning_s - self._reasoning_at_disturbance)
         self.trace.add(self.world.tick, "recovery_switch", failure=detection.failure.name, edge=detection.edge_id,
                        to=candidates[0].edge_id, alternatives=[c.edge_id for c in candidates[1:]],
                        strategy=self.strategy.name, latency_ticks=self.world.tick - detection.onset_tick)
-        return self._begin_recovery(candidates)
+        outcome = self._begin_recovery(candidates)
+        if lost is not None:
+            # The recovery waits for what fell; if it was never really let go, the edge goes on.
+            self.binding.suspended, self.binding.lost = interrupted, lost
+            self.binding.failure, self.binding.recovering_from = detection.failure.name, previous_context
+            self.binding.window = detection.failure.window
+        return outcome
 
     def _repair(self, program: EdgeProgram) -> Detection | None:
         """Online repair of an unanticipated failure at the end of ``program``.

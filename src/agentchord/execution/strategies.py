@@ -30,6 +30,10 @@ class RecoveryStrategy:
     name = "base"
     #: Whether the active edge's compiled monitors are armed (the baselines that ask a VQA model do not).
     uses_monitors = True
+    #: Whether a lost hold that comes back as it was, while the recovery waits for what fell, lets the
+    #: interrupted edge go on (``execution.binding``). Only where the recovery is a branch of the same
+    #: graph: a re-plan has replaced the graph already, a backtrack does not wait.
+    resumes_cleared_failures = False
     #: The latency model; None charges no reasoning (``run``, ``demo``: robot time only).
     reasoning: ReasoningConfig | None = None
     #: The reasoner calls that planned this episode's graph (none: a library graph, modelled).
@@ -75,6 +79,7 @@ class AgentChordStrategy(RecoveryStrategy):
     """
 
     name = "agentchord"
+    resumes_cleared_failures = True
 
     def recover(self, executor: Executor, detection: Detection) -> list[EdgeProgram]:
         candidates = executor.recovery_map.candidates(detection.edge_id, detection.failure.name)

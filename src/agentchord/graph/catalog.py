@@ -42,6 +42,11 @@ class GraspArgs(_Args):
     skip_if_held: bool = Field(
         False, description="If the arm already holds obj with a closed grip, do nothing (finish an interrupted synchronous grasp)."
     )
+    skip_if_placed: bool = Field(
+        False,
+        description="If obj is not held and already lies where the edge's next place of it (same arm) puts it, only open the "
+        "hand: a drop that finished the place (that place, with skip_if_placed, then only retreats).",
+    )
     reseat: bool = Field(
         False,
         description="A fallen object, once set upright in hand, is put down upright, the arm goes home and grasps it again "
@@ -83,7 +88,8 @@ class PlaceArgs(_Args):
     )
     skip_if_placed: bool = Field(
         False,
-        description="If obj is not held but already stands upright on the table, only open and retreat (finish an interrupted synchronous place).",
+        description="If obj is not held but already stands upright on the table, or lies released at target (within 3 cm, "
+        "at yaw), only open and retreat (finish an interrupted synchronous place, or one a drop finished).",
     )
     free_hand: bool = Field(
         False,

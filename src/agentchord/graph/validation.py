@@ -208,7 +208,20 @@ def _check_actions(graph: TaskGraph) -> list[Problem]:
                     )
                 if call is not None:
                     problems += _check_call(f"{base}.{arm}", call, graph.objects)
+                if call is not None and call.fn == "grasp" and call.args.get("skip_if_placed") and not _placed_later(edge, s, arm, call):
+                    problems.append(Problem(f"{base}.{arm}.args.skip_if_placed",
+                                            f"no later place of {call.args.get('obj')} by the {arm} arm with a target in this edge "
+                                            "to tell where it would lie placed"))
     return problems
+
+
+def _placed_later(edge: Edge, s: int, arm: str, grasp: ActionCall) -> bool:
+    """Whether a step after ``s`` places the grasped object with the same arm at a target."""
+    for step in edge.steps[s + 1:]:
+        call = step.get(arm)
+        if call is not None and call.fn == "place" and call.args.get("obj") == grasp.args.get("obj"):
+            return call.args.get("target") is not None
+    return False
 
 
 def _check_call(path: str, call: ActionCall, objects: list[str]) -> list[Problem]:

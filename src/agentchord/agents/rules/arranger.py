@@ -121,13 +121,21 @@ def _with_skips(call: ActionCall) -> ActionCall:
     return call
 
 
-def _regrasp(account: Account, arm: str, obj: str, tall: bool = False, skip_if_held: bool = True) -> ActionCall:
+def _places_at_target(edge: Edge, arm: str, obj: str) -> bool:
+    """Whether ``edge`` has ``arm`` put ``obj`` down at a target (a drop there may finish the place)."""
+    return any(c.fn == "place" and c.args.get("obj") == obj and c.args.get("target") is not None for c in _calls(edge, arm))
+
+
+def _regrasp(account: Account, arm: str, obj: str, tall: bool = False, skip_if_held: bool = True,
+             skip_if_placed: bool = False) -> ActionCall:
     grasp = account[arm].grasp
     args = dict(grasp.args) if grasp is not None and grasp.args.get("obj") == obj else {"obj": obj}
     if tall and args.get("mode", "auto") != "top":
         # A tall object that fell is taken again from its side once upright: the nominal hold,
         # not the off-centre fallen-object hold (a pour or an upright place needs it).
         args["reseat"] = True
+    if skip_if_placed:  # fallen where the edge was putting it: only let go (the replayed place does)
+        args["skip_if_placed"] = True
     return ActionCall(fn="grasp", args={**args, "skip_if_held": skip_if_held})
 
 
@@ -309,7 +317,8 @@ class Arranger:
             tall = obj in self.objects and kb.is_tall(self.objects[obj])
             # Carried by two arms and lost by one, it hangs from the other: both let go (a grasp opens
             # first), so it lands flat, and both take it again.
-            regrasp: Step = {a: _regrasp(before, a, obj, tall, skip_if_held=len(at_s) < 2) for a in at_s}
+            regrasp: Step = {a: _regrasp(before, a, obj, tall, skip_if_held=len(at_s) < 2,
+                                         skip_if_placed=_places_at_target(edge, a, obj)) for a in at_s}
             # An arm of this edge with empty hands gets out of the way while the object is taken again.
             regrasp.update({a: ActionCall(fn="back") for a in busy if a not in at_s and before[a].holding is None})
             steps = [regrasp, *_replay_then_edge(before, edge, at_s or busy)]
