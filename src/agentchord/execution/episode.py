@@ -11,11 +11,12 @@ from agentchord.agents.reasoner import Scene
 from agentchord.agents.rules.goals import GoalSpec
 from agentchord.execution.baselines.progress import GoalEvents
 from agentchord.execution.baselines.strategies import BaselineContext
-from agentchord.execution.executor import EpisodeResult, Executor, ExecutorConfig
+from agentchord.execution.executor import Executor, ExecutorConfig
 from agentchord.execution.harness import SuccessTracker
 from agentchord.execution.methods import is_baseline, make_method
 from agentchord.execution.reasoning import ReasoningConfig
 from agentchord.execution.repair import Repairer
+from agentchord.execution.result import EpisodeResult
 from agentchord.graph.grounding import require_runnable
 from agentchord.graph.models import TaskGraph
 from agentchord.tasks import load_task_graph

@@ -5,7 +5,9 @@ the active edge's compiled monitors, and on a persistent violation switch at
 once to what the recovery strategy says -- for AgentChord a pre-compiled
 forward-moving recovery edge that starts from the robot's current state, for
 the backtracking ablation a return to an earlier node's keyframe. Budgets end
-an episode as a failure with a reason, never as a hang. With a repairer, an edge
+an episode as a failure with a reason, never as a hang. A recovery that must wait for what fell
+to come to rest keeps the interrupted edge suspended: if the lost hold comes back as it was, the
+failure has cleared and the edge resumes (:mod:`agentchord.execution.binding`). With a repairer, an edge
 that ends short of its target's constraints with no monitor fired (a failure
 nobody anticipated) is repaired online: the graph gains one branch, the compiled
 artefacts are rebuilt and the new recovery edge starts at once.
@@ -15,7 +17,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -29,6 +31,7 @@ from agentchord.execution.edge_program import EdgeProgram
 from agentchord.execution.feasibility import FeasibilityChecker, first_grasps, off_table
 from agentchord.execution.harness import Disturbance, DisturbanceEvent, SuccessTracker
 from agentchord.execution.repair import RepairRejectedError, Repairer, validate_repair
+from agentchord.execution.result import UNRECOVERABLE, EpisodeResult
 from agentchord.execution.strategies import RecoveryStrategy
 from agentchord.execution.trace import Trace
 from agentchord.expr import Vocabulary, compile_expr
@@ -58,81 +61,6 @@ class ExecutorConfig:
     off_table_ticks: int = 5
     #: Ticks a recovery waits for the objects it grasps to come to rest before binding its arm.
     bind_wait_ticks: int = 100
-
-
-#: Prefix of the reason of an episode that ended because no arm can take an object any more.
-UNRECOVERABLE = "unrecoverable"
-@dataclass
-class EpisodeResult:
-    """What an episode did: the metrics of DESIGN section 7.
-
-    ``drops_*`` count the paper's drop disturbance; ``disturbances`` maps every injected
-    kind to [injected, detected, recovered]. Reaction latencies are ticks from a
-    disturbance to the first detection after it. ``repairs`` counts accepted online repairs.
-    """
-
-    success: bool
-    reason: str
-    steps: int
-    time_s: float
-    wall_s: float
-    path: list[str]
-    failures_detected: int
-    recoveries: int
-    repairs: int
-    drops_injected: int
-    drops_detected: int
-    drops_recovered: int
-    reaction_latency_ticks: list[int]
-    disturbances: dict[str, list[int]]
-    trace: Trace = field(repr=False)
-    #: Measured wall time of the planner's own work during the episode (re-plans, repairs).
-    compute_s: float = 0.0
-    #: Reasoning latency charged: modelled per call offline, measured for a real LLM.
-    reasoning_s: float = 0.0
-    #: Reasoning calls by kind (``plan``, ``vqa``, ``vlm``).
-    reasoning_calls: dict[str, int] = field(default_factory=dict)
-    #: Seconds from each detected disturbance to the start of its recovery, reasoning included.
-    reaction_latency_s: list[float] = field(default_factory=list)
-    #: Re-plans made (the re-planning baselines).
-    replans: int = 0
-
-    @property
-    def exec_time_s(self) -> float:
-        """Execution time: robot time + measured compute + reasoning latency (DESIGN section 6)."""
-        return self.time_s + self.compute_s + self.reasoning_s
-
-    @property
-    def unrecoverable(self) -> bool:
-        """Whether it ended because an object was beyond every arm (off the table, out of reach)."""
-        return self.reason.startswith(UNRECOVERABLE)
-
-    def summary(self) -> dict:
-        """The JSON summary of ``agentchord run --json``."""
-        return {
-            "success": self.success,
-            "reason": self.reason,
-            "steps": self.steps,
-            "time_s": round(self.time_s, 3),
-            "wall_s": round(self.wall_s, 3),
-            "failures_detected": self.failures_detected,
-            "recoveries": self.recoveries,
-            "repairs": self.repairs,
-            "drops_injected": self.drops_injected,
-            "drops_detected": self.drops_detected,
-            "drops_recovered": self.drops_recovered,
-            "reaction_latency_ticks": self.reaction_latency_ticks,
-            "reaction_latency_s": [round(x, 3) for x in self.reaction_latency_s],
-            "exec_time_s": round(self.exec_time_s, 3),
-            "robot_time_s": round(self.time_s, 3),
-            "compute_s": round(self.compute_s, 3),
-            "reasoning_s": round(self.reasoning_s, 3),
-            "reasoning_calls": dict(self.reasoning_calls),
-            "replans": self.replans,
-            "disturbances": self.disturbances,
-            "unrecoverable": self.unrecoverable,
-            "path": self.path,
-        }
 
 
 class Executor:
