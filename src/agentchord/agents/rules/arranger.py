@@ -1,8 +1,8 @@
 """The offline arranger: failure modes, monitors and forward-moving recovery branches (Sec. III-C).
 
 Works on any nominal graph, the composer's or a hand-written one: it walks the nominal
-path and keeps a symbolic account of the atomic actions' effects (who holds what, which
-motions since the last grasp, what each arm's pose is relative to). For each nominal edge
+path and keeps a symbolic account of the atomic actions' effects (:mod:`.accounts`: who holds
+what, which motions since the last grasp, what each arm's pose is relative to). For each nominal edge
 ``e: s -> t`` it predicts, from what the edge does and that account:
 
 - a held object can drop or slip (Eq. 16-17): ``regrasp`` where it fell, restore the arm's
@@ -25,92 +25,34 @@ and recovery places skip an object already placed (an interrupted two-arm step).
 
 from __future__ import annotations
 
-import copy
 import re
 from collections.abc import Iterable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from agentchord.agents.reasoner import Scene, SceneObject, UnanticipatedFailure
 from agentchord.agents.rules import knowledge as kb
+from agentchord.agents.rules.accounts import (
+    ARMS,
+    RELATIVE,
+    Account,
+    ArmAccount,
+    apply_step,
+    calls_of,
+    cancel_undone,
+    holders_of,
+    side_by_side,
+)
 from agentchord.agents.rules.arm_switch import add_arm_switch_alternatives
 from agentchord.features.frame import tilt_deg
 from agentchord.graph.models import ActionCall, Edge, FailureMode, Step, TaskGraph
 from agentchord.graph.progress import forward_filter, nominal_path
 
-ARMS = ("left", "right")
 #: Ticks a placed relation must stay broken before it counts (a released cloth settles).
 MISPLACED_WINDOW = 10
 #: Tilt (deg) of a placed upright object beyond which it leans (the placed constraints allow 10).
 PLACED_TILT_DEG = 10.0
-ABSOLUTE = frozenset({"move_to_obj", "move_to_target", "place", "grasp", "back"})
-RELATIVE = frozenset({"rotate_eef", "move_by_offset"})
-
-
-@dataclass
-class ArmAccount:
-    """What one arm is doing at a node of the nominal path.
-
-    Attributes:
-        holding: Object held, if any.
-        grasp: The call that took it (``None`` when it was taken from the other arm).
-        since_grasp: Motions since the grasp that set the held object's pose (to replay).
-        relative_to: Object the arm's last absolute motion aimed at.
-    """
-
-    holding: str | None = None
-    grasp: ActionCall | None = None
-    since_grasp: list[ActionCall] = field(default_factory=list)
-    relative_to: str | None = None
-
-
-Account = dict[str, ArmAccount]
-
-
 #: An upright path constraint, ``tilt(obj) - X`` (X in degrees), matched with its spaces removed.
 _UPRIGHT_PATH = re.compile(r"tilt\((\w+)\)-(\d+(?:\.\d+)?)")
-
-
-def _apply(account: Account, step: Step) -> Account:
-    """The account after one step (both arms' calls of the step)."""
-    after = copy.deepcopy(account)
-    for arm, call in step.items():
-        if call is None:
-            continue
-        me = after[arm]
-        args = call.args
-        if call.fn == "grasp":
-            # Taken from the other arm (a handover) only if it held it before this step: a two-arm grasp is not.
-            taken = any(account[a].holding == args["obj"] for a in ARMS if a != arm)
-            me.holding, me.grasp, me.since_grasp, me.relative_to = args["obj"], (None if taken else call), [], None
-        elif call.fn == "place" or call.fn == "open_gripper":
-            me.holding, me.grasp, me.since_grasp, me.relative_to = None, None, [], None
-        elif call.fn == "back":
-            me.since_grasp, me.relative_to = [], None
-        elif call.fn in ("move_to_obj", "move_to_target"):
-            me.since_grasp = [call] if me.holding else []
-            me.relative_to = args.get("obj")
-        elif call.fn in RELATIVE and me.holding:
-            me.since_grasp = _cancel([*me.since_grasp, call])
-    return after
-
-
-def _cancel(calls: list[ActionCall]) -> list[ActionCall]:
-    """Drop a rotation undone by the next one (tilt, then tilt back)."""
-    out: list[ActionCall] = []
-    for call in calls:
-        if out and call.fn == "rotate_eef" and out[-1].fn == "rotate_eef" and abs(out[-1].args["angle"] + call.args["angle"]) < 1e-6:
-            out.pop()
-        else:
-            out.append(call)
-    return out
-
-
-def _holders(account: Account, obj: str) -> list[str]:
-    return [a for a in ARMS if account[a].holding == obj]
-
-
-def _calls(edge: Edge, arm: str) -> list[ActionCall]:
-    return [step[arm] for step in edge.steps if step.get(arm) is not None]
 
 
 def _with_skips(call: ActionCall) -> ActionCall:
@@ -123,7 +65,7 @@ def _with_skips(call: ActionCall) -> ActionCall:
 
 def _places_at_target(edge: Edge, arm: str, obj: str) -> bool:
     """Whether ``edge`` has ``arm`` put ``obj`` down at a target (a drop there may finish the place)."""
-    return any(c.fn == "place" and c.args.get("obj") == obj and c.args.get("target") is not None for c in _calls(edge, arm))
+    return any(c.fn == "place" and c.args.get("obj") == obj and c.args.get("target") is not None for c in calls_of(edge, arm))
 
 
 def _regrasp(account: Account, arm: str, obj: str, tall: bool = False, skip_if_held: bool = True,
@@ -139,27 +81,21 @@ def _regrasp(account: Account, arm: str, obj: str, tall: bool = False, skip_if_h
     return ActionCall(fn="grasp", args={**args, "skip_if_held": skip_if_held})
 
 
-def _sequence(per_arm: dict[str, list[ActionCall]]) -> list[Step]:
-    """Steps that run each arm's calls in order, the arms side by side."""
-    longest = max((len(c) for c in per_arm.values()), default=0)
-    return [{arm: calls[k] for arm, calls in per_arm.items() if k < len(calls)} for k in range(longest)]
-
-
 def _replay_then_edge(account: Account, edge: Edge, arms: Iterable[str]) -> list[Step]:
     """Restore each arm's relative motions since its grasp where ``edge`` continues them, then ``edge`` again."""
     prefix: dict[str, list[ActionCall]] = {}
     stripped: set[str] = set()
     for arm in arms:
-        mine = _calls(edge, arm)
+        mine = calls_of(edge, arm)
         history = account[arm].since_grasp
         if not mine or mine[0].fn not in RELATIVE or not history:
             continue
-        remaining = _cancel([*history, *mine])
+        remaining = cancel_undone([*history, *mine])
         if len(remaining) < len(history):  # the edge undoes earlier motions: replay what is left, skip the edge's part
             prefix[arm], _ = remaining, stripped.add(arm)
         else:
             prefix[arm] = history
-    steps = _sequence(prefix)
+    steps = side_by_side(prefix)
     for step in edge.steps:
         kept = {a: _with_skips(c) for a, c in step.items() if c is not None and a not in stripped}
         if kept:
@@ -213,7 +149,7 @@ class Arranger:
             edge = graph.edge(edge_id)
             out[edge_id] = account
             for step in edge.steps:
-                account = _apply(account, step)
+                account = apply_step(account, step)
         return out
 
     # --- one edge ----------------------------------------------------------------------
@@ -222,7 +158,7 @@ class Arranger:
         """Failure modes of one nominal edge and their recovery entry edges."""
         after = account
         for step in edge.steps:
-            after = _apply(after, step)
+            after = apply_step(after, step)
         out = []
         held = [o for o in dict.fromkeys([a.holding for a in account.values()] + [a.holding for a in after.values()]) if o]
         for obj in held:
@@ -273,7 +209,7 @@ class Arranger:
         out: list[tuple[FailureMode, Edge]] = []
         if len(singles) == 2 and singles[0][2] != singles[1][2]:
             (m1, _, a1, s1), (m2, _, a2, s2) = singles
-            both = _sequence({a1: [c for st in s1 for c in st.values()], a2: [c for st in s2 for c in st.values()]})
+            both = side_by_side({a1: [c for st in s1 for c in st.values()], a2: [c for st in s2 for c in st.values()]})
             entry = f"{edge.id}_r_both_misplaced"
             monitor = f"min({m1.monitor}, {m2.monitor})"
             out.append((FailureMode(name="both_misplaced", monitor=monitor, window=MISPLACED_WINDOW, intent="re-place", recovery=entry),
@@ -298,11 +234,11 @@ class Arranger:
                         placed[call.args["obj"]] = (call.args["relative_to"], arm, account[arm].grasp, call, list(account[arm].since_grasp))
                     elif call is not None and call.fn == "grasp":
                         placed.pop(call.args["obj"], None)
-                account = _apply(account, step)
+                account = apply_step(account, step)
         return placed
 
     def _drop(self, edge: Edge, before: Account, after: Account, obj: str) -> tuple[FailureMode, Edge]:
-        at_s, at_t = _holders(before, obj), _holders(after, obj)
+        at_s, at_t = holders_of(before, obj), holders_of(after, obj)
         if at_s and at_t and at_s != at_t:  # passed between the arms: someone must hold it throughout
             monitor = f"0.5 - max(holding(left, {obj}), holding(right, {obj}))"
         else:
@@ -350,8 +286,8 @@ class Arranger:
                 continue
             obj, limit = match.group(1), float(match.group(2))
             info = self.objects.get(obj)
-            holders = _holders(before, obj)
-            if info is None or not kb.is_tall(info) or len(holders) != 1 or _holders(after, obj) != holders:
+            holders = holders_of(before, obj)
+            if info is None or not kb.is_tall(info) or len(holders) != 1 or holders_of(after, obj) != holders:
                 continue
             out.append(self._slipped(edge, before, holders[0], obj, limit))
         return out
@@ -360,7 +296,7 @@ class Arranger:
         """Objects the edge aims at (or keeps a pose relative to) whose pose its target constrains."""
         names: list[str] = []
         for arm in ARMS:
-            calls = _calls(edge, arm)
+            calls = calls_of(edge, arm)
             for call in calls:
                 for key in ("obj", "relative_to"):
                     name = call.args.get(key)
@@ -392,7 +328,7 @@ class Arranger:
     def _after_park(account: Account, edge: Edge, busy: set[str]) -> list[Step]:
         # Parking is an absolute move: restore the whole pose since the grasp, then the edge.
         history = {a: account[a].since_grasp for a in busy if account[a].since_grasp}
-        steps = _sequence(history)
+        steps = side_by_side(history)
         for step in edge.steps:
             kept = {a: _with_skips(c) for a, c in step.items() if c is not None}
             if kept:
@@ -408,12 +344,12 @@ class Arranger:
         for obj, (host, arm, grasp, place, _) in placed.items():
             if host not in carried or host not in self.objects:
                 continue
-            holders = _holders(before, host)
+            holders = holders_of(before, host)
             tol = round(0.5 * min(self.objects[host].extent[0], self.objects[host].extent[1]), 3)
             steps: list[Step] = [{a: ActionCall(fn="place", args={"obj": host, "skip_if_placed": True}) for a in holders}]
             steps += [{arm: _with_skips(grasp)}, {arm: place}]
             steps.append({a: _regrasp(before, a, host) for a in holders})
-            steps += _sequence({a: before[a].since_grasp for a in holders if before[a].since_grasp})
+            steps += side_by_side({a: before[a].since_grasp for a in holders if before[a].since_grasp})
             recovery = Edge(id=f"{edge.id}_r_{obj}_out", source=edge.source, target=edge.source, kind="recovery", actions=steps)
             mode = FailureMode(name=f"{obj}_out", monitor=f"misaligned({obj}.pos, {host}.pos, {tol:g})", window=kb.WINDOW, intent="re-place", recovery=recovery.id)
             out.append((mode, recovery))
@@ -453,7 +389,7 @@ class Arranger:
     def _replace_tilted(self, edge: Edge, before: Account, current: dict[str, SceneObject], holding: set) -> tuple[FailureMode, Edge] | None:
         """An upright object this edge put down leans (released on something, or held off-centre): place it again."""
         for arm in ARMS:
-            for call in _calls(edge, arm):
+            for call in calls_of(edge, arm):
                 obj = call.args.get("obj")
                 info = self.objects.get(obj or "")
                 if call.fn != "place" or info is None or obj not in current or (arm, obj) in holding:
@@ -483,7 +419,7 @@ class Arranger:
             return None
         after = before
         for step in edge.steps:
-            after = _apply(after, step)
+            after = apply_step(after, step)
         current = {o.name: o for o in now.objects}
         holding = {(a.name, a.holding) for a in now.arms if a.holding}
         branch: tuple[FailureMode, Edge] | None = None

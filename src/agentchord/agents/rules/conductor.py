@@ -22,7 +22,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from agentchord.agents.reasoner import Scene, SceneObject
-from agentchord.agents.rules.arranger import ARMS, Account, ArmAccount, Arranger, _apply
+from agentchord.agents.rules.accounts import ARMS, Account, ArmAccount, apply_step
+from agentchord.agents.rules.arranger import Arranger
 from agentchord.graph.models import ActionCall, Edge, TaskGraph
 from agentchord.features.frame import FeatureFrame, make_static_frame
 from agentchord.solvers.obstacles import object_spheres, scene_spheres
@@ -98,7 +99,7 @@ class Conductor:
                     if edge.path_constraints and call.fn in ("move_to_obj", "move_to_target") and account[arm].holding:
                         # A carried object under a path constraint: the receding-horizon path solver keeps it clear.
                         call.args["path"] = "solved"
-                account = _apply(account, step)
+                account = apply_step(account, step)
         return out
 
     def _tool_target(
