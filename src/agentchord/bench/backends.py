@@ -8,11 +8,10 @@ backend changes when a record arrives, never what it says (wall-clock fields asi
 
 from __future__ import annotations
 
-import multiprocessing
 from collections.abc import Iterator
 
 from agentchord.bench.exceptions import BackendError
-from agentchord.bench.runner import default_workers
+from agentchord.bench.runner import default_workers, pooled
 from agentchord.bench.sweep import EpisodeKey, SweepConfig, run_record
 
 BACKENDS = ("local", "ray")
@@ -30,14 +29,7 @@ def _episode(key: EpisodeKey, config: SweepConfig) -> tuple[EpisodeKey, dict]:
 
 def run_local(keys: list[EpisodeKey], config: SweepConfig, workers: int | None = None) -> Iterator[tuple[EpisodeKey, dict]]:
     """Episodes in a pool of worker processes (default: one per core); one worker runs them in this process."""
-    workers = min(workers or default_workers(), len(keys)) or 1
-    if workers == 1:
-        for key in keys:
-            yield _run((key, config))
-        return
-    # "spawn": MuJoCo and BLAS threads do not survive fork reliably. chunksize 1: records arrive as episodes end.
-    with multiprocessing.get_context("spawn").Pool(workers) as pool:
-        yield from pool.imap_unordered(_run, [(key, config) for key in keys], chunksize=1)
+    yield from pooled(_run, [(key, config) for key in keys], workers)
 
 
 def run_ray(keys: list[EpisodeKey], config: SweepConfig, address: str | None = None,

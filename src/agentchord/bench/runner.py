@@ -5,6 +5,7 @@ from __future__ import annotations
 import multiprocessing
 import os
 from collections.abc import Callable, Iterable, Iterator
+from typing import TypeVar
 
 from agentchord.execution.episode import EpisodeSpec, run_episode
 
@@ -19,6 +20,25 @@ def default_workers() -> int:
     return max(len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1, 1)
 
 
+Item = TypeVar("Item")
+Result = TypeVar("Result")
+
+
+def pooled(fn: Callable[[Item], Result], items: Iterable[Item], workers: int | None = None) -> Iterator[Result]:
+    """``fn`` over ``items`` in worker processes (one worker: in this process), results as they finish.
+
+    ``fn`` must be a module-level function (it is pickled into the workers).
+    """
+    items = list(items)
+    workers = min(workers or default_workers(), len(items)) or 1
+    if workers == 1:
+        yield from map(fn, items)
+        return
+    # "spawn": MuJoCo and BLAS threads do not survive fork reliably. chunksize 1: results arrive as items end.
+    with multiprocessing.get_context("spawn").Pool(workers) as pool:
+        yield from pool.imap_unordered(fn, items, chunksize=1)
+
+
 def run_many(specs: Iterable[EpisodeSpec], workers: int | None = None,
              progress: Callable[[EpisodeSpec, dict], None] | None = None) -> Iterator[tuple[EpisodeSpec, dict]]:
     """Run episodes, yielding ``(spec, summary)`` as they finish (order not kept).
@@ -26,18 +46,7 @@ def run_many(specs: Iterable[EpisodeSpec], workers: int | None = None,
     Each episode is deterministic given its spec, so running in parallel does
     not change any result.
     """
-    specs = list(specs)
-    workers = min(workers or default_workers(), len(specs)) or 1
-    if workers == 1:
-        for spec in specs:
-            item = _run(spec)
-            if progress:
-                progress(*item)
-            yield item
-        return
-    # "spawn": MuJoCo and BLAS threads do not survive fork reliably.
-    with multiprocessing.get_context("spawn").Pool(workers) as pool:
-        for item in pool.imap_unordered(_run, specs):
-            if progress:
-                progress(*item)
-            yield item
+    for item in pooled(_run, specs, workers):
+        if progress:
+            progress(*item)
+        yield item
