@@ -21,10 +21,11 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
+from agentchord.actions.library import POINT_EXTENT
 from agentchord.execution.edge_program import EdgeProgram
 from agentchord.features.frame import FeatureFrame
+from agentchord.solvers.poses import quat_to_rotation
 
 #: Object speed (m/s) under which it counts as at rest, and for how many ticks in a row.
 REST_SPEED = 0.03
@@ -38,8 +39,6 @@ RECATCH_OFFSET = 0.03
 RECATCH_TILT_DEG = 20.0
 #: A hold last seen more than this many ticks before a failure was not lost by it.
 RECENT_HOLD_TICKS = 30
-#: Objects smaller than this (m, largest extent) are points (a cloth's corner): not resumed.
-POINT_EXTENT = 0.01
 
 
 @dataclass(frozen=True)
@@ -64,9 +63,14 @@ class Hold:
     def seen(cls, frame: FeatureFrame, arm: str, obj: str) -> Hold:
         """The hold of ``obj`` by ``arm`` in ``frame`` (whether or not the fingers grip it now)."""
         arm_feats, obj_feats = frame.arms[arm], frame.objects[obj]
-        w, x, y, z = arm_feats.ee_quat
-        to_tool = Rotation.from_quat([x, y, z, w]).as_matrix().T
-        return cls(arm, obj, to_tool @ (obj_feats.pos - arm_feats.ee), to_tool @ obj_feats.axis, frame.tick)
+        return cls.of(arm, obj, arm_feats.ee, arm_feats.ee_quat, obj_feats.pos, obj_feats.axis, frame.tick)
+
+    @classmethod
+    def of(cls, arm: str, obj: str, ee: np.ndarray, ee_quat: np.ndarray, pos: np.ndarray, axis: np.ndarray,
+           tick: int) -> Hold:
+        """The hold of an object at ``pos`` along ``axis`` by a tool at ``ee`` turned by ``ee_quat`` (w, x, y, z)."""
+        to_tool = quat_to_rotation(ee_quat).as_matrix().T
+        return cls(arm, obj, to_tool @ (pos - ee), to_tool @ axis, tick)
 
     def same_as(self, other: Hold) -> bool:
         """Whether ``other`` puts the object where this hold had it (see the module docstring)."""
@@ -77,20 +81,25 @@ class Hold:
 
 @dataclass
 class HoldMemory:
-    """The last hold seen of every (arm, object) pair, refreshed every tick.
+    """The last sighting of every (arm, object) pair in a grasp, refreshed every tick.
+
+    Only the poses are kept each tick (on the executor's tick loop); the hold in the tool frame is
+    worked out when a failure asks for it.
 
     Attributes:
-        last: Per (arm, object), the hold at the last tick the arm held the object.
+        last: Per (arm, object), the tick, tool position and quaternion, object centre and axis at
+            the last tick the arm held the object.
     """
 
-    last: dict[tuple[str, str], Hold] = field(default_factory=dict)
+    last: dict[tuple[str, str], tuple] = field(default_factory=dict)
 
     def observe(self, frame: FeatureFrame) -> None:
         """Record the holds of this tick's frame (rigid objects only)."""
         for arm, obj in frame.holding:
             feats = frame.objects.get(obj)
             if feats is not None and float(np.max(feats.extent)) >= POINT_EXTENT:
-                self.last[(arm, obj)] = Hold.seen(frame, arm, obj)
+                tool = frame.arms[arm]
+                self.last[(arm, obj)] = (frame.tick, tool.ee.copy(), tool.ee_quat.copy(), feats.pos.copy(), feats.axis.copy())
 
     def lost(self, frame: FeatureFrame, arms: set[str], objects: list[str]) -> list[Hold] | None:
         """The recent holds of ``objects`` by ``arms`` that no arm holds now.
@@ -102,8 +111,8 @@ class HoldMemory:
         for obj in objects:
             if any(o == obj for _, o in frame.holding):
                 return None
-            recent = [h for (arm, o), h in self.last.items()
-                      if o == obj and arm in arms and frame.tick - h.tick <= RECENT_HOLD_TICKS]
+            recent = [Hold.of(arm, o, ee, quat, pos, axis, tick) for (arm, o), (tick, ee, quat, pos, axis) in self.last.items()
+                      if o == obj and arm in arms and frame.tick - tick <= RECENT_HOLD_TICKS]
             if not recent:
                 return None
             holds.extend(recent)

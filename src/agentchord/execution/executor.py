@@ -237,7 +237,8 @@ class Executor:
     def _tick(self) -> tuple[bool, str] | None:
         frame = self.extractor.update()
         self.tracker.observe(frame)
-        self.holds.observe(frame)
+        if self.strategy.resumes_cleared_failures:
+            self.holds.observe(frame)
         if self.disturbance is not None:
             event = self.disturbance.apply(self.world, frame)
             if event is not None:
@@ -371,10 +372,7 @@ class Executor:
         self.binding = None
         program = binding.suspended
         self.program = program
-        edge_monitors = self.monitors.get(program.edge_id)
-        self.armed = edge_monitors if edge_monitors is not None and edge_monitors.monitors else None
-        if self.armed is not None:
-            self.armed.reset()
+        self._arm_monitors(program)
         self.recovering_from = binding.recovering_from
         # A cleared failure cost nothing: it does not count against the mode's failure budget.
         self.fire_counts[(program.edge_id, binding.failure)] -= 1
@@ -444,16 +442,22 @@ class Executor:
         self.program = program
         program.on_action_start = self._action_started
         program.on_action_end = self._action_ended
-        # Only the active edge's own monitors are armed. A failure during a recovery edge
-        # without monitors shows at its merge node: the next edge's monitors catch it.
-        edge_monitors = self.monitors.get(program.edge_id) if self.strategy.uses_monitors else None
-        self.armed = edge_monitors if edge_monitors is not None and edge_monitors.monitors else None
-        if self.armed is not None:
-            self.armed.reset()
+        self._arm_monitors(program)
         self.frame.capture_refs()
         self.path.append(program.edge_id)
         self.trace.add(self.world.tick, "edge_start", edge=program.edge_id, kind=program.kind, target=program.target)
         program.initialise(self.robot)
+
+    def _arm_monitors(self, program: EdgeProgram) -> None:
+        """Arm ``program``'s edge's monitors, their persistence history cleared.
+
+        Only the active edge's own monitors are armed. A failure during a recovery edge
+        without monitors shows at its merge node: the next edge's monitors catch it.
+        """
+        edge_monitors = self.monitors.get(program.edge_id) if self.strategy.uses_monitors else None
+        self.armed = edge_monitors if edge_monitors is not None and edge_monitors.monitors else None
+        if self.armed is not None:
+            self.armed.reset()
 
     def _on_program_done(self) -> tuple[bool, str] | None:
         program = self.program

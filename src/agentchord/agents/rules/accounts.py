@@ -13,9 +13,7 @@ from dataclasses import dataclass, field
 from agentchord.graph.models import ActionCall, Edge, Step
 
 ARMS = ("left", "right")
-#: Motions to an absolute target (a pose, an object) ...
-ABSOLUTE = frozenset({"move_to_obj", "move_to_target", "place", "grasp", "back"})
-#: ... and motions relative to the arm's current pose (replayed after a regrasp).
+#: Motions relative to the arm's current pose (replayed after a regrasp; the others aim at a pose or an object).
 RELATIVE = frozenset({"rotate_eef", "move_by_offset"})
 
 
