@@ -2,6 +2,7 @@
 
 import json
 
+import pytest
 from click.testing import CliRunner
 
 from agentchord.cli import main
@@ -128,6 +129,16 @@ def test_run_prints_which_arm_a_recovery_was_bound_to_under_the_real_protocol():
 
     from agentchord.cli import main
 
-    result = CliRunner().invoke(main, ["run", "single_arm_pour_water", "--protocol", "real", "--seed", "9"])
+    result = CliRunner().invoke(main, ["run", "single_arm_pour_water", "--protocol", "real", "--seed", "16"])
     assert result.exit_code in (0, 1), result.output
     assert "disturbance" in result.output and "recovery bound to" in result.output
+
+
+@pytest.mark.parametrize("seed,line", [
+    (9, "sub-goal met: v5 already holds"),  # pulled out of the hand while being put down, set down upright
+    (5, "merged ahead: at v2, v3 reached before the failure and v4 holds: e3, e4 skipped"),  # taken mid-pour
+])
+def test_run_prints_a_recovery_that_had_nothing_left_to_do(seed, line):
+    result = CliRunner().invoke(main, ["run", "single_arm_pour_water", "--protocol", "real", "--seed", str(seed)])
+    assert result.exit_code == 0, result.output
+    assert line in " ".join(result.output.split())  # the console wraps long lines

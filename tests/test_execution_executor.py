@@ -185,3 +185,41 @@ def test_a_recovery_that_merges_with_a_constraint_violated_fires_the_failure_wat
     switches = [(s["edge"], s["to"], s["latency_ticks"]) for s in result.trace.of("recovery_switch")]
     assert switches[-1] == ("e3", "e3_r_bottle_dropped", 0)
     assert result.success, result.reason
+
+
+@pytest.mark.parametrize("lying", [False, True])
+def test_a_recovery_whose_merge_sub_goal_already_holds_is_skipped(lying):
+    # The bottle is pulled out of the hand as it is being put down. Set down upright elsewhere, v5 ("standing
+    # upright on the table, released") already holds: the regrasp-and-place recovery is skipped. Laid on its
+    # side, v5 does not hold, and the recovery runs.
+    pull = ScriptedDisturbance("place", "pull", after=60, seed=1, spot=(0.2, 0.55), lying=lying)
+    result = run_episode(EpisodeSpec(TASK, seed=1, disturbance=pull))
+    assert result.success, result.reason
+    assert result.trace.of("recovery_switch")[0]["to"] == "e5_r_bottle_dropped"
+    met = result.trace.of("subgoal_met")
+    if lying:
+        assert met == [] and "e5_r_bottle_dropped" in result.path
+    else:
+        assert [(m["edge"], m["node"]) for m in met] == [("e5_r_bottle_dropped", "v5")]
+        assert result.path[result.path.index("e5"):] == ["e5", "v5", "e6", "v6"]
+        # Detected and handled (merged at v5): the disturbance counts as recovered.
+        assert result.summary()["disturbances"]["pull"] == [1, 1, 1]
+        # Nothing redone: fewer steps than the undisturbed episode, whose place ran to its end.
+        assert result.steps < run_episode(EpisodeSpec(TASK, seed=1)).steps
+
+
+@pytest.mark.parametrize("after,poured_before", [(20, False), (85, True)])
+def test_a_recovery_merges_past_a_pour_that_was_done_before_the_bottle_was_taken(after, poured_before):
+    # Taken out of the hand mid-pour. Once the pour had reached the cup (v3 passed), the regrasped bottle,
+    # held upright (v4 holds), goes on to be put down: e3 and e4 are skipped. Taken early in the tilt, it
+    # pours again. The task's own criterion (the pouring event happened) passes both ways.
+    pull = ScriptedDisturbance("rotate_eef", "pull", after=after, seed=1, lying=False)
+    result = run_episode(EpisodeSpec(TASK, seed=1, disturbance=pull))
+    assert result.success, result.reason
+    after_recovery = result.path[result.path.index("e3_r_bottle_dropped"):]
+    ahead = result.trace.of("merged_ahead")
+    if poured_before:
+        assert [(a["node"], a["to"], a["passed"], a["skipped"]) for a in ahead] == [("v2", "v4", ["v3"], ["e3", "e4"])]
+        assert after_recovery[:4] == ["e3_r_bottle_dropped", "v2", "v4", "e5"]
+    else:
+        assert ahead == [] and after_recovery[:4] == ["e3_r_bottle_dropped", "v2", "e3", "v3"]

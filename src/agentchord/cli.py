@@ -268,6 +268,10 @@ def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, inst
                 video.announce(f"RECOVERY -> {event['to']}")
             elif event["event"] == "failure_cleared":
                 video.announce(f"CLEARED: {', '.join(event['objects'])} held again, {event['edge']} goes on")
+            elif event["event"] == "subgoal_met":
+                video.announce(f"MET: {event['node']} already holds, {event['edge']} skipped")
+            elif event["event"] == "merged_ahead":
+                video.announce(f"AHEAD: {', '.join(event['passed'])} done already, on from {event['to']}")
             elif event["event"] == "disturbance":
                 video.announce(f"DISTURBANCE: {event['kind']} {event['obj']}", ticks=25)
         recorder["seen"] = len(executor.trace.events)
@@ -417,6 +421,12 @@ def _print_episode(console: Console, result) -> None:
         elif kind == "failure_cleared":
             console.print(f"{tick}  [green]failure cleared[/green]: {event['failure']} on {event['edge']}: "
                           f"{', '.join(event['objects'])} held again as before, after {event['waited_ticks']} ticks; the edge goes on")
+        elif kind == "subgoal_met":
+            console.print(f"{tick}  [green]sub-goal met[/green]: {event['node']} already holds once at rest "
+                          f"(after {event['waited_ticks']} ticks): {event['edge']} skipped")
+        elif kind == "merged_ahead":
+            console.print(f"{tick}  [green]merged ahead[/green]: at {event['node']}, {', '.join(event['passed'])} reached before "
+                          f"the failure and {event['to']} holds: {', '.join(event['skipped'])} skipped")
         elif kind == "recovery_failed":
             console.print(f"{tick}  [red]recovery failed[/red]: {event['edge']}: {event['reason']}; trying the next candidate")
         elif kind == "unrecoverable":

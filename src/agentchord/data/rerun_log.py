@@ -33,6 +33,8 @@ EVENT_LEVELS = {
     "recovery_switch": "WARN",
     "recovery_merged": "INFO",
     "failure_cleared": "INFO",
+    "subgoal_met": "INFO",
+    "merged_ahead": "INFO",
     "recovery_failed": "ERROR",
     "repair": "INFO",
     "unrecoverable": "CRITICAL",

@@ -111,6 +111,9 @@ class Executor:
         # Per reached nominal node: the robot's keyframe (arm joints and grips), for backtracking.
         self.keyframes: dict[str, dict[str, tuple[np.ndarray, float]]] = {}
         self.visited_nominal: list[str] = []
+        # Nominal nodes whose constraints held at some tick of the edge into them, even if a failure cut
+        # that edge short afterwards (a pour that reached the cup before the bottle was taken).
+        self.passed: set[str] = set()
         self.path: list[str] = []
         self.program: EdgeProgram | None = None
         self.binding: Binding | None = None
@@ -254,6 +257,10 @@ class Executor:
             outcome = self._bind(frame)
             if outcome is not None:
                 return outcome
+        program = self.program
+        if (self.strategy.merges_met_subgoals and program is not None and program.kind == "nominal"
+                and program.target not in self.passed and self.constraints_hold(program.target)):
+            self.passed.add(program.target)
         # While a recovery is still binding, nothing is armed or running: the arms hold their poses.
         if self.armed is not None:
             detection = self.armed.evaluate(frame)
@@ -350,6 +357,13 @@ class Executor:
         self.binding = None
         if binding.suspended is not None:
             binding.suspended.terminate(Status.INVALID)
+        met = self._met_merge(binding.candidates[0], binding.objects)
+        if met is not None:
+            # What the recovery was for already holds (a bottle pulled out of the hand as it was being
+            # put down, set down upright by the person): nothing to redo, go on from the merge node.
+            self.trace.add(self.world.tick, "subgoal_met", edge=binding.candidates[0].edge_id, node=met,
+                           waited_ticks=waited)
+            return self._arrive(met)
         refused = []
         for k, candidate in enumerate(binding.candidates):
             problems = self.feasibility.check_program(candidate)
@@ -366,6 +380,44 @@ class Executor:
             if outcome is not None:
                 return outcome
         return False, f"no feasible recovery for {', '.join(binding.objects)} at {self.feasibility.where(binding.objects[0])}: {summary}"
+
+    def _met_merge(self, recovery: EdgeProgram, objects: list[str]) -> str | None:
+        """The recovery's merge node, if the strategy merges met sub-goals and all its constraints hold now.
+
+        Only while no arm holds what the recovery grasps: a hold caught again (lower in the hand, askew)
+        may meet a node's ``holding`` constraint and still not be the hold the next edges need; the
+        binding judges those (:mod:`agentchord.execution.binding`).
+        """
+        if not self.strategy.merges_met_subgoals or recovery.kind != "recovery":
+            return None
+        if any(obj in objects for _, obj in self.frame.holding):
+            return None
+        node = self.graph.node(recovery.target)
+        if node.kind != "nominal" or not self.constraints[node.id] or not self.constraints_hold(node.id):
+            return None
+        return node.id
+
+    def _merge_ahead(self, node_id: str) -> tuple[str, list[str], list[str]] | None:
+        """Where a recovery merged at ``node_id`` goes on from, when what lies ahead was done already.
+
+        Walking the nominal path from ``node_id``: while the next node was passed (reached before a
+        failure cut its edge short) and the node after it holds now, both edges are skipped. A
+        bottle taken out of the hand mid-pour, once regrasped upright, is not poured again: v3
+        (pouring) was passed and v4 (held upright after pouring) holds. Never into the goal, whose
+        criterion is the task's. Returns (node to go on from, passed nodes, skipped edges) or None.
+        """
+        here, passed, skipped = node_id, [], []
+        while True:
+            into = self.nominal_next.get(here)
+            middle = self.graph.edge(into).target if into is not None else None
+            out = self.nominal_next.get(middle) if middle in self.passed else None
+            after = self.graph.edge(out).target if out is not None else None
+            if after is None or after == self.graph.goal or not self.constraints[after] or not self.constraints_hold(after):
+                break
+            here = after
+            passed.append(middle)
+            skipped.extend([into, out])
+        return (here, passed, skipped) if here != node_id else None
 
     def _resume(self, binding: Binding) -> None:
         """The lost holds came back as they were: the failure cleared, the interrupted edge goes on."""
@@ -401,6 +453,11 @@ class Executor:
                 self.trace.add(self.world.tick, "recovery_merged", node=node_id)
                 self._recovered.extend(self._unmerged)
                 self._unmerged = []
+                ahead = self._merge_ahead(node_id) if self.strategy.merges_met_subgoals else None
+                if ahead is not None:
+                    node_ahead, passed, skipped = ahead
+                    self.trace.add(self.world.tick, "merged_ahead", node=node_id, to=node_ahead, passed=passed, skipped=skipped)
+                    return self._arrive(node_ahead)
         if node_id == self.graph.goal:
             verdict = self.tracker.verdict(self.frame, self.world)
             return verdict.success, verdict.reason

@@ -34,6 +34,10 @@ class RecoveryStrategy:
     #: interrupted edge go on (``execution.binding``). Only where the recovery is a branch of the same
     #: graph: a re-plan has replaced the graph already, a backtrack does not wait.
     resumes_cleared_failures = False
+    #: Whether a recovery whose merge node's constraints already hold once what fell is at rest is
+    #: skipped (the executor goes on from the merge node). Only where the recovery is a branch of the
+    #: same graph: a re-plan checks what is achieved itself, a backtrack returns regardless.
+    merges_met_subgoals = False
     #: The latency model; None charges no reasoning (``run``, ``demo``: robot time only).
     reasoning: ReasoningConfig | None = None
     #: The reasoner calls that planned this episode's graph (none: a library graph, modelled).
@@ -80,6 +84,7 @@ class AgentChordStrategy(RecoveryStrategy):
 
     name = "agentchord"
     resumes_cleared_failures = True
+    merges_met_subgoals = True
 
     def recover(self, executor: Executor, detection: Detection) -> list[EdgeProgram]:
         candidates = executor.recovery_map.candidates(detection.edge_id, detection.failure.name)
