@@ -4,7 +4,7 @@ import pytest
 
 from agentchord.execution.episode import EpisodeSpec, run_episode
 from agentchord.tasks import library_tasks
-from agentchord.worlds.sim.disturbances import KINDS
+from agentchord.worlds.sim.disturbances import KINDS, ScriptedDisturbance
 from agentchord.worlds.sim.tasks import SIM_TASKS
 
 TASKS = sorted(set(SIM_TASKS) & set(library_tasks()))
@@ -33,11 +33,41 @@ def test_a_bottle_pushed_askew_in_its_grasp_is_set_down_and_taken_again():
     assert "e2_r_bottle_slipped" in _recoveries(result)
 
 
+class _Both:
+    """Two scripted disturbances in one episode (each keeps its own schedule)."""
+
+    def __init__(self, *parts: ScriptedDisturbance) -> None:
+        self.parts = parts
+
+    @property
+    def events(self) -> list:
+        return [event for part in self.parts for event in part.events]
+
+    def action_started(self, arm, action, expected_ticks, tick) -> None:
+        for part in self.parts:
+            part.action_started(arm, action, expected_ticks, tick)
+
+    def action_ended(self, arm) -> None:
+        for part in self.parts:
+            part.action_ended(arm)
+
+    def apply(self, world, frame):
+        for part in self.parts:
+            event = part.apply(world, frame)
+            if event is not None:
+                return event
+        return None
+
+
 def test_an_arm_switch_whose_busy_hand_already_lost_its_object_goes_on():
-    # Stress protocol, seed 8: both arms lose their objects; the cup's recovery passes to the right
-    # arm, whose bottle already fell: its hand is free already (place free_hand), and it takes the
-    # fallen bottle again re-seated before the pour.
-    result = run_episode(EpisodeSpec("dual_arm_pour_water", seed=8, protocol=True, disturb=KINDS))
+    # Both arms lose their objects: the right arm drops the bottle on its way to the cup, then, as the
+    # recovery starts, a person takes the cup out of the left hand and sets it down on the right. The
+    # cup's recovery passes to the right arm, whose bottle already fell: its hand is free already
+    # (place free_hand), and it takes the fallen bottle again before the pour.
+    both = _Both(ScriptedDisturbance("move_to_obj", "drop", nth=0, after=36),
+                 ScriptedDisturbance("move_to_target", "pull", nth=1, after=1, seed=1, spot=(0.2, 0.35), lying=False))
+    result = run_episode(EpisodeSpec("dual_arm_pour_water", seed=8, disturbance=both))
+    assert [(e["kind"], e["obj"], e["arm"]) for e in result.trace.of("disturbance")] == [("drop", "bottle", "right"), ("pull", "cup", "left")]
     assert result.success, result.reason
     assert "e3_r_cup_dropped_via_right" in result.path
 

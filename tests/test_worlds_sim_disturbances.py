@@ -135,3 +135,19 @@ def test_a_long_object_pulled_out_of_a_top_grasp_leaves_the_fingers_and_lands_fl
     # Taken out along its length (18 cm: more than the usual 10 cm slide), it is not caught again as
     # the fingers close after the fault, and it lies flat, not on its edge.
     assert seen == {"held": False, "tilt": seen["tilt"]} and seen["tilt"] < 20
+
+
+@pytest.mark.parametrize("spot_seed", [0, 3])
+def test_a_person_takes_the_object_out_of_a_gripper_that_keeps_moving(spot_seed):
+    # Inner Monologue does not stop for a pull until its sub-goal check: the arm carries on towards the cup
+    # while the person takes the bottle. The person still gets it (a moving arm used to catch it again).
+    held = {}
+
+    def watch(executor):
+        held[executor.world.tick] = ("right", "bottle") in set(executor.frame.holding)
+
+    pull = ScriptedDisturbance("move_to_obj", "pull", after=26, seed=spot_seed)
+    result = run_episode(EpisodeSpec(TASK, strategy="inner-monologue", seed=16, disturbance=pull), on_tick=watch)
+    pulled = result.trace.of("disturbance")[0]["tick"]
+    assert not held[pulled + 75] and not held[pulled + 150]
+    assert result.trace.of("replan")  # its sub-goal check saw the bottle gone

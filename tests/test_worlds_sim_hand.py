@@ -47,3 +47,49 @@ def test_a_tall_object_is_laid_on_its_side_and_stays_there():
     pos, matrix = world.object_pose("bottle")
     assert abs(matrix[2, 2]) < 0.1  # its axis is horizontal
     assert np.linalg.norm(pos[:2] - [0.0, 0.7]) < 0.05  # set down still: it did not roll away
+
+
+def test_out_of_a_moving_gripper_the_object_is_held_clear_of_it_until_it_stops():
+    # The arm carries on while a person pulls (a baseline that does not stop): the out-of-the-fingers
+    # segment follows the gripper, and the carry waits while the gripper still moves, so the arm does
+    # not run into the object again.
+    from agentchord.worlds.sim.hand import OUT_S, PersonHand
+
+    world = _world()
+    body = world.model.body("bottle").id
+    pos, matrix = world.object_pose("bottle")
+    gripper = {"pos": pos - np.array([0.0, 0.03, 0.0])}
+    path = set_down_path(pos, Rotation.from_matrix(matrix), np.array([0.0, 1.0, 0.0]), np.array([0.1, 0.7]), 0.1, Rotation.identity())
+    hand = PersonHand(world.model, world.data, body, path, tool=lambda: (gripper["pos"].copy(), np.eye(3)))
+    dt, moving_until = 0.002, OUT_S + 0.4
+    offsets, elapsed = [], 0.0
+    while elapsed < moving_until:
+        gripper["pos"] = gripper["pos"] + np.array([0.0, 0.2 * dt, 0.0])  # 0.2 m/s along the pull
+        hand.apply(dt)
+        offsets.append(hand._reference()[0] - gripper["pos"])
+        elapsed += dt
+    # Out of the fingers: 10 cm beyond where it was held, in the moving gripper's frame; then held there.
+    assert np.allclose(offsets[-1], offsets[int(OUT_S / dt) + 5], atol=1e-3)
+    assert abs(offsets[-1][1] - (0.03 + 0.10)) < 1e-3
+    assert hand._t <= OUT_S + 1e-9
+    # The gripper stops: the carry goes on, along the world's path from where the object was held.
+    for _ in range(int(2.0 / dt)):
+        hand.apply(dt)
+    assert hand.done
+
+
+def test_a_gripper_that_never_stops_is_waited_for_at_most_the_stated_time():
+    from agentchord.worlds.sim.hand import MAX_CLEAR_HOLD_S, PersonHand
+
+    world = _world()
+    pos, matrix = world.object_pose("bottle")
+    gripper = {"pos": pos.copy()}
+    path = set_down_path(pos, Rotation.from_matrix(matrix), np.array([0.0, 1.0, 0.0]), np.array([0.1, 0.7]), 0.1, Rotation.identity())
+    hand = PersonHand(world.model, world.data, world.model.body("bottle").id, path, tool=lambda: (gripper["pos"].copy(), np.eye(3)))
+    dt, elapsed = 0.002, 0.0
+    while not hand.done and elapsed < 10.0:
+        gripper["pos"] = gripper["pos"] + np.array([0.2 * dt, 0.0, 0.0])
+        hand.apply(dt)
+        elapsed += dt
+    assert hand.done
+    assert abs(elapsed - (hand.duration + MAX_CLEAR_HOLD_S)) < 0.01

@@ -311,8 +311,9 @@ class RemoteWorld:
         """Knock an object over."""
         self._sim("knock", obj, np.asarray(direction, dtype=float), int(ticks))
 
-    def hand_carry(self, obj: str, waypoints: list) -> None:
-        """A person's hand carries ``obj`` along ``waypoints`` (each ``pos``, ``rotation``, ``seconds``)."""
+    def hand_carry(self, obj: str, waypoints: list, out_of: str | None = None) -> None:
+        """A person's hand carries ``obj`` along ``waypoints`` (each ``pos``, ``rotation``, ``seconds``),
+        the first one moving with ``out_of``'s gripper."""
         wire = [{"pos": np.asarray(w.pos, dtype=float), "quat": w.rotation.as_quat(), "seconds": float(w.seconds)}
                 for w in waypoints]
-        self._sim("hand_carry", obj, wire)
+        self._sim("hand_carry", obj, wire, out_of)

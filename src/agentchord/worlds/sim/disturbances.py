@@ -198,7 +198,7 @@ def _take_and_set_down(world: SimWorld, frame: FeatureFrame, obj: str, arm: str,
         rest, height = yaw, 0.5 * spec.height
     # Out of the fingers entirely: a fork taken out of a top grasp slides along its length.
     distance = max(PULL_OUT_DISTANCE, _half_extent_along(spec, matrix, out) + PULL_OUT_MARGIN)
-    world.hand_carry(obj, set_down_path(pos, Rotation.from_matrix(matrix), out, spot, height, rest, distance))
+    world.hand_carry(obj, set_down_path(pos, Rotation.from_matrix(matrix), out, spot, height, rest, distance), out_of=arm)
 
 
 def _half_extent_along(spec, matrix: np.ndarray, direction: np.ndarray) -> float:

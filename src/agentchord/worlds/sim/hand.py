@@ -11,6 +11,7 @@ and the table; nothing is teleported.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import mujoco
@@ -31,6 +32,10 @@ OUT_S, CARRY_S, LOWER_S, HOLD_S = 0.3, 0.9, 0.3, 0.3
 #: Height (m) the object's resting pose is carried above before it is lowered, and released above.
 CARRY_CLEARANCE = 0.05
 RELEASE_CLEARANCE = 0.001
+#: Out of the fingers, a person holds the object clear of a gripper still moving faster than this
+#: (m/s) before carrying it off (else the arm runs into it again), at most this long (s).
+MOVING_TOOL_SPEED = 0.05
+MAX_CLEAR_HOLD_S = 1.5
 
 
 def min_jerk(s: float) -> float:
@@ -48,6 +53,10 @@ class Waypoint:
     seconds: float
 
 
+#: Where a gripper is now: its position and rotation matrix (world frame).
+ToolPose = Callable[[], tuple[np.ndarray, np.ndarray]]
+
+
 class PersonHand:
     """Carries one body along waypoints, then lets go.
 
@@ -56,9 +65,15 @@ class PersonHand:
         data: Its data (xfrc_applied is written every physics step while carrying).
         body: Id of the object's body.
         waypoints: Poses to reach in turn; the first segment starts at the object's pose now.
+        tool: The pose of the gripper the object is taken out of. Given, the first segment (out of
+            the fingers) moves with that gripper, and the object is held there, clear of it, while
+            the gripper still moves (at most :data:`MAX_CLEAR_HOLD_S`): a person takes the object
+            out of the hand wherever the arm goes meanwhile, and does not carry it back into the
+            arm's way. The next segment starts where the object was held.
     """
 
-    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, body: int, waypoints: list[Waypoint]) -> None:
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, body: int, waypoints: list[Waypoint],
+                 tool: ToolPose | None = None) -> None:
         self.model, self.data, self.body = model, data, body
         self.mass = float(model.body_subtreemass[body])
         self.inertia = float(np.max(model.body_inertia[body]))
@@ -66,22 +81,59 @@ class PersonHand:
         self._segments = list(zip([start, *waypoints[:-1]], waypoints, strict=True))
         # One interpolator per segment, built once: the reference is read every physics step.
         self._slerps = [Slerp([0.0, 1.0], Rotation.concatenate([a.rotation, b.rotation])) for a, b in self._segments]
+        self._tool = tool
+        if tool is not None:
+            # The first segment's ends in the gripper's frame at the grab.
+            tool_pos, tool_rot = tool()
+            self._out_local = [tool_rot.T @ (w.pos - tool_pos) for w in self._segments[0]]
+            self._tool_pos, self._tool_speed = tool_pos, 0.0
+        self._held_clear = 0.0
         self._t = 0.0
         self.done = False
 
+    def _out_ends(self) -> tuple[np.ndarray, np.ndarray]:
+        """The first segment's ends in the world now, following the gripper."""
+        tool_pos, tool_rot = self._tool()
+        return tool_pos + tool_rot @ self._out_local[0], tool_pos + tool_rot @ self._out_local[1]
+
+    def _leave_tool(self) -> None:
+        """Out of the fingers and clear: the rest of the path is the world's, from where the object is held."""
+        out_end = self._out_ends()[1]
+        self._tool = None
+        a, b = self._segments[0]
+        self._segments[0] = (a, Waypoint(out_end, b.rotation, b.seconds))
+        nxt_a, nxt_b = self._segments[1]
+        self._segments[1] = (Waypoint(out_end, nxt_a.rotation, nxt_a.seconds), nxt_b)
+
     def _reference(self) -> tuple[np.ndarray, Rotation]:
         t = self._t
-        for (a, b), slerp in zip(self._segments, self._slerps, strict=True):
-            if t <= b.seconds:
+        for k, ((a, b), slerp) in enumerate(zip(self._segments, self._slerps, strict=True)):
+            if t <= b.seconds or (k == 0 and self._tool is not None):
                 s = min_jerk(t / b.seconds)
-                return a.pos + s * (b.pos - a.pos), slerp([s])[0]
+                start, end = self._out_ends() if k == 0 and self._tool is not None else (a.pos, b.pos)
+                return start + s * (end - start), slerp([s])[0]
             t -= b.seconds
         last = self._segments[-1][1]
         return last.pos, last.rotation
 
+    def _advance(self, dt: float) -> None:
+        """Move the path's clock on; out of the fingers, wait while the gripper still moves."""
+        if self._tool is not None:
+            tool_pos = self._tool()[0]
+            self._tool_speed = float(np.linalg.norm(tool_pos - self._tool_pos)) / dt
+            self._tool_pos = tool_pos
+            out_s = self._segments[0][1].seconds
+            if self._t + dt > out_s:
+                if self._tool_speed > MOVING_TOOL_SPEED and self._held_clear < MAX_CLEAR_HOLD_S:
+                    self._t = out_s
+                    self._held_clear += dt
+                    return
+                self._leave_tool()
+        self._t += dt
+
     @property
     def duration(self) -> float:
-        """Seconds from the grip to the release."""
+        """Seconds of the path from the grip to the release (not counting time held clear of a moving gripper)."""
         return sum(b.seconds for _, b in self._segments)
 
     def apply(self, dt: float) -> None:
@@ -105,7 +157,7 @@ class PersonHand:
         max_torque = min(MAX_TORQUE, self.inertia * MAX_ANGULAR_ACCEL)
         wrench[:3] = force * min(1.0, max_force / max(np.linalg.norm(force), 1e-9))
         wrench[3:] = torque * min(1.0, max_torque / max(np.linalg.norm(torque), 1e-9))
-        self._t += dt
+        self._advance(dt)
 
 
 def set_down_path(

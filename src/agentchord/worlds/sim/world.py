@@ -132,10 +132,19 @@ class SimWorld:
         self.data.xfrc_applied[body, 3:] = np.cross(top, force)
         self._push_until[body] = self.tick + ticks
 
-    def hand_carry(self, obj: str, waypoints: list[Waypoint]) -> PersonHand:
-        """A person's hand takes ``obj`` and carries it along ``waypoints``, then lets go (see ``hand``)."""
+    def hand_carry(self, obj: str, waypoints: list[Waypoint], out_of: str | None = None) -> PersonHand:
+        """A person's hand takes ``obj`` and carries it along ``waypoints``, then lets go (see ``hand``).
+
+        ``out_of``: the arm whose gripper it is taken out of; the first waypoint moves with that gripper.
+        """
         self.object_spec(obj)
-        hand = PersonHand(self.model, self.data, self._object_body[obj], waypoints)
+        tool = None
+        if out_of is not None:
+            site = self._tcp_site[out_of]
+
+            def tool() -> tuple[np.ndarray, np.ndarray]:
+                return self.data.site_xpos[site].copy(), self.data.site_xmat[site].reshape(3, 3).copy()
+        hand = PersonHand(self.model, self.data, self._object_body[obj], waypoints, tool)
         self._hands.append(hand)
         return hand
 
