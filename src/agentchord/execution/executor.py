@@ -7,7 +7,8 @@ forward-moving recovery edge that starts from the robot's current state, for
 the backtracking ablation a return to an earlier node's keyframe. Budgets end
 an episode as a failure with a reason, never as a hang. A recovery that must wait for what fell
 to come to rest keeps the interrupted edge suspended: if the lost hold comes back as it was, the
-failure has cleared and the edge resumes (:mod:`agentchord.execution.binding`). With a repairer, an edge
+failure has cleared and the edge resumes (:mod:`agentchord.execution.binding`); a recovery with nothing
+left to do stops short (:mod:`agentchord.execution.shortcuts`). With a repairer, an edge
 that ends short of its target's constraints with no monitor fired (a failure
 nobody anticipated) is repaired online: the graph gains one branch, the compiled
 artefacts are rebuilt and the new recovery edge starts at once.
@@ -32,6 +33,7 @@ from agentchord.execution.feasibility import FeasibilityChecker, first_grasps, o
 from agentchord.execution.harness import Disturbance, DisturbanceEvent, SuccessTracker
 from agentchord.execution.repair import RepairRejectedError, Repairer, validate_repair
 from agentchord.execution.result import UNRECOVERABLE, EpisodeResult
+from agentchord.execution.shortcuts import Shortcuts
 from agentchord.execution.strategies import RecoveryStrategy
 from agentchord.execution.trace import Trace
 from agentchord.expr import Vocabulary, compile_expr
@@ -111,9 +113,8 @@ class Executor:
         # Per reached nominal node: the robot's keyframe (arm joints and grips), for backtracking.
         self.keyframes: dict[str, dict[str, tuple[np.ndarray, float]]] = {}
         self.visited_nominal: list[str] = []
-        # Nominal nodes whose constraints held at some tick of the edge into them, even if a failure cut
-        # that edge short afterwards (a pour that reached the cup before the bottle was taken).
-        self.passed: set[str] = set()
+        # Nodes passed before a failure cut their edge short; sub-goals a recovery finds met already.
+        self.shortcuts = Shortcuts()
         self.path: list[str] = []
         self.program: EdgeProgram | None = None
         self.binding: Binding | None = None
@@ -257,10 +258,8 @@ class Executor:
             outcome = self._bind(frame)
             if outcome is not None:
                 return outcome
-        program = self.program
-        if (self.strategy.merges_met_subgoals and program is not None and program.kind == "nominal"
-                and program.target not in self.passed and self.constraints_hold(program.target)):
-            self.passed.add(program.target)
+        if self.strategy.merges_met_subgoals:
+            self.shortcuts.observe(self.program, self._node_holds)
         # While a recovery is still binding, nothing is armed or running: the arms hold their poses.
         if self.armed is not None:
             detection = self.armed.evaluate(frame)
@@ -357,7 +356,9 @@ class Executor:
         self.binding = None
         if binding.suspended is not None:
             binding.suspended.terminate(Status.INVALID)
-        met = self._met_merge(binding.candidates[0], binding.objects)
+        met = None
+        if self.strategy.merges_met_subgoals:
+            met = Shortcuts.met_merge(self.graph, binding.candidates[0], binding.objects, self.frame.holding, self._node_holds)
         if met is not None:
             # What the recovery was for already holds (a bottle pulled out of the hand as it was being
             # put down, set down upright by the person): nothing to redo, go on from the merge node.
@@ -381,43 +382,9 @@ class Executor:
                 return outcome
         return False, f"no feasible recovery for {', '.join(binding.objects)} at {self.feasibility.where(binding.objects[0])}: {summary}"
 
-    def _met_merge(self, recovery: EdgeProgram, objects: list[str]) -> str | None:
-        """The recovery's merge node, if the strategy merges met sub-goals and all its constraints hold now.
-
-        Only while no arm holds what the recovery grasps: a hold caught again (lower in the hand, askew)
-        may meet a node's ``holding`` constraint and still not be the hold the next edges need; the
-        binding judges those (:mod:`agentchord.execution.binding`).
-        """
-        if not self.strategy.merges_met_subgoals or recovery.kind != "recovery":
-            return None
-        if any(obj in objects for _, obj in self.frame.holding):
-            return None
-        node = self.graph.node(recovery.target)
-        if node.kind != "nominal" or not self.constraints[node.id] or not self.constraints_hold(node.id):
-            return None
-        return node.id
-
-    def _merge_ahead(self, node_id: str) -> tuple[str, list[str], list[str]] | None:
-        """Where a recovery merged at ``node_id`` goes on from, when what lies ahead was done already.
-
-        Walking the nominal path from ``node_id``: while the next node was passed (reached before a
-        failure cut its edge short) and the node after it holds now, both edges are skipped. A
-        bottle taken out of the hand mid-pour, once regrasped upright, is not poured again: v3
-        (pouring) was passed and v4 (held upright after pouring) holds. Never into the goal, whose
-        criterion is the task's. Returns (node to go on from, passed nodes, skipped edges) or None.
-        """
-        here, passed, skipped = node_id, [], []
-        while True:
-            into = self.nominal_next.get(here)
-            middle = self.graph.edge(into).target if into is not None else None
-            out = self.nominal_next.get(middle) if middle in self.passed else None
-            after = self.graph.edge(out).target if out is not None else None
-            if after is None or after == self.graph.goal or not self.constraints[after] or not self.constraints_hold(after):
-                break
-            here = after
-            passed.append(middle)
-            skipped.extend([into, out])
-        return (here, passed, skipped) if here != node_id else None
+    def _node_holds(self, node_id: str) -> bool:
+        """Whether the node has constraints and all of them hold now."""
+        return bool(self.constraints[node_id]) and self.constraints_hold(node_id)
 
     def _resume(self, binding: Binding) -> None:
         """The lost holds came back as they were: the failure cleared, the interrupted edge goes on."""
@@ -453,11 +420,12 @@ class Executor:
                 self.trace.add(self.world.tick, "recovery_merged", node=node_id)
                 self._recovered.extend(self._unmerged)
                 self._unmerged = []
-                ahead = self._merge_ahead(node_id) if self.strategy.merges_met_subgoals else None
+                ahead = None
+                if self.strategy.merges_met_subgoals:
+                    ahead = self.shortcuts.ahead(self.graph, self.nominal_next, node_id, self._node_holds)
                 if ahead is not None:
-                    node_ahead, passed, skipped = ahead
-                    self.trace.add(self.world.tick, "merged_ahead", node=node_id, to=node_ahead, passed=passed, skipped=skipped)
-                    return self._arrive(node_ahead)
+                    self.trace.add(self.world.tick, "merged_ahead", node=node_id, to=ahead.node, passed=ahead.passed, skipped=ahead.skipped)
+                    return self._arrive(ahead.node)
         if node_id == self.graph.goal:
             verdict = self.tracker.verdict(self.frame, self.world)
             return verdict.success, verdict.reason
