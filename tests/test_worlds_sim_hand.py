@@ -60,13 +60,16 @@ def test_out_of_a_moving_gripper_the_object_is_held_clear_of_it_until_it_stops()
     pos, matrix = world.object_pose("bottle")
     gripper = {"pos": pos - np.array([0.0, 0.03, 0.0])}
     path = set_down_path(pos, Rotation.from_matrix(matrix), np.array([0.0, 1.0, 0.0]), np.array([0.1, 0.7]), 0.1, Rotation.identity())
-    hand = PersonHand(world.model, world.data, body, path, tool=lambda: (gripper["pos"].copy(), np.eye(3)))
+    def tool():
+        return gripper["pos"].copy(), np.eye(3)
+
+    hand = PersonHand(world.model, world.data, body, path, tool=tool)
     dt, moving_until = 0.002, OUT_S + 0.4
     offsets, elapsed = [], 0.0
     while elapsed < moving_until:
         gripper["pos"] = gripper["pos"] + np.array([0.0, 0.2 * dt, 0.0])  # 0.2 m/s along the pull
         hand.apply(dt)
-        offsets.append(hand._reference()[0] - gripper["pos"])
+        offsets.append(hand._reference(tool())[0] - gripper["pos"])
         elapsed += dt
     # Out of the fingers: 10 cm beyond where it was held, in the moving gripper's frame; then held there.
     assert np.allclose(offsets[-1], offsets[int(OUT_S / dt) + 5], atol=1e-3)

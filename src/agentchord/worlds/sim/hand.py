@@ -86,49 +86,49 @@ class PersonHand:
             # The first segment's ends in the gripper's frame at the grab.
             tool_pos, tool_rot = tool()
             self._out_local = [tool_rot.T @ (w.pos - tool_pos) for w in self._segments[0]]
-            self._tool_pos, self._tool_speed = tool_pos, 0.0
+            self._tool_pos = tool_pos
         self._held_clear = 0.0
         self._t = 0.0
         self.done = False
 
-    def _out_ends(self) -> tuple[np.ndarray, np.ndarray]:
-        """The first segment's ends in the world now, following the gripper."""
-        tool_pos, tool_rot = self._tool()
+    def _out_ends(self, tool: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+        """The first segment's ends in the world, following the gripper at ``tool`` (position, rotation)."""
+        tool_pos, tool_rot = tool
         return tool_pos + tool_rot @ self._out_local[0], tool_pos + tool_rot @ self._out_local[1]
 
-    def _leave_tool(self) -> None:
+    def _leave_tool(self, tool: tuple[np.ndarray, np.ndarray]) -> None:
         """Out of the fingers and clear: the rest of the path is the world's, from where the object is held."""
-        out_end = self._out_ends()[1]
+        out_end = self._out_ends(tool)[1]
         self._tool = None
         a, b = self._segments[0]
         self._segments[0] = (a, Waypoint(out_end, b.rotation, b.seconds))
         nxt_a, nxt_b = self._segments[1]
         self._segments[1] = (Waypoint(out_end, nxt_a.rotation, nxt_a.seconds), nxt_b)
 
-    def _reference(self) -> tuple[np.ndarray, Rotation]:
+    def _reference(self, tool: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, Rotation]:
+        """The pose the object should have now; ``tool``: the gripper's pose while the object follows it."""
         t = self._t
         for k, ((a, b), slerp) in enumerate(zip(self._segments, self._slerps, strict=True)):
-            if t <= b.seconds or (k == 0 and self._tool is not None):
+            if t <= b.seconds or (k == 0 and tool is not None):
                 s = min_jerk(t / b.seconds)
-                start, end = self._out_ends() if k == 0 and self._tool is not None else (a.pos, b.pos)
+                start, end = self._out_ends(tool) if k == 0 and tool is not None else (a.pos, b.pos)
                 return start + s * (end - start), slerp([s])[0]
             t -= b.seconds
         last = self._segments[-1][1]
         return last.pos, last.rotation
 
-    def _advance(self, dt: float) -> None:
+    def _advance(self, dt: float, tool: tuple[np.ndarray, np.ndarray] | None) -> None:
         """Move the path's clock on; out of the fingers, wait while the gripper still moves."""
-        if self._tool is not None:
-            tool_pos = self._tool()[0]
-            self._tool_speed = float(np.linalg.norm(tool_pos - self._tool_pos)) / dt
-            self._tool_pos = tool_pos
+        if tool is not None:
+            speed = float(np.linalg.norm(tool[0] - self._tool_pos)) / dt
+            self._tool_pos = tool[0]
             out_s = self._segments[0][1].seconds
             if self._t + dt > out_s:
-                if self._tool_speed > MOVING_TOOL_SPEED and self._held_clear < MAX_CLEAR_HOLD_S:
+                if speed > MOVING_TOOL_SPEED and self._held_clear < MAX_CLEAR_HOLD_S:
                     self._t = out_s
                     self._held_clear += dt
                     return
-                self._leave_tool()
+                self._leave_tool(tool)
         self._t += dt
 
     @property
@@ -143,7 +143,8 @@ class PersonHand:
             wrench[:] = 0.0
             self.done = True
             return
-        pos_ref, rot_ref = self._reference()
+        tool = self._tool() if self._tool is not None else None  # read once per physics step
+        pos_ref, rot_ref = self._reference(tool)
         vel = np.zeros(6)
         mujoco.mj_objectVelocity(self.model, self.data, mujoco.mjtObj.mjOBJ_BODY, self.body, vel, 0)
         omega, lin = vel[:3], vel[3:]
@@ -157,7 +158,7 @@ class PersonHand:
         max_torque = min(MAX_TORQUE, self.inertia * MAX_ANGULAR_ACCEL)
         wrench[:3] = force * min(1.0, max_force / max(np.linalg.norm(force), 1e-9))
         wrench[3:] = torque * min(1.0, max_torque / max(np.linalg.norm(torque), 1e-9))
-        self._advance(dt)
+        self._advance(dt, tool)
 
 
 def set_down_path(
