@@ -33,6 +33,15 @@ def test_a_bottle_pushed_askew_in_its_grasp_is_set_down_and_taken_again():
     assert "e2_r_bottle_slipped" in _recoveries(result)
 
 
+def test_a_bottle_taken_again_askew_after_a_reseat_is_set_down_before_the_pour():
+    # Real-world protocol, seed 16: the person lays the bottle down; the reseat's retreat knocks it
+    # against the cup and the side grasp takes it leaning 35 deg. The carry on to the cup watches
+    # for an askew hold as the nominal carry does, so it is set down and taken again, not poured askew.
+    result = run_episode(EpisodeSpec("single_arm_pour_water", seed=16, protocol=True, disturb=("perturb", "pull")))
+    assert result.success, result.reason
+    assert _recoveries(result)[-1] == "r_bottle_regrasped_slipped"
+
+
 class _Both:
     """Two scripted disturbances in one episode (each keeps its own schedule)."""
 

@@ -99,8 +99,9 @@ class BacktrackStrategy(RecoveryStrategy):
     """
 
     name = "agentchord-bt"
-    #: The same graph, monitors and compilation without recovery branches: no arranger call.
-    begin_roles = {"composer": "plan", "conductor": "plan"}
+    # The same three agents answer before the first tick (the default ``begin_roles``): the paper's
+    # ablation keeps "the same task graph, feature extractors and compiled monitors", and the
+    # monitors are the arranger's (its failure modes); only the recovery edges are not followed.
 
     def recover(self, executor: Executor, detection: Detection) -> list[EdgeProgram]:
         for node_id in reversed(executor.visited_nominal):
