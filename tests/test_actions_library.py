@@ -6,6 +6,7 @@ from scipy.spatial.transform import Rotation
 
 from agentchord.actions.base import Status
 from agentchord.actions.controller import RobotController
+from agentchord.actions.grasp import GraspMissed
 from agentchord.actions.library import make_action
 from agentchord.features.oracle import OracleExtractor
 from agentchord.worlds.sim.world import SimWorld
@@ -77,6 +78,23 @@ def test_grasp_of_a_fallen_bottle_sets_it_upright_in_hand(pour_scene):
     assert status == Status.SUCCESS, make_action
     assert world.holding("right", "bottle")
     assert extractor.frame.objects["bottle"].axis[2] > np.cos(np.radians(20))
+
+
+def test_a_side_grasp_refuses_an_object_knocked_over_meanwhile(pour_scene):
+    # A side grasp closing on a bottle that now lies would carry it lying across the fingers; the
+    # grasp's retry takes it the way a fallen one is taken instead.
+    world, robot, extractor = _setup(pour_scene)
+    grasp = make_action("grasp", "right", {"obj": "bottle"})
+    grasp._still_standing(robot, "during the approach")  # upright: goes on
+    adr = world.model.joint("bottle_free").qposadr[0]
+    radius = pour_scene.objects[0].size[0]
+    x, y, z, w = (Rotation.from_euler("z", 1.2) * Rotation.from_euler("y", 90, degrees=True)).as_quat()
+    world.data.qpos[adr : adr + 7] = [0.08, 0.5, radius + 0.001, w, x, y, z]
+    for _ in range(40):
+        world.step()
+    extractor.update()
+    with pytest.raises(GraspMissed, match="fell over during the approach"):
+        grasp._still_standing(robot, "during the approach")
 
 
 def test_place_without_the_object_in_hand_fails_with_a_reason(pour_scene):

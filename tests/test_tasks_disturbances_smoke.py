@@ -42,6 +42,15 @@ def test_a_bottle_taken_again_askew_after_a_reseat_is_set_down_before_the_pour()
     assert _recoveries(result)[-1] == "r_bottle_regrasped_slipped"
 
 
+def test_a_bottle_knocked_over_as_it_is_taken_again_is_taken_as_a_fallen_one():
+    # Stress protocol, seed 19: the bottle pulled out of the hand during the pour is set down upright;
+    # the regrasp's approach knocks it over and used to close on it lying, carrying it across the
+    # fingers to a pour that never came. The grasp now sees it fell and takes it as a fallen one.
+    result = run_episode(EpisodeSpec("dual_arm_pour_water", seed=19, protocol=True, disturb=KINDS))
+    assert result.success, result.reason
+    assert _recoveries(result) == ["e4_r_bottle_dropped"]
+
+
 class _Both:
     """Two scripted disturbances in one episode (each keeps its own schedule)."""
 

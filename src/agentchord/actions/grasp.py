@@ -251,6 +251,8 @@ class Grasp(ArmAction):
         yield from grip(robot, self.arm, 1.0)
         if not robot.frame.is_holding(self.arm, self.args.obj):
             raise GraspMissed(f"fingers closed but {self.args.obj} is not held")
+        if self._taken_as == "side":
+            self._still_standing(robot, "as the fingers closed")
         # Pushed while the fingers closed, it is held off-centre (a pour or a place would then miss):
         # where the grasp point is now, seen from where the tool aimed, says so.
         # (Not for a fallen or leaning object: the closing fingers turn it, which is the point.)
@@ -262,6 +264,17 @@ class Grasp(ArmAction):
             off = float(np.linalg.norm(self._side_point(robot, self._height_fraction) - aimed))
         if off > OFF_CENTRE_TOLERANCE:
             raise GraspMissed(f"{self.args.obj} is held {100 * off:.1f} cm off the grasp point")
+
+    def _still_standing(self, robot: RobotController, when: str) -> None:
+        """A side grasp is for an object standing or leaning a little: knocked over meanwhile (by this
+        arm's own fingers, or a push), it is taken again the way a fallen one is.
+
+        Raises:
+            GraspMissed: The object now leans as far as a fallen one (the retry takes it lying).
+        """
+        tilt = tilt_deg(robot.frame.objects[self.args.obj].axis)
+        if tilt >= self.LEANING_AS_FALLEN_DEG:
+            raise GraspMissed(f"{self.args.obj} fell over {when} ({tilt:.0f} deg)")
 
     def _side_rotation(self, robot: RobotController, point: np.ndarray) -> np.ndarray:
         """The side-grasp tool frame: approach from the arm's base, or at the yaw asked for."""
@@ -276,6 +289,7 @@ class Grasp(ArmAction):
         if np.linalg.norm(robot.commanded_pose(arm).pos[:2] - pre[:2]) > 0.05:
             yield from self._clear_from_below(robot, pre[2] + 0.08)
         yield from approach(robot, arm, pose_from_matrix(pre, rotation))
+        self._still_standing(robot, "during the approach")
         # Re-observe: the object may have moved while the arm approached.
         point = self._side_point(robot, self._height_fraction)
         yield from move_to(robot, arm, pose_from_matrix(point, rotation), speed=0.15)
