@@ -5,13 +5,12 @@ the active edge's compiled monitors, and on a persistent violation switch at
 once to what the recovery strategy says -- for AgentChord a pre-compiled
 forward-moving recovery edge that starts from the robot's current state, for
 the backtracking ablation a return to an earlier node's keyframe. Budgets end
-an episode as a failure with a reason, never as a hang. A recovery that must wait for what fell
-to come to rest keeps the interrupted edge suspended: if the lost hold comes back as it was, the
-failure has cleared and the edge resumes (:mod:`agentchord.execution.binding`); a recovery with nothing
-left to do stops short (:mod:`agentchord.execution.shortcuts`). With a repairer, an edge
-that ends short of its target's constraints with no monitor fired (a failure
-nobody anticipated) is repaired online: the graph gains one branch, the compiled
-artefacts are rebuilt and the new recovery edge starts at once.
+an episode as a failure with a reason, never as a hang.
+
+This module holds the loop, the transitions between edges and nodes, and the queries the
+strategies ask; what happens from a detection to the recovery program running (binding, a
+cleared failure, online repair) is :mod:`agentchord.execution.switching`, and the disturbance
+metrics are :mod:`agentchord.execution.ledger`.
 """
 
 from __future__ import annotations
@@ -25,15 +24,15 @@ import numpy as np
 from agentchord.actions.base import ArmAction, Status
 from agentchord.actions.catalog import ACTIONS
 from agentchord.actions.controller import RobotController
-from agentchord.agents.exceptions import ReasonerError
-from agentchord.agents.reasoner import UnanticipatedFailure
 from agentchord.execution.binding import Binding, HoldMemory
 from agentchord.execution.edge_program import EdgeProgram
 from agentchord.execution.feasibility import FeasibilityChecker, first_grasps, off_table
-from agentchord.execution.harness import Disturbance, DisturbanceEvent, SuccessTracker
-from agentchord.execution.repair import RepairRejectedError, Repairer, validate_repair
+from agentchord.execution.harness import Disturbance, SuccessTracker
+from agentchord.execution.ledger import DisturbanceLedger
+from agentchord.execution.repair import Repairer
 from agentchord.execution.result import UNRECOVERABLE, EpisodeResult
 from agentchord.execution.shortcuts import Shortcuts
+from agentchord.execution.switching import RecoverySwitching
 from agentchord.execution.strategies import RecoveryStrategy
 from agentchord.execution.trace import Trace
 from agentchord.expr import Vocabulary, compile_expr
@@ -65,7 +64,7 @@ class ExecutorConfig:
     bind_wait_ticks: int = 100
 
 
-class Executor:
+class Executor(RecoverySwitching):
     """Runs one episode of a graph on a world with a recovery strategy.
 
     Args:
@@ -127,21 +126,14 @@ class Executor:
         self.recovering_from: str | None = None
         self.fire_counts: dict[tuple[str, str], int] = {}
         self.node = self.graph.start
-        self._open_disturbance: DisturbanceEvent | None = None
-        self._latencies: list[int] = []
-        self._detected: list[DisturbanceEvent] = []
-        self._recovered: list[DisturbanceEvent] = []
-        # Detected disturbances whose recovery has not merged back yet (a second one can interrupt the first's).
-        self._unmerged: list[DisturbanceEvent] = []
+        self.disturbances = DisturbanceLedger()
         # (edge, target) pairs a repair was attempted for: one attempt each.
         self._repair_attempts: set[tuple[str, str]] = set()
-        # Reasoning charged so far (see charge()), and at the last disturbance (for reaction seconds).
+        # Reasoning charged so far (see charge()).
         self.reasoning_s = 0.0
         self.compute_s = 0.0
         self.reasoning_calls: dict[str, int] = {}
         self.replans = 0
-        self._reasoning_at_disturbance = 0.0
-        self._reaction_s: list[float] = []
 
     def _compile(self, graph: TaskGraph) -> None:
         """Adopt a (filtered) graph: compile what the tick loop evaluates.
@@ -209,6 +201,7 @@ class Executor:
             outcome = self._tick()
         success, reason = outcome
         injected = self.disturbance.events if self.disturbance is not None else []
+        drops = self.disturbances.drops(injected)
         result = EpisodeResult(
             success=success,
             reason=reason,
@@ -219,17 +212,16 @@ class Executor:
             failures_detected=len(self.trace.of("failure_detected")),
             recoveries=len(self.trace.of("recovery_switch")) - len(self.trace.of("failure_cleared")),
             repairs=sum(e["accepted"] for e in self.trace.of("repair")),
-            drops_injected=sum(e.kind == "drop" for e in injected),
-            drops_detected=sum(e.kind == "drop" for e in self._detected),
-            drops_recovered=sum(e.kind == "drop" for e in self._recovered),
-            disturbances={kind: [sum(e.kind == kind for e in group) for group in (injected, self._detected, self._recovered)]
-                          for kind in sorted({e.kind for e in injected})},
-            reaction_latency_ticks=self._latencies,
+            drops_injected=drops[0],
+            drops_detected=drops[1],
+            drops_recovered=drops[2],
+            disturbances=self.disturbances.by_kind(injected),
+            reaction_latency_ticks=self.disturbances.latency_ticks,
             trace=self.trace,
             compute_s=self.compute_s,
             reasoning_s=self.reasoning_s,
             reasoning_calls=dict(sorted(self.reasoning_calls.items())),
-            reaction_latency_s=self._reaction_s,
+            reaction_latency_s=self.disturbances.latency_s,
             replans=self.replans,
         )
         self.trace.add(self.world.tick, "episode_end", success=success, reason=reason, steps=result.steps)
@@ -246,8 +238,7 @@ class Executor:
         if self.disturbance is not None:
             event = self.disturbance.apply(self.world, frame)
             if event is not None:
-                self._open_disturbance = event
-                self._reasoning_at_disturbance = self.reasoning_s
+                self.disturbances.injected(event, self.reasoning_s)
                 self.trace.add(event.tick, "disturbance", kind=event.kind, arm=event.arm, obj=event.obj, action=event.action)
         if self.world.tick >= self.config.tick_limit:
             return False, f"tick limit {self.config.tick_limit} reached at {self._where()}"
@@ -323,84 +314,9 @@ class Executor:
                 return f"{UNRECOVERABLE}: {name} fell off the table (z = {z:.2f} m, table top at 0) at {self._where()}"
         return None
 
-    def _beyond_every_arm(self, obj: str, confirm_ik: bool) -> tuple[bool, str] | None:
-        """The unrecoverable outcome when no arm can take ``obj`` where it is (else None)."""
-        beyond = self.feasibility.unreachable(obj, confirm_ik=confirm_ik)
-        if not beyond:
-            return None
-        reasons = "; ".join(c.reason for c in beyond)
-        self.trace.add(self.world.tick, "unrecoverable", obj=obj, reason=reasons)
-        return False, f"{UNRECOVERABLE}: no arm can take {obj} at {self.feasibility.where(obj)} ({reasons})"
-
-    # ------------------------------------------------------- binding
-    def _begin_recovery(self, candidates: list[EdgeProgram]) -> tuple[bool, str] | None:
-        """Start a recovery: at once when it grasps nothing, else after binding its arm."""
-        objects = sorted({g.args.obj for c in candidates for g in first_grasps(c)})
-        if not objects:
-            self._start(candidates[0])
-            return None
-        # The arms hold still while what was dropped or taken comes to rest; then the arm is bound.
-        self.program, self.armed = None, None
-        self.binding = Binding(candidates, objects, self.world.tick)
-        return None
-
-    def _bind(self, frame: FeatureFrame) -> tuple[bool, str] | None:
-        """One tick of a binding recovery: wait for rest, then start the first feasible candidate."""
-        binding = self.binding
-        waited = self.world.tick - binding.since
-        if binding.holds_back(frame):
-            self._resume(binding)
-            return None
-        if not binding.at_rest(frame, CONTROL_HZ) and waited < self.config.bind_wait_ticks:
-            return None
-        self.binding = None
-        if binding.suspended is not None:
-            binding.suspended.terminate(Status.INVALID)
-        met = None
-        if self.strategy.merges_met_subgoals:
-            met = Shortcuts.met_merge(self.graph, binding.candidates[0], binding.objects, self.frame.holding, self._node_holds)
-        if met is not None:
-            # What the recovery was for already holds (a bottle pulled out of the hand as it was being
-            # put down, set down upright by the person): nothing to redo, go on from the merge node.
-            self.trace.add(self.world.tick, "subgoal_met", edge=binding.candidates[0].edge_id, node=met,
-                           waited_ticks=waited)
-            return self._arrive(met)
-        refused = []
-        for k, candidate in enumerate(binding.candidates):
-            problems = self.feasibility.check_program(candidate)
-            if not problems:
-                self.trace.add(self.world.tick, "recovery_bound", edge=candidate.edge_id, waited_ticks=waited,
-                               refused=refused, arms=sorted({a.arm for step in candidate.steps for a in step}))
-                self._start(candidate)
-                self._fallbacks = binding.candidates[k + 1:]  # not started yet: still fresh programs
-                return None
-            refused.append({"edge": candidate.edge_id, "reason": "; ".join(p.reason for p in problems)})
-        summary = "; ".join(f"{r['edge']}: {r['reason']}" for r in refused)
-        for obj in binding.objects:
-            outcome = self._beyond_every_arm(obj, confirm_ik=True)
-            if outcome is not None:
-                return outcome
-        return False, f"no feasible recovery for {', '.join(binding.objects)} at {self.feasibility.where(binding.objects[0])}: {summary}"
-
     def _node_holds(self, node_id: str) -> bool:
         """Whether the node has constraints and all of them hold now."""
         return bool(self.constraints[node_id]) and self.constraints_hold(node_id)
-
-    def _resume(self, binding: Binding) -> None:
-        """The lost holds came back as they were: the failure cleared, the interrupted edge goes on."""
-        self.binding = None
-        program = binding.suspended
-        self.program = program
-        self._arm_monitors(program)
-        self.recovering_from = binding.recovering_from
-        # A cleared failure cost nothing: it does not count against the mode's failure budget.
-        self.fire_counts[(program.edge_id, binding.failure)] -= 1
-        if self.recovering_from is None:  # nothing else is being recovered: this disturbance is over
-            self._recovered.extend(self._unmerged)
-            self._unmerged = []
-        self.trace.add(self.world.tick, "failure_cleared", edge=program.edge_id, failure=binding.failure,
-                       waited_ticks=self.world.tick - binding.since,
-                       objects=[h.obj for h in binding.lost])
 
     # ------------------------------------------------------- transitions
     def _arrive(self, node_id: str) -> tuple[bool, str] | None:
@@ -418,8 +334,7 @@ class Executor:
             if self.recovering_from is not None:
                 self.recovering_from = None
                 self.trace.add(self.world.tick, "recovery_merged", node=node_id)
-                self._recovered.extend(self._unmerged)
-                self._unmerged = []
+                self.disturbances.merged()
                 ahead = None
                 if self.strategy.merges_met_subgoals:
                     ahead = self.shortcuts.ahead(self.graph, self.nominal_next, node_id, self._node_holds)
@@ -505,92 +420,6 @@ class Executor:
             self._start(EdgeProgram.from_edge(exits[0]))
             return None
         return self._arrive(program.target)
-
-    def _on_failure(self, detection: Detection) -> tuple[bool, str] | None:
-        key = (detection.edge_id, detection.failure.name)
-        self.fire_counts[key] = self.fire_counts.get(key, 0) + 1
-        self.trace.add(detection.tick, "failure_detected", edge=detection.edge_id, failure=detection.failure.name,
-                       onset_tick=detection.onset_tick, value=detection.value, count=self.fire_counts[key])
-        disturbance = self._open_disturbance
-        if disturbance is not None:
-            # The first detection after a disturbance is its detection.
-            self._detected.append(self._open_disturbance)
-            self._latencies.append(detection.tick - self._open_disturbance.tick)
-            self._unmerged.append(self._open_disturbance)
-            self._open_disturbance = None
-        if self.fire_counts[key] > self.config.failure_budget:
-            return False, f"failure budget exhausted: {detection.failure.name} on {detection.edge_id} fired {self.fire_counts[key]} times"
-        interrupted, self.program = self.program, None  # None after an online repair: the failed edge had ended
-        resumable = interrupted is not None and self.strategy.resumes_cleared_failures
-        if interrupted is not None and not resumable:
-            interrupted.terminate(Status.INVALID)
-        failed_nominal = self.recovering_from or detection.edge_id
-        candidates = self.strategy.recover(self, detection)
-        lost = None
-        if resumable:
-            # A hold lost by the interrupted edge's arms may come back while the recovery waits.
-            objects = sorted({g.args.obj for c in candidates for g in first_grasps(c)})
-            lost = self.holds.lost(self.frame, {a.arm for a in interrupted.running}, objects) if objects else None
-            if lost is None:
-                interrupted.terminate(Status.INVALID)
-        if not candidates:
-            return False, f"no recovery for {detection.failure.name} on {detection.edge_id}"
-        previous_context, self.recovering_from = self.recovering_from, failed_nominal
-        if disturbance is not None:
-            # Seconds from the disturbance to this switch: robot time plus the reasoning charged since.
-            self._reaction_s.append((self.world.tick - disturbance.tick) / CONTROL_HZ + self.reasoning_s - self._reasoning_at_disturbance)
-        self.trace.add(self.world.tick, "recovery_switch", failure=detection.failure.name, edge=detection.edge_id,
-                       to=candidates[0].edge_id, alternatives=[c.edge_id for c in candidates[1:]],
-                       strategy=self.strategy.name, latency_ticks=self.world.tick - detection.onset_tick)
-        outcome = self._begin_recovery(candidates)
-        if lost is not None:
-            # The recovery waits for what fell; if it was never really let go, the edge goes on.
-            self.binding.suspended, self.binding.lost = interrupted, lost
-            self.binding.failure, self.binding.recovering_from = detection.failure.name, previous_context
-            self.binding.window = detection.failure.window
-        return outcome
-
-    def _repair(self, program: EdgeProgram) -> Detection | None:
-        """Online repair of an unanticipated failure at the end of ``program``.
-
-        The program ended (so no monitor of its edge fired) but its target's
-        constraints do not hold. Within the budgets, ask the repairer for one new
-        failure mode on the edge, validate it, rebuild the compiled graph and
-        return the detection "as if" the new mode's monitor had fired now, so the
-        usual switch (the strategy's ``recover``: for AgentChord the new entry
-        edge) starts from where the robot is. The failed target is not "reached".
-
-        Returns:
-            The synthetic detection, or None to carry on as without a repairer.
-        """
-        if self.repairer is None or program.kind == "backtrack" or self.constraints_hold(program.target):
-            return None
-        key = (program.edge_id, program.target)
-        if len(self._repair_attempts) >= self.config.max_repairs or key in self._repair_attempts:
-            return None
-        self._repair_attempts.add(key)
-        edge = self.graph.edge(program.edge_id)
-        failure = UnanticipatedFailure(edge=edge.id, context=edge.source, observation=self.describe_violation(program.target))
-        record = {"edge": edge.id, "target": program.target, "context": edge.source, "observation": failure.observation}
-        started = time.perf_counter()
-        try:
-            proposal = self.repairer(self.graph, failure, self.frame)
-            if proposal is None:
-                raise RepairRejectedError(edge.id, "the repairer proposed no branch")
-            repair = validate_repair(self.graph, proposal, failure)
-        except (RepairRejectedError, ReasonerError) as error:
-            reason = error.reason if isinstance(error, RepairRejectedError) else error.headline
-            self.trace.add(self.world.tick, "repair", **record, failure=None, recovery=None, accepted=False,
-                           reason=reason, latency_s=time.perf_counter() - started)
-            return None
-        self._compile(repair.filtered.graph)
-        latency = time.perf_counter() - started
-        for removed in repair.filtered.removed:
-            self.trace.add(self.world.tick, "branch_removed", failure=removed.failure, edge=removed.edge, reason=removed.reason)
-        self.trace.add(self.world.tick, "repair", **record, failure=repair.failure.name, recovery=repair.recovery.id,
-                       accepted=True, latency_s=latency)
-        monitor = next(m for m in self.monitors[edge.id].monitors if m.failure.name == repair.failure.name)
-        return Detection(edge.id, repair.failure, self.world.tick, self.world.tick, monitor.expr.scalar(self.frame))
 
     # --------------------------------------------------------- hooks
     def _action_started(self, arm: str, action: ArmAction) -> None:

@@ -1,0 +1,216 @@
+"""From a detection to the recovery program running: the executor's failure switching.
+
+On a detection the strategy names its recovery programs; :meth:`_on_failure` switches to them at
+once. A recovery that grasps first waits (binds) until what fell is at rest, then starts the first
+candidate its arms can make (:mod:`agentchord.execution.feasibility`); while it waits, a lost hold
+that comes back as it was resumes the interrupted edge (:mod:`agentchord.execution.binding`), and a
+recovery whose merge sub-goal already holds is skipped (:mod:`agentchord.execution.shortcuts`). An
+edge that ends short of its target with no monitor fired is repaired online, within budgets
+(:mod:`agentchord.execution.repair`).
+
+:class:`RecoverySwitching` is a part of :class:`~agentchord.execution.executor.Executor` (a mixin):
+it reads and sets the executor's episode state, named in the annotations below.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import TYPE_CHECKING, Any
+
+from agentchord.actions.base import Status
+from agentchord.agents.exceptions import ReasonerError
+from agentchord.agents.reasoner import UnanticipatedFailure
+from agentchord.execution.binding import Binding, HoldMemory
+from agentchord.execution.edge_program import EdgeProgram
+from agentchord.execution.feasibility import FeasibilityChecker, first_grasps
+from agentchord.execution.ledger import DisturbanceLedger
+from agentchord.execution.repair import RepairRejectedError, Repairer, validate_repair
+from agentchord.execution.result import UNRECOVERABLE
+from agentchord.execution.shortcuts import Shortcuts
+from agentchord.features.frame import FeatureFrame
+from agentchord.monitor import Detection
+from agentchord.worlds.protocol import CONTROL_HZ
+
+if TYPE_CHECKING:
+    from agentchord.execution.strategies import RecoveryStrategy
+    from agentchord.execution.trace import Trace
+    from agentchord.graph.models import TaskGraph
+    from agentchord.monitor import EdgeMonitors
+    from agentchord.worlds.protocol import World
+
+
+class RecoverySwitching:
+    """The executor's failure handling (detection -> recovery switch -> binding -> start or resume)."""
+
+    # The executor's state this part reads and sets.
+    world: World
+    graph: TaskGraph
+    config: Any  # ExecutorConfig (its budgets); not imported: executor.py imports this module
+    strategy: RecoveryStrategy
+    trace: Trace
+    feasibility: FeasibilityChecker
+    shortcuts: Shortcuts
+    holds: HoldMemory
+    disturbances: DisturbanceLedger
+    repairer: Repairer | None
+    monitors: dict[str, EdgeMonitors]
+    program: EdgeProgram | None
+    binding: Binding | None
+    armed: EdgeMonitors | None
+    recovering_from: str | None
+    fire_counts: dict[tuple[str, str], int]
+    reasoning_s: float
+    _fallbacks: list[EdgeProgram]
+    _repair_attempts: set[tuple[str, str]]
+
+    def _beyond_every_arm(self, obj: str, confirm_ik: bool) -> tuple[bool, str] | None:
+        """The unrecoverable outcome when no arm can take ``obj`` where it is (else None)."""
+        beyond = self.feasibility.unreachable(obj, confirm_ik=confirm_ik)
+        if not beyond:
+            return None
+        reasons = "; ".join(c.reason for c in beyond)
+        self.trace.add(self.world.tick, "unrecoverable", obj=obj, reason=reasons)
+        return False, f"{UNRECOVERABLE}: no arm can take {obj} at {self.feasibility.where(obj)} ({reasons})"
+
+    def _begin_recovery(self, candidates: list[EdgeProgram]) -> tuple[bool, str] | None:
+        """Start a recovery: at once when it grasps nothing, else after binding its arm."""
+        objects = sorted({g.args.obj for c in candidates for g in first_grasps(c)})
+        if not objects:
+            self._start(candidates[0])
+            return None
+        # The arms hold still while what was dropped or taken comes to rest; then the arm is bound.
+        self.program, self.armed = None, None
+        self.binding = Binding(candidates, objects, self.world.tick)
+        return None
+
+    def _bind(self, frame: FeatureFrame) -> tuple[bool, str] | None:
+        """One tick of a binding recovery: wait for rest, then start the first feasible candidate."""
+        binding = self.binding
+        waited = self.world.tick - binding.since
+        if binding.holds_back(frame):
+            self._resume(binding)
+            return None
+        if not binding.at_rest(frame, CONTROL_HZ) and waited < self.config.bind_wait_ticks:
+            return None
+        self.binding = None
+        if binding.suspended is not None:
+            binding.suspended.terminate(Status.INVALID)
+        met = None
+        if self.strategy.merges_met_subgoals:
+            met = Shortcuts.met_merge(self.graph, binding.candidates[0], binding.objects, self.frame.holding, self._node_holds)
+        if met is not None:
+            # What the recovery was for already holds (a bottle pulled out of the hand as it was being
+            # put down, set down upright by the person): nothing to redo, go on from the merge node.
+            self.trace.add(self.world.tick, "subgoal_met", edge=binding.candidates[0].edge_id, node=met,
+                           waited_ticks=waited)
+            return self._arrive(met)
+        refused = []
+        for k, candidate in enumerate(binding.candidates):
+            problems = self.feasibility.check_program(candidate)
+            if not problems:
+                self.trace.add(self.world.tick, "recovery_bound", edge=candidate.edge_id, waited_ticks=waited,
+                               refused=refused, arms=sorted({a.arm for step in candidate.steps for a in step}))
+                self._start(candidate)
+                self._fallbacks = binding.candidates[k + 1:]  # not started yet: still fresh programs
+                return None
+            refused.append({"edge": candidate.edge_id, "reason": "; ".join(p.reason for p in problems)})
+        summary = "; ".join(f"{r['edge']}: {r['reason']}" for r in refused)
+        for obj in binding.objects:
+            outcome = self._beyond_every_arm(obj, confirm_ik=True)
+            if outcome is not None:
+                return outcome
+        return False, f"no feasible recovery for {', '.join(binding.objects)} at {self.feasibility.where(binding.objects[0])}: {summary}"
+
+    def _resume(self, binding: Binding) -> None:
+        """The lost holds came back as they were: the failure cleared, the interrupted edge goes on."""
+        self.binding = None
+        program = binding.suspended
+        self.program = program
+        self._arm_monitors(program)
+        self.recovering_from = binding.recovering_from
+        # A cleared failure cost nothing: it does not count against the mode's failure budget.
+        self.fire_counts[(program.edge_id, binding.failure)] -= 1
+        if self.recovering_from is None:  # nothing else is being recovered: this disturbance is over
+            self.disturbances.merged()
+        self.trace.add(self.world.tick, "failure_cleared", edge=program.edge_id, failure=binding.failure,
+                       waited_ticks=self.world.tick - binding.since,
+                       objects=[h.obj for h in binding.lost])
+
+    def _on_failure(self, detection: Detection) -> tuple[bool, str] | None:
+        key = (detection.edge_id, detection.failure.name)
+        self.fire_counts[key] = self.fire_counts.get(key, 0) + 1
+        self.trace.add(detection.tick, "failure_detected", edge=detection.edge_id, failure=detection.failure.name,
+                       onset_tick=detection.onset_tick, value=detection.value, count=self.fire_counts[key])
+        disturbance = self.disturbances.detection(detection.tick)
+        if self.fire_counts[key] > self.config.failure_budget:
+            return False, f"failure budget exhausted: {detection.failure.name} on {detection.edge_id} fired {self.fire_counts[key]} times"
+        interrupted, self.program = self.program, None  # None after an online repair: the failed edge had ended
+        resumable = interrupted is not None and self.strategy.resumes_cleared_failures
+        if interrupted is not None and not resumable:
+            interrupted.terminate(Status.INVALID)
+        failed_nominal = self.recovering_from or detection.edge_id
+        candidates = self.strategy.recover(self, detection)
+        lost = None
+        if resumable:
+            # A hold lost by the interrupted edge's arms may come back while the recovery waits.
+            objects = sorted({g.args.obj for c in candidates for g in first_grasps(c)})
+            lost = self.holds.lost(self.frame, {a.arm for a in interrupted.running}, objects) if objects else None
+            if lost is None:
+                interrupted.terminate(Status.INVALID)
+        if not candidates:
+            return False, f"no recovery for {detection.failure.name} on {detection.edge_id}"
+        previous_context, self.recovering_from = self.recovering_from, failed_nominal
+        if disturbance is not None:
+            self.disturbances.switched(disturbance, self.world.tick, self.reasoning_s)
+        self.trace.add(self.world.tick, "recovery_switch", failure=detection.failure.name, edge=detection.edge_id,
+                       to=candidates[0].edge_id, alternatives=[c.edge_id for c in candidates[1:]],
+                       strategy=self.strategy.name, latency_ticks=self.world.tick - detection.onset_tick)
+        outcome = self._begin_recovery(candidates)
+        if lost is not None:
+            # The recovery waits for what fell; if it was never really let go, the edge goes on.
+            self.binding.suspended, self.binding.lost = interrupted, lost
+            self.binding.failure, self.binding.recovering_from = detection.failure.name, previous_context
+            self.binding.window = detection.failure.window
+        return outcome
+
+    def _repair(self, program: EdgeProgram) -> Detection | None:
+        """Online repair of an unanticipated failure at the end of ``program``.
+
+        The program ended (so no monitor of its edge fired) but its target's
+        constraints do not hold. Within the budgets, ask the repairer for one new
+        failure mode on the edge, validate it, rebuild the compiled graph and
+        return the detection "as if" the new mode's monitor had fired now, so the
+        usual switch (the strategy's ``recover``: for AgentChord the new entry
+        edge) starts from where the robot is. The failed target is not "reached".
+
+        Returns:
+            The synthetic detection, or None to carry on as without a repairer.
+        """
+        if self.repairer is None or program.kind == "backtrack" or self.constraints_hold(program.target):
+            return None
+        key = (program.edge_id, program.target)
+        if len(self._repair_attempts) >= self.config.max_repairs or key in self._repair_attempts:
+            return None
+        self._repair_attempts.add(key)
+        edge = self.graph.edge(program.edge_id)
+        failure = UnanticipatedFailure(edge=edge.id, context=edge.source, observation=self.describe_violation(program.target))
+        record = {"edge": edge.id, "target": program.target, "context": edge.source, "observation": failure.observation}
+        started = time.perf_counter()
+        try:
+            proposal = self.repairer(self.graph, failure, self.frame)
+            if proposal is None:
+                raise RepairRejectedError(edge.id, "the repairer proposed no branch")
+            repair = validate_repair(self.graph, proposal, failure)
+        except (RepairRejectedError, ReasonerError) as error:
+            reason = error.reason if isinstance(error, RepairRejectedError) else error.headline
+            self.trace.add(self.world.tick, "repair", **record, failure=None, recovery=None, accepted=False,
+                           reason=reason, latency_s=time.perf_counter() - started)
+            return None
+        self._compile(repair.filtered.graph)
+        latency = time.perf_counter() - started
+        for removed in repair.filtered.removed:
+            self.trace.add(self.world.tick, "branch_removed", failure=removed.failure, edge=removed.edge, reason=removed.reason)
+        self.trace.add(self.world.tick, "repair", **record, failure=repair.failure.name, recovery=repair.recovery.id,
+                       accepted=True, latency_s=latency)
+        monitor = next(m for m in self.monitors[edge.id].monitors if m.failure.name == repair.failure.name)
+        return Detection(edge.id, repair.failure, self.world.tick, self.world.tick, monitor.expr.scalar(self.frame))
