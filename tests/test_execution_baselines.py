@@ -91,3 +91,26 @@ def test_code_as_monitor_replans_with_the_vlm_on_a_detection():
     assert result.success and result.replans >= 1
     assert set(result.reasoning_calls) == {"vlm"}
     assert _events(result, "failure_detected")  # the compiled monitors fired
+
+
+def test_step_constraints_follow_the_graph_run_now_whatever_its_address():
+    # A re-plan's graph reuses edge ids, and a freed graph's address is reused by a new one: a
+    # cache keyed by id(graph) answered a new graph with an old graph's constraints (an episode then
+    # depended on memory layout). Each new graph here is allocated where the last was freed.
+    import gc
+    from types import SimpleNamespace
+
+    from agentchord.execution.baselines.strategies import DoReMiStrategy
+    from agentchord.tasks import load_task_graph
+
+    strategy = DoReMiStrategy()
+    executor = SimpleNamespace(graph=load_task_graph(TASK))
+    strategy.step_constraints(executor, "e2")
+    for k in range(1, 60):
+        executor.graph = None
+        gc.collect()
+        graph = load_task_graph(TASK)
+        graph.edge("e2").path_constraints = [f"tilt(bottle) - {k}"]
+        executor.graph = graph
+        del graph
+        assert strategy.step_constraints(executor, "e2")[0].source == f"tilt(bottle) - {k}"

@@ -24,7 +24,7 @@ from agentchord.execution.edge_program import EdgeProgram
 from agentchord.execution.reasoning import ReasoningConfig, charge_calls
 from agentchord.execution.strategies import RecoveryStrategy
 from agentchord.expr import Vocabulary, compile_expr
-from agentchord.graph.models import FailureMode
+from agentchord.graph.models import FailureMode, TaskGraph
 from agentchord.graph.progress import nominal_path
 from agentchord.monitor import Detection
 
@@ -85,7 +85,11 @@ class BaselineStrategy(RecoveryStrategy):
         self.reasoning = reasoning or ReasoningConfig()
         self.context = context or BaselineContext()
         self.vqa = SimulatedVqa(self.context.seed, self.reasoning.vqa_miss, self.reasoning.vqa_false_alarm)
-        self._compiled: dict[tuple[int, str], list] = {}
+        # Step constraints compiled for the graph run now, by edge id. The graph itself is kept: a
+        # re-plan's graph reuses edge ids, and a cache keyed by id(graph) could find a collected
+        # graph's entries under a new graph at the same address (an episode then depends on memory).
+        self._compiled_graph: TaskGraph | None = None
+        self._compiled: dict[str, list] = {}
 
     # -- charges ---------------------------------------------------------------------------
     def _charge(self, executor: Executor, kind: str, agent: str) -> None:
@@ -101,7 +105,9 @@ class BaselineStrategy(RecoveryStrategy):
         """What must hold while an edge runs: its path constraints and the constraints its
         source and target share (what is held stays held: ReKep's "still grasping" path
         constraint, DoReMi's step constraints). Compiled, cached per graph."""
-        key = (id(executor.graph), edge_id)
+        if self._compiled_graph is not executor.graph:
+            self._compiled_graph, self._compiled = executor.graph, {}
+        key = edge_id
         if key not in self._compiled:
             graph = executor.graph
             edge = graph.edge(edge_id)
