@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import pytest
 
-from agentchord.agents.reasoner import ArmState, ArrangeRequest, Scene, UnanticipatedFailure, check_reply
+from agentchord.agents.checks import check_reply
+from agentchord.agents.reasoner import ArrangeRequest, UnanticipatedFailure
+from agentchord.agents.scene import ArmState, Scene
 from agentchord.agents.rules import RulesReasoner
 from agentchord.agents.rules.arranger import Arranger
 from agentchord.graph.progress import forward_filter

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from agentchord.agents.observe import observe, task_regions
-from agentchord.agents.reasoner import ComposeRequest, check_reply
+from agentchord.agents.checks import check_reply
+from agentchord.agents.reasoner import ComposeRequest
 from agentchord.agents.rules import RulesReasoner
 from agentchord.tasks import load_task_graph
 from agentchord.worlds.sim.tasks import SIM_TASKS

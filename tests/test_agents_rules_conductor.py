@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
-from agentchord.agents.reasoner import ConductRequest, Scene, SceneObject, check_reply
+from agentchord.agents.checks import check_reply
+from agentchord.agents.reasoner import ConductRequest
+from agentchord.agents.scene import Scene, SceneObject
 from agentchord.agents.rules.conductor import Conductor
 from agentchord.graph.models import ActionCall, Edge, Node, TaskGraph
 

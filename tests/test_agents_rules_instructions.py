@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from agentchord.agents.exceptions import InstructionNotGroundedError
-from agentchord.agents.reasoner import Region, Scene, SceneObject
+from agentchord.agents.scene import Region, Scene, SceneObject
 from agentchord.agents.rules.goals import Folded, HandedOver, Inside, On, Placed, Poured
 from agentchord.agents.rules.instructions import ground_instruction
 

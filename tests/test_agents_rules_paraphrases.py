@@ -18,7 +18,7 @@ import yaml
 from agentchord.agents.exceptions import InstructionNotGroundedError, ReasonerError
 from agentchord.agents.observe import observe, task_regions
 from agentchord.agents.pipeline import make_reasoner, plan_task
-from agentchord.agents.reasoner import Scene
+from agentchord.agents.scene import Scene
 from agentchord.agents.rules.composer import compose
 from agentchord.agents.rules.feasibility import goal_problems
 from agentchord.agents.rules.goals import GoalSpec

@@ -246,7 +246,8 @@ def test_import_release_refuses_a_bad_rename(tmp_path):
 
 def test_an_llm_reply_with_a_bad_object_name_is_a_problem_to_repair_not_a_crash():
     from agentchord.agents.llm import parse_reply
-    from agentchord.agents.reasoner import ComposeRequest, Scene, SceneObject
+    from agentchord.agents.reasoner import ComposeRequest
+    from agentchord.agents.scene import Scene, SceneObject
 
     scene = Scene(objects=[SceneObject(name="bottle", pos=(0, 0.4, 0.1), extent=(0.05, 0.05, 0.2))])
     reply = json.dumps({"task": "t", "start": "v0", "goal": "v1", "objects": ["my bottle"], "nodes": [], "edges": []})
@@ -428,7 +429,8 @@ def test_a_dripping_server_cannot_hold_a_plan_past_the_deadline(tmp_path):
 def test_a_server_that_always_fails_is_given_up_at_the_deadline():
     from agentchord.agents.exceptions import ReasonerTransportError
     from agentchord.agents.llm import LlmConfig, LlmReasoner
-    from agentchord.agents.reasoner import ComposeRequest, Scene
+    from agentchord.agents.reasoner import ComposeRequest
+    from agentchord.agents.scene import Scene
 
     sleeps: list[float] = []
     with HostileServer(lambda body: Reply({"error": {"message": "busy"}}, status=503)) as server:
@@ -466,7 +468,8 @@ def test_an_llm_reply_with_nan_arguments_is_refused_and_its_trace_kept(tmp_path)
 def test_malformed_llm_replies_are_problems_not_crashes(content, usage, message):
     from agentchord.agents.exceptions import InvalidReplyError
     from agentchord.agents.llm import LlmConfig, LlmReasoner
-    from agentchord.agents.reasoner import ComposeRequest, Scene
+    from agentchord.agents.reasoner import ComposeRequest
+    from agentchord.agents.scene import Scene
 
     with HostileServer(lambda body: Reply(completion(content, usage))) as server:
         llm = LlmReasoner(LlmConfig(base_url=server.base_url, model="m", api_key="k", max_repairs=1))
@@ -480,7 +483,8 @@ def test_malformed_llm_replies_are_problems_not_crashes(content, usage, message)
 def test_an_oversized_reply_is_refused_and_not_sent_back():
     from agentchord.agents.exceptions import InvalidReplyError
     from agentchord.agents.llm import LlmConfig, LlmReasoner
-    from agentchord.agents.reasoner import ComposeRequest, Scene
+    from agentchord.agents.reasoner import ComposeRequest
+    from agentchord.agents.scene import Scene
 
     huge = "{" + " " * 3_000_000 + "}"
     with HostileServer(lambda body: Reply(completion(huge))) as server:
@@ -684,7 +688,7 @@ def test_nonsense_goal_specs_are_refused(tmp_path, goals, message):
 
 
 def test_an_object_too_big_for_its_container_is_refused():
-    from agentchord.agents.reasoner import Scene, SceneObject
+    from agentchord.agents.scene import Scene, SceneObject
     from agentchord.agents.rules.feasibility import goal_problems
     from agentchord.agents.rules.goals import GoalSpec
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
+from agentchord.agents.checks import check_reply
 from agentchord.agents.exceptions import (
     InvalidReplyError,
     ReasonerConfigError,
@@ -22,19 +23,16 @@ from agentchord.agents.reasoner import (
     AGENTS,
     Agent,
     AgentRequest,
-    ArmState,
     ArrangeRequest,
     ComposeRequest,
     ConductRequest,
     Reasoner,
     ReasonerAttempt,
     ReasonerCall,
-    Scene,
-    SceneObject,
     UnanticipatedFailure,
-    check_reply,
     total_usage,
 )
+from agentchord.agents.scene import ArmState, Scene, SceneObject
 
 if TYPE_CHECKING:
     from agentchord.agents.llm import LlmConfig, LlmReasoner

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from agentchord.agents.reasoner import Region, Scene
+from agentchord.agents.scene import Region, Scene
 from agentchord.features.extractors import make_extractor
 from agentchord.worlds.protocol import World
 

@@ -15,10 +15,9 @@ from agentchord.agents.reasoner import (
     ConductRequest,
     Reasoner,
     ReasonerCall,
-    Region,
-    Scene,
     UnanticipatedFailure,
 )
+from agentchord.agents.scene import Region, Scene
 from agentchord.agents.rules.goals import GoalSpec
 from agentchord.features.frame import FeatureFrame
 from agentchord.graph.models import TaskGraph

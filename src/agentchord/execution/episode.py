@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 from agentchord.agents.observe import observe, task_regions
 from agentchord.agents.pipeline import ReasonerRepairer, Replanner, make_reasoner, plan_task
-from agentchord.agents.reasoner import Scene
+from agentchord.agents.scene import Scene
 from agentchord.agents.rules.goals import GoalSpec
 from agentchord.execution.baselines.progress import GoalEvents
 from agentchord.execution.baselines.strategies import BaselineContext

@@ -15,16 +15,8 @@ Example:
     -20.0
 """
 
-from agentchord.expr.compiler import (
-    CALLABLES,
-    FUNCTIONS,
-    MAX_DEPTH,
-    MAX_EXPONENT,
-    MAX_SOURCE_LENGTH,
-    CompiledExpr,
-    Vocabulary,
-    compile_expr,
-)
+from agentchord.expr.builder import MAX_EXPONENT
+from agentchord.expr.compiler import CompiledExpr, compile_expr
 from agentchord.expr.exceptions import (
     ExprError,
     ExprEvalError,
@@ -35,7 +27,9 @@ from agentchord.expr.exceptions import (
     ExprValueError,
 )
 from agentchord.expr.library import ArgKind, Function, Param
+from agentchord.expr.parse import MAX_DEPTH, MAX_SOURCE_LENGTH
 from agentchord.expr.templates import TEMPLATES, TemplateInfo
+from agentchord.expr.vocabulary import CALLABLES, FUNCTIONS, Vocabulary
 
 __all__ = [
     "CALLABLES",

@@ -13,7 +13,7 @@ from typing import Annotated
 
 from pydantic import AfterValidator, Field
 
-from agentchord.expr.compiler import CALLABLES
+from agentchord.expr.vocabulary import CALLABLES
 from agentchord.features.frame import ARMS
 
 #: Longest object name accepted.

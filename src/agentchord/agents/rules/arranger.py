@@ -29,7 +29,8 @@ import re
 from collections.abc import Iterable
 from dataclasses import dataclass
 
-from agentchord.agents.reasoner import Scene, SceneObject, UnanticipatedFailure
+from agentchord.agents.reasoner import UnanticipatedFailure
+from agentchord.agents.scene import Scene, SceneObject
 from agentchord.agents.rules import knowledge as kb
 from agentchord.agents.rules.accounts import (
     ARMS,

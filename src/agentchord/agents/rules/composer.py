@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from agentchord.agents.reasoner import Scene
+from agentchord.agents.scene import Scene
 from agentchord.agents.rules import skills
 from agentchord.agents.rules.goals import GoalSpec
 from agentchord.agents.rules.planner import Operator, Plan, Round, State, plan, schedule

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from agentchord.agents.reasoner import Scene, SceneObject
+from agentchord.agents.scene import Scene, SceneObject
 from agentchord.agents.rules.accounts import ARMS, Account, ArmAccount, apply_step
 from agentchord.agents.rules.arranger import Arranger
 from agentchord.graph.models import ActionCall, Edge, TaskGraph

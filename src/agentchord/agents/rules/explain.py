@@ -9,7 +9,7 @@ and says where reading or planning stopped when it does.
 from __future__ import annotations
 
 from agentchord.agents.exceptions import ReasonerError
-from agentchord.agents.reasoner import Scene
+from agentchord.agents.scene import Scene
 from agentchord.agents.rules.composer import compose
 from agentchord.agents.rules.goals import GoalSpec
 from agentchord.agents.rules.instructions import read_instruction

@@ -9,7 +9,7 @@ goal naming an object the scene does not have.
 
 from __future__ import annotations
 
-from agentchord.agents.reasoner import Scene, SceneObject
+from agentchord.agents.scene import Scene, SceneObject
 from agentchord.agents.rules import knowledge as kb
 from agentchord.agents.rules.goals import GoalSpec, Inside, Placed, Poured, static_problems
 

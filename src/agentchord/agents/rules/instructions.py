@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 
 from agentchord.agents.exceptions import InstructionNotGroundedError
 from agentchord.agents.observe import COLOURS
-from agentchord.agents.reasoner import Scene
+from agentchord.agents.scene import Scene
 from agentchord.agents.rules import knowledge as kb
 from agentchord.agents.rules.goals import Folded, Goal, GoalSpec, HandedOver, Inside, On, Placed, Poured
 from agentchord.agents.rules.language import Clause, NounPhrase, ParseError, Where, parse

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
-from agentchord.agents.reasoner import SceneObject
+from agentchord.agents.scene import SceneObject
 
 # --- categories ---------------------------------------------------------------------------
 

@@ -16,6 +16,7 @@ from collections.abc import Callable
 from pydantic import ValidationError
 
 from agentchord.agents.exceptions import InfeasibleGoalError, InvalidReplyError, ReasonerError
+from agentchord.agents.checks import check_reply
 from agentchord.agents.reasoner import (
     AgentRequest,
     ArrangeRequest,
@@ -23,7 +24,6 @@ from agentchord.agents.reasoner import (
     ConductRequest,
     ReasonerAttempt,
     ReasonerCall,
-    check_reply,
 )
 from agentchord.agents.rules.arranger import Arranger
 from agentchord.agents.rules.composer import compose

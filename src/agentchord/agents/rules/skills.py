@@ -22,7 +22,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
-from agentchord.agents.reasoner import Scene, SceneObject
+from agentchord.agents.scene import Scene, SceneObject
 from agentchord.agents.rules import knowledge as kb
 from agentchord.agents.rules.goals import Folded, GoalSpec, HandedOver, Inside, On, Placed, Poured
 from agentchord.agents.rules.planner import Fact, Operator

@@ -1,0 +1,98 @@
+"""What is sent to the model: the system prompt of each agent, the request, a repair turn."""
+
+from __future__ import annotations
+
+import json
+
+from agentchord.agents.llm.replies import task_graph_schema
+from agentchord.agents.prompts import graph_json, render_prompt
+from agentchord.agents.reasoner import AgentRequest, ArrangeRequest, ComposeRequest, ConductRequest
+from agentchord.agents.scene import Scene
+
+
+def system_prompt(agent: str, mode: str = "json_schema") -> str:
+    """The system message of an agent; without ``json_schema`` output, the schema is appended."""
+    prompt = render_prompt(agent)
+    if mode == "json_schema":
+        return prompt
+    schema = json.dumps(task_graph_schema(), separators=(",", ":"))
+    return f"{prompt}\n\n# Reply format\n\nThe reply is one JSON object that matches this JSON Schema:\n\n{schema}\n"
+
+
+def request_message(request: AgentRequest) -> str:
+    """The user message that carries a request's data (the task itself is in the system prompt)."""
+    scene = scene_json(request.scene)
+    if isinstance(request, ComposeRequest):
+        return "\n".join(
+            [
+                f"Instruction: {request.instruction}",
+                f"Task name: {request.task or '(choose a short snake_case name)'}",
+                "First observation (world frame, metres; quat = w, x, y, z; extent = full size along the "
+                "object's principal axes; axis = its bottom-to-top direction):",
+                scene,
+                "",
+                "Write the nominal task graph.",
+            ]
+        )
+    if isinstance(request, ArrangeRequest):
+        lines = [
+            f"Instruction: {request.graph.instruction or '(not given)'}",
+            "Scene (world frame, metres; quat = w, x, y, z; extent = full size along the object's principal axes):",
+            scene,
+            "",
+        ]
+        if request.failure is None:
+            lines += [
+                "Nominal task graph:",
+                graph_json(request.graph),
+                "",
+                "Return the recovery-augmented graph.",
+            ]
+        else:
+            failure = request.failure
+            lines += [
+                "Current task graph:",
+                graph_json(request.graph),
+                "",
+                f"Online repair: edge {failure.edge!r} ended without reaching its target's sub-goal and no "
+                f"monitor fired. Failure context (last completed sub-goal): {failure.context!r}.",
+                f"Observation: {failure.observation or '(none)'}",
+                f"Return the whole graph with one new failure mode on edge {failure.edge!r} and its recovery branch.",
+            ]
+        return "\n".join(lines)
+    if isinstance(request, ConductRequest):
+        return "\n".join(
+            [
+                f"Instruction: {request.graph.instruction or '(not given)'}",
+                "Scene (world frame, metres; quat = w, x, y, z; extent = full size along the object's principal axes):",
+                scene,
+                "",
+                "Recovery-augmented task graph:",
+                graph_json(request.graph),
+                "",
+                "Return the graph with its parameters grounded in this scene.",
+            ]
+        )
+    raise TypeError(f"expected a ComposeRequest, ArrangeRequest or ConductRequest, got {type(request).__name__}")
+
+
+def scene_json(scene: Scene) -> str:
+    """A scene as JSON, one object or arm per line."""
+    data = scene.model_dump(mode="json")
+    lines = ["{"]
+    for key in ("objects", "arms"):
+        items = [f"    {json.dumps(item)}" for item in data[key]]
+        lines += [f'  "{key}": [', ",\n".join(items), "  ],"] if items else [f'  "{key}": [],']
+    lines += [f'  "notes": {json.dumps(data["notes"])}', "}"]
+    return "\n".join(lines)
+
+
+def repair_message(problems: list[str]) -> str:
+    """The follow-up user message that asks the model to fix an invalid reply."""
+    listed = "\n".join(f"- {problem}" for problem in problems)
+    return (
+        "Your reply is not a valid task graph. Problems (field path: what is wrong):\n"
+        f"{listed}\n\n"
+        "Reply again with the complete corrected task graph as one JSON object, no prose; "
+        "keep everything that was right."
+    )

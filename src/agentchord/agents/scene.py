@@ -1,0 +1,143 @@
+"""The first observation the agents reason over: objects, arms and named regions, in plain numbers."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from typing import Any
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from agentchord.features.frame import UP, FeatureFrame
+
+Vec3 = tuple[float, float, float]
+Vec4 = tuple[float, float, float, float]
+
+
+class _Model(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+
+class SceneObject(_Model):
+    """One object of the scene as the reasoner sees it (world frame, metres).
+
+    Attributes:
+        name: The name graphs use for it (``bottle``).
+        description: Category, colour, material, in words (optional).
+        pos: Centre.
+        quat: Orientation (w, x, y, z).
+        axis: Unit principal axis (bottom to top for an upright object).
+        extent: Full size along the object's principal axes.
+    """
+
+    name: str
+    description: str = ""
+    pos: Vec3
+    quat: Vec4 = (1.0, 0.0, 0.0, 0.0)
+    axis: Vec3 = (0.0, 0.0, 1.0)
+    extent: Vec3
+
+
+class ArmState(_Model):
+    """The measurable state of one arm at the first observation.
+
+    Attributes:
+        name: ``left`` or ``right``.
+        ee: Tool centre point.
+        width: Gripper opening (m).
+        closed: Whether the gripper is commanded closed.
+        holding: Name of the object in the gripper, if any.
+        home: Whether the arm is at its home pose (false in an observation taken mid-task
+            with the arm elsewhere: a plan that ends at home sends it back).
+    """
+
+    name: str
+    ee: Vec3
+    width: float = 0.0
+    closed: bool = False
+    holding: str | None = None
+    home: bool = True
+
+
+class Region(_Model):
+    """A named region of the table (a target area), a disc.
+
+    Attributes:
+        name: How instructions name it (``target``, ``forward``).
+        description: More words that name it.
+        center: Centre (x, y), metres.
+        radius: Radius, metres.
+    """
+
+    name: str
+    description: str = ""
+    center: tuple[float, float]
+    radius: float = Field(0.04, gt=0.0)
+
+
+class Scene(_Model):
+    """The first observation given to the agents: objects with poses and sizes, and the arms.
+
+    Attributes:
+        objects: Scene objects.
+        arms: Arm states (may be empty when unknown).
+        regions: Named regions of the table.
+        notes: Anything else worth saying (table height, workspace bounds, in words).
+    """
+
+    objects: list[SceneObject]
+    arms: list[ArmState] = Field(default_factory=list)
+    regions: list[Region] = Field(default_factory=list)
+    notes: str = ""
+
+    @property
+    def object_names(self) -> list[str]:
+        """Names of the scene's objects, in order."""
+        return [obj.name for obj in self.objects]
+
+    @classmethod
+    def from_frame(
+        cls,
+        frame: FeatureFrame,
+        descriptions: Mapping[str, str] | None = None,
+        notes: str = "",
+        decimals: int = 4,
+        regions: Iterable[Region] = (),
+    ) -> Scene:
+        """The scene seen in a feature frame (oracle or RGB-D), rounded for a prompt.
+
+        Args:
+            frame: The first frame of the episode.
+            descriptions: Optional words per object name.
+            notes: Free text passed on to the agents.
+            regions: Named regions of the table.
+            decimals: Rounding of every coordinate (4: 0.1 mm).
+        """
+
+        def r(values: Iterable[float]) -> Any:
+            return tuple(round(float(v), decimals) for v in values)
+
+        descriptions = descriptions or {}
+        objects = [
+            SceneObject(
+                name=name,
+                description=descriptions.get(name, ""),
+                pos=r(feats.pos),
+                quat=r(feats.quat),
+                axis=r(feats.axis if feats.axis is not None else UP),
+                extent=r(feats.extent),
+            )
+            for name, feats in frame.objects.items()
+        ]
+        arms = []
+        for name, arm in frame.arms.items():
+            held = [obj for (a, obj) in sorted(frame.holding) if a == name]
+            arms.append(
+                ArmState(
+                    name=name,
+                    ee=r(arm.ee),
+                    width=round(float(arm.width), decimals),
+                    closed=bool(arm.closed),
+                    holding=held[0] if held else None,
+                )
+            )
+        return cls(objects=objects, arms=arms, regions=list(regions), notes=notes)
