@@ -51,6 +51,16 @@ def test_a_bottle_knocked_over_as_it_is_taken_again_is_taken_as_a_fallen_one():
     assert _recoveries(result) == ["e4_r_bottle_dropped"]
 
 
+
+def test_an_arm_that_falls_short_of_a_pushed_object_is_not_blamed_on_the_other_arm():
+    # Stress protocol, seed 2: the fork is pushed during the recovery's grasp to where neither arm
+    # reaches (2 cm short). The right arm stops short with both tools near each other but its
+    # links 12 cm clear of the left arm's: the reason used to say "the other arm was in the way".
+    result = run_episode(EpisodeSpec("rearrange_table", seed=2, protocol=True, disturb=KINDS))
+    assert not result.success
+    assert "stopped short of the grasp of fork" in result.reason
+    assert "in the way" not in result.reason
+
 class _Both:
     """Two scripted disturbances in one episode (each keeps its own schedule)."""
 

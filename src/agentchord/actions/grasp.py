@@ -27,7 +27,7 @@ from agentchord.actions.motion import (
     wait_for_rest,
 )
 from agentchord.features.frame import tilt_deg
-from agentchord.solvers.ik import PoseTarget, solve_from_scratch
+from agentchord.solvers.ik import ARM_CLEARANCE, PoseTarget, solve_from_scratch
 from agentchord.robot.aloha import HOME_Q
 
 #: Joint speed (rad/s, largest joint) of joint-space moves with an empty hand.
@@ -36,6 +36,8 @@ EMPTY_HAND_JOINT_SPEED = 2.0
 UPRIGHT_TOLERANCE_DEG = 25.0
 #: An object that moved more than this (m) while the tool approached it is looked at again.
 MOVED_DURING_APPROACH = 0.01
+#: Proxy clearance (m) under which the arm-arm collision limit is taken to have held an arm back.
+BLOCKED_CLEARANCE = 2 * ARM_CLEARANCE
 #: A closed grasp whose grasp point is farther than this (m) from where the tool aimed is off-centre.
 OFF_CENTRE_TOLERANCE = 0.025
 
@@ -244,8 +246,16 @@ class Grasp(ArmAction):
             if moved > MOVED_DURING_APPROACH:
                 raise GraspMissed(f"{self.args.obj} moved {100 * moved:.1f} cm during the approach") from None
             if robot.ik.arms_close():
-                # The collision limit held this arm back from the other one (busy beside it): try again.
-                raise GraspMissed(f"the other arm was in the way of the grasp of {self.args.obj}") from None
+                # Tools this near, the collision limit may have held this arm back from the other one
+                # (busy beside it): try again. Its proxies clear of the other arm's, nothing did:
+                # the arm fell short on its own (a joint limit), and the message says so.
+                clearance = robot.ik.arm_clearance()
+                if clearance < BLOCKED_CLEARANCE:
+                    raise GraspMissed(f"the other arm was in the way of the grasp of {self.args.obj}") from None
+                raise GraspMissed(
+                    f"the arm stopped short of the grasp of {self.args.obj}, "
+                    f"{100 * clearance:.0f} cm clear of the other arm"
+                ) from None
             raise
         aimed = robot.commanded_pose(self.arm).pos.copy()
         yield from grip(robot, self.arm, 1.0)
