@@ -64,15 +64,20 @@ def test_interrupted_action_leaves_the_arm_holding_still(pour_scene):
     assert np.linalg.norm(world.tcp_pose("right")[0] - held) < 0.005
 
 
-def test_grasp_of_a_fallen_bottle_sets_it_upright_in_hand(pour_scene):
-    world, robot, extractor = _setup(pour_scene)
+def _lay_bottle_down(world, scene, extractor) -> None:
+    """The bottle lying on the table, its top turned 1.2 rad about z, at rest."""
     adr = world.model.joint("bottle_free").qposadr[0]
-    radius = pour_scene.objects[0].size[0]
+    radius = scene.objects[0].size[0]
     x, y, z, w = (Rotation.from_euler("z", 1.2) * Rotation.from_euler("y", 90, degrees=True)).as_quat()
     world.data.qpos[adr : adr + 7] = [0.08, 0.5, radius + 0.001, w, x, y, z]
     for _ in range(40):
         world.step()
     extractor.update()
+
+
+def test_grasp_of_a_fallen_bottle_sets_it_upright_in_hand(pour_scene):
+    world, robot, extractor = _setup(pour_scene)
+    _lay_bottle_down(world, pour_scene, extractor)
     assert extractor.frame.objects["bottle"].axis[2] < 0.2  # lying down
     status, _ = _run(robot, extractor, make_action("grasp", "right", {"obj": "bottle"}))
     assert status == Status.SUCCESS, make_action
@@ -86,13 +91,7 @@ def test_a_side_grasp_refuses_an_object_knocked_over_meanwhile(pour_scene):
     world, robot, extractor = _setup(pour_scene)
     grasp = make_action("grasp", "right", {"obj": "bottle"})
     grasp._still_standing(robot, "during the approach")  # upright: goes on
-    adr = world.model.joint("bottle_free").qposadr[0]
-    radius = pour_scene.objects[0].size[0]
-    x, y, z, w = (Rotation.from_euler("z", 1.2) * Rotation.from_euler("y", 90, degrees=True)).as_quat()
-    world.data.qpos[adr : adr + 7] = [0.08, 0.5, radius + 0.001, w, x, y, z]
-    for _ in range(40):
-        world.step()
-    extractor.update()
+    _lay_bottle_down(world, pour_scene, extractor)
     with pytest.raises(GraspMissed, match="fell over during the approach"):
         grasp._still_standing(robot, "during the approach")
 
