@@ -91,3 +91,19 @@ def test_an_llm_sweep_plans_every_episode_and_charges_what_the_calls_measured(tm
     assert 0.5 <= record["reasoning_s"] < 5.0, record["reasoning_s"]
     assert json.loads((out / "sweep.json").read_text())["reasoner"] == "llm"
     assert "planning calls measured" in " ".join(result.output.split())
+
+
+def test_the_report_of_several_methods_has_the_paired_table(tmp_path):
+    from agentchord.bench.sweep import SweepConfig
+    from agentchord.cli_bench import write_report
+
+    def record(method, seed, success, exec_time, steps):
+        return {"id": f"single_arm_pour_water|{method}|protocol=real|{seed}", "task": "single_arm_pour_water",
+                "method": method, "condition": "protocol=real", "p": None, "protocol": "real", "seed": seed,
+                "success": success, "exec_time_s": exec_time, "robot_time_s": exec_time - 7.0, "compute_s": 0.0,
+                "reasoning_s": 7.0, "steps": steps, "disturbances_injected": 1, "reasoning_calls": {"plan": 1}, "replans": 0}
+
+    records = [record(m, seed, True, 30.0 + seed, 900 + seed) for m in ("rekep", "agentchord") for seed in range(3)]
+    written = write_report(records, tmp_path, SweepConfig(), None, trials=3, first_seed=0)
+    assert tmp_path / "tables" / "paired.md" in written and tmp_path / "tables" / "paired.csv" in written
+    assert "| ReKep | 3 |" in (tmp_path / "tables" / "paired.md").read_text()

@@ -145,6 +145,7 @@ def _run(todo, config, store, backend, ray_address, workers, console) -> None:
 def write_report(records: list[dict], out: Path, config, console: Console | None, trials: int, first_seed: int) -> list[Path]:
     """Tables (Markdown and CSV) and figures (PNG) of a sweep's records, written atomically under ``out``."""
     from agentchord.bench.figures import steps_figure, stress_figure  # noqa: PLC0415
+    from agentchord.bench.paired import REFERENCE, paired_csv, paired_markdown  # noqa: PLC0415
     from agentchord.bench.sweep import describe  # noqa: PLC0415
     from agentchord.bench.tables import ABLATION_METHODS, summary_csv, table_layout, table_markdown  # noqa: PLC0415
     from agentchord.guard.outputs import atomic_write_bytes, atomic_write_text  # noqa: PLC0415
@@ -178,6 +179,10 @@ def write_report(records: list[dict], out: Path, config, console: Console | None
         if console is not None:
             console.print(markdown, markup=False, highlight=False)
     write(out / "tables" / "summary.csv", summary_csv(records))
+    if REFERENCE in {r["method"] for r in records} and len({r["method"] for r in records}) > 1:
+        # AgentChord against each method, episode by episode (pairs match task, condition and seed).
+        write(out / "tables" / "paired.md", paired_markdown(records))
+        write(out / "tables" / "paired.csv", paired_csv(records))
     figure = stress_figure(records)
     if figure is not None:
         write(out / "figures" / "stress.png", figure)
