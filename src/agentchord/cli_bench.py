@@ -181,8 +181,11 @@ def write_report(records: list[dict], out: Path, config, console: Console | None
     write(out / "tables" / "summary.csv", summary_csv(records))
     if REFERENCE in {r["method"] for r in records} and len({r["method"] for r in records}) > 1:
         # AgentChord against each method, episode by episode (pairs match task, condition and seed).
-        write(out / "tables" / "paired.md", paired_markdown(records))
+        paired = paired_markdown(records)
+        write(out / "tables" / "paired.md", paired)
         write(out / "tables" / "paired.csv", paired_csv(records))
+        if console is not None:
+            console.print(paired, markup=False, highlight=False)
     figure = stress_figure(records)
     if figure is not None:
         write(out / "figures" / "stress.png", figure)
