@@ -179,7 +179,8 @@ def write_report(records: list[dict], out: Path, config, console: Console | None
         if console is not None:
             console.print(markdown, markup=False, highlight=False)
     write(out / "tables" / "summary.csv", summary_csv(records))
-    if REFERENCE in {r["method"] for r in records} and len({r["method"] for r in records}) > 1:
+    methods = {r["method"] for r in records}
+    if REFERENCE in methods and len(methods) > 1:
         # AgentChord against each method, episode by episode (pairs match task, condition and seed).
         paired = paired_markdown(records)
         write(out / "tables" / "paired.md", paired)

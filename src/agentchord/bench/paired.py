@@ -11,13 +11,11 @@ from __future__ import annotations
 
 import csv
 import io
-import math
 from collections import defaultdict
 from dataclasses import dataclass
-from statistics import mean, stdev
+from statistics import mean
 
-from scipy import stats as scipy_stats
-
+from agentchord.bench.tables import markdown_table, mean_ci, ordered
 from agentchord.execution.methods import METHODS, SHORT
 
 #: The method compared against the others unless told otherwise.
@@ -63,15 +61,9 @@ class PairedRow:
 def _difference(pairs: list[tuple[float, float]]) -> Difference | None:
     if not pairs:
         return None
-    reference = mean(a for a, _ in pairs)
-    other = mean(b for _, b in pairs)
-    diffs = [a - b for a, b in pairs]
-    centre = reference - other
-    half = 0.0
-    if len(diffs) > 1:
-        half = float(scipy_stats.t.ppf(0.975, len(diffs) - 1)) * stdev(diffs) / math.sqrt(len(diffs))
-    return Difference(n=len(pairs), reference=reference, other=other, low=centre - half, high=centre + half,
-                      reference_better=sum(a < b for a, b in pairs))
+    _, (low, high) = mean_ci([a - b for a, b in pairs])
+    return Difference(n=len(pairs), reference=mean(a for a, _ in pairs), other=mean(b for _, b in pairs),
+                      low=low, high=high, reference_better=sum(a < b for a, b in pairs))
 
 
 def _episodes(records: list[dict]) -> dict[tuple[str, str, int], dict[str, dict]]:
@@ -80,11 +72,6 @@ def _episodes(records: list[dict]) -> dict[tuple[str, str, int], dict[str, dict]
     for record in records:
         episodes[(record["task"], record["condition"], record["seed"])][record["method"]] = record
     return episodes
-
-
-def _in_order(methods: set[str]) -> list[str]:
-    """The paper's method order, unknown names last."""
-    return [m for m in METHODS if m in methods] + sorted(methods - set(METHODS))
 
 
 def _disturbed(*runs: dict) -> bool:
@@ -101,7 +88,7 @@ def paired_rows(records: list[dict], reference: str = REFERENCE) -> list[PairedR
     methods = {m for runs in episodes.values() for m in runs}
     if reference not in methods:
         raise ValueError(f"no records of {reference!r} (methods: {', '.join(sorted(methods))})")
-    others = _in_order(methods - {reference})
+    others = ordered(methods - {reference}, METHODS)
     rows = []
     for method in others:
         both = [(runs[reference], runs[method]) for runs in episodes.values()
@@ -124,7 +111,7 @@ def common_steps(records: list[dict]) -> tuple[int, dict[str, float]]:
         How many such episodes there are, and each method's mean steps over them (empty if none).
     """
     episodes = _episodes(records)
-    methods = _in_order({m for runs in episodes.values() for m in runs})
+    methods = ordered({m for runs in episodes.values() for m in runs}, METHODS)
     common = [runs for runs in episodes.values()
               if all(m in runs and runs[m]["success"] for m in methods) and _disturbed(*runs.values())]
     if not common:
@@ -159,13 +146,11 @@ def paired_markdown(records: list[dict], reference: str = REFERENCE) -> str:
     """The paired table, its reading, and the steps over the episodes every method completed."""
     header, rows = paired_layout(records, reference)
     ref = SHORT.get(reference, reference)
-    lines = ["| " + " | ".join(header) + " |", "|" + "|".join("---" for _ in header) + "|"]
-    lines += ["| " + " | ".join(row) + " |" for row in rows]
     n, steps = common_steps(records)
     common = (f"Steps over the {n} disturbed episodes every method completed: "
               + ", ".join(f"{SHORT.get(m, m)} {value:.0f}" for m, value in steps.items()) + "."
               if n else "No disturbed episode was completed by every method.")
-    return (f"### Paired: {ref} against each method on the same episodes\n\n" + "\n".join(lines) + "\n\n"
+    return (f"### Paired: {ref} against each method on the same episodes\n\n" + markdown_table(header, rows) + "\n"
             f"Over the episodes both methods completed (same task, condition and seed: the same scene and "
             f"disturbance schedule); steps over those of them with a disturbance in either run. "
             f"Δ = {ref} minus the other method, mean with its 95% t-interval; negative: {ref} is lower. "

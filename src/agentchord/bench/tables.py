@@ -59,7 +59,8 @@ class Cell:
         return self.successes / self.n if self.n else 0.0
 
 
-def _mean_ci(values: list[float]) -> tuple[float | None, tuple[float, float] | None]:
+def mean_ci(values: list[float]) -> tuple[float | None, tuple[float, float] | None]:
+    """Mean and its 95% Student-t interval (the mean itself for one value; ``None`` for none)."""
     if not values:
         return None, None
     centre = mean(values)
@@ -74,7 +75,7 @@ def cell(records: list[dict]) -> Cell:
     n = len(records)
     successes = sum(bool(r["success"]) for r in records)
     won = [r for r in records if r["success"]]
-    time_s, time_ci = _mean_ci([r["exec_time_s"] for r in won])
+    time_s, time_ci = mean_ci([r["exec_time_s"] for r in won])
     disturbed = [r for r in won if r["disturbances_injected"] > 0]
     return Cell(
         n=n, successes=successes, success_ci=wilson_interval(successes, n),
@@ -96,7 +97,8 @@ def group(records: list[dict]) -> dict[tuple[str, str, str], Cell]:
     return {key: cell(rows) for key, rows in groups.items()}
 
 
-def _ordered(names, order) -> list[str]:
+def ordered(names, order) -> list[str]:
+    """``names`` in ``order``, unknown ones last, sorted."""
     known = [n for n in order if n in names]
     return known + sorted(set(names) - set(known))
 
@@ -119,7 +121,8 @@ def _steps(c: Cell | None) -> str:
     return "-" if c is None or c.steps_disturbed is None else f"{c.steps_disturbed:.0f}"
 
 
-def _markdown(header: list[str], rows: list[list[str]]) -> str:
+def markdown_table(header: list[str], rows: list[list[str]]) -> str:
+    """A Markdown table."""
     lines = ["| " + " | ".join(header) + " |", "|" + "|".join("---" for _ in header) + "|"]
     lines += ["| " + " | ".join(row) + " |" for row in rows]
     return "\n".join(lines) + "\n"
@@ -147,8 +150,8 @@ def table_layout(records: list[dict], methods: list[str] | None = None, with_ste
                  with_condition: bool = True) -> tuple[list[str], list[list[str]]]:
     """Rows in the paper's layout: a row per task (and condition), success | time | steps per method."""
     cells = group(records)
-    methods = _ordered({m for _, _, m in cells} if methods is None else methods, METHODS)
-    tasks = _ordered({t for t, _, _ in cells}, list(TASK_TITLES))
+    methods = ordered({m for _, _, m in cells} if methods is None else methods, METHODS)
+    tasks = ordered({t for t, _, _ in cells}, list(TASK_TITLES))
     conditions = sorted({c for _, c, _ in cells}, key=lambda label: (label.startswith("protocol"), label))
     header = ["Task"] + (["Condition"] if with_condition else [])
     header += [f"Success % {SHORT.get(m, m)}" for m in methods] + [f"Exec. time s {SHORT.get(m, m)}" for m in methods]
@@ -175,7 +178,7 @@ def table_markdown(records: list[dict], title: str, caption: str, methods: list[
                    with_steps: bool = True, with_condition: bool = True) -> str:
     """A titled Markdown table with its caption (the latency model, the intervals)."""
     header, rows = table_layout(records, methods, with_steps, with_condition)
-    return f"### {title}\n\n{_markdown(header, rows)}\n{caption}\n"
+    return f"### {title}\n\n{markdown_table(header, rows)}\n{caption}\n"
 
 
 def summary_csv(records: list[dict]) -> str:
@@ -203,7 +206,7 @@ def ordering(records: list[dict], method: str = "agentchord") -> dict[str, dict]
     per-method means and whether ``method`` is best (ties count as best).
     """
     cells = group(records)
-    methods = _ordered({m for _, _, m in cells}, METHODS)
+    methods = ordered({m for _, _, m in cells}, METHODS)
     rows = {(t, c) for t, c, _ in cells}
     rows = [row for row in rows if all((*row, m) in cells for m in methods)]
     out: dict[str, dict] = {}
