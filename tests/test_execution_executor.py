@@ -2,8 +2,12 @@
 
 import pytest
 
+from agentchord.actions.base import Status
+from agentchord.agents.rules.arm_switch import arm_switch_alternative
+from agentchord.execution.edge_program import EdgeProgram
 from agentchord.execution.episode import EpisodeSpec, run_episode
 from agentchord.execution.executor import ExecutorConfig
+from agentchord.tasks import load_task_graph
 from agentchord.worlds.sim.disturbances import ScriptedDisturbance, ScriptedDrop
 
 TASK = "single_arm_pour_water"
@@ -223,3 +227,29 @@ def test_a_recovery_merges_past_a_pour_that_was_done_before_the_bottle_was_taken
         assert after_recovery[:4] == ["e3_r_bottle_dropped", "v2", "v4", "e5"]
     else:
         assert ahead == [] and after_recovery[:4] == ["e3_r_bottle_dropped", "v2", "e3", "v3"]
+
+
+def test_a_recovery_made_at_run_time_is_bound_again_from_its_own_edge():
+    # A baseline's re-plan adds the arm-switch alternative of its first edge, an edge in no graph.
+    # When that recovery failed because the scene changed under it, binding it once more looked its
+    # edge up in the graph and ended the sweep with UnknownEdgeError (Table II, dual-arm pour).
+    graph = load_task_graph(TASK)
+    alternative = arm_switch_alternative(graph.edge("e2_r_bottle_dropped"), ["bottle", "cup"])
+    made = alternative.model_copy(update={"id": "made_at_run_time", "alternative_to": None})
+    assert made.id not in {e.id for e in graph.edges}
+
+    class SceneChangedUnderIt(EdgeProgram):
+        def update(self, robot):
+            self.failure_reason, self.scene_changed = "bottle is not held: nothing to place", True
+            return Status.FAILURE
+
+    def inject(executor):
+        if executor.world.tick == 20:
+            stub = SceneChangedUnderIt.from_edge(made)
+            stub.initialise = lambda robot: None
+            executor.program = stub
+
+    result = run_episode(EpisodeSpec(TASK, seed=1), on_tick=inject)
+    failed = result.trace.of("recovery_failed")
+    assert [f["edge"] for f in failed][:1] == ["made_at_run_time"]
+    assert any(e["edge"] == "made_at_run_time" for e in result.trace.of("recovery_bound"))

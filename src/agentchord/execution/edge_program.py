@@ -28,10 +28,13 @@ class EdgeProgram:
         target: The node reached when the program succeeds.
         steps: Per step, the arm actions to run together.
         kind: ``nominal``, ``recovery`` or ``backtrack``.
+        edge: The edge it was compiled from (None for a synthetic program). Kept because an
+            edge made at run time (a re-plan's arm-switch alternative) is in no graph.
     """
 
-    def __init__(self, edge_id: str, target: str, steps: list[list[ArmAction]], kind: str) -> None:
+    def __init__(self, edge_id: str, target: str, steps: list[list[ArmAction]], kind: str, edge: Edge | None = None) -> None:
         self.edge_id = edge_id
+        self.edge = edge
         self.target = target
         self.steps = steps
         self.kind = kind
@@ -49,7 +52,7 @@ class EdgeProgram:
         """Compile a graph edge's steps into arm actions."""
         steps = [[make_action(call.fn, arm, call.args) for arm, call in step.items() if call is not None] for step in edge.steps]
         _link_grasps_to_places(steps)
-        return cls(edge.id, edge.target, steps, edge.kind)
+        return cls(edge.id, edge.target, steps, edge.kind, edge=edge)
 
     @property
     def running(self) -> list[ArmAction]:

@@ -272,7 +272,7 @@ class Executor(RecoverySwitching):
                 if program.kind == "recovery" and program.attempt == 1 and program.scene_changed:
                     # What it had found done was undone under it (a cup found placed, then knocked over
                     # before its place step): bound once more from where things are, then the rest.
-                    again = EdgeProgram.from_edge(self.graph.edge(program.edge_id))
+                    again = EdgeProgram.from_edge(program.edge or self.graph.edge(program.edge_id))
                     again.attempt = 2
                     self._fallbacks.insert(0, again)
                 detection = None if self._fallbacks else self.strategy.on_program_failure(self, self.program)

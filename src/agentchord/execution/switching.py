@@ -192,7 +192,7 @@ class RecoverySwitching:
         if len(self._repair_attempts) >= self.config.max_repairs or key in self._repair_attempts:
             return None
         self._repair_attempts.add(key)
-        edge = self.graph.edge(program.edge_id)
+        edge = program.edge or self.graph.edge(program.edge_id)
         failure = UnanticipatedFailure(edge=edge.id, context=edge.source, observation=self.describe_violation(program.target))
         record = {"edge": edge.id, "target": program.target, "context": edge.source, "observation": failure.observation}
         started = time.perf_counter()
