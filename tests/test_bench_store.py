@@ -57,3 +57,14 @@ def test_an_output_that_is_a_file_is_refused(tmp_path):
     path.write_text("x")
     with pytest.raises(SweepStoreError, match="not a directory"):
         RecordStore(path, SweepConfig())
+
+
+def test_an_episode_stopped_on_an_internal_error_runs_again_and_its_verdict_counts(tmp_path):
+    store = RecordStore(tmp_path, SweepConfig())
+    store.append(_record("k0", success=False, error="KeyError: 'x'", traceback="..."))
+    assert "k0" not in store  # not finished: a rerun runs it again
+    store.append(_record("k0", steps=700))
+    store.append(_record("k0", success=False, error="KeyError: 'x'"))  # finished now: not written again
+    reopened = RecordStore(tmp_path, SweepConfig())
+    assert "k0" in reopened and reopened.records["k0"]["steps"] == 700
+    assert len((tmp_path / RECORDS).read_text().splitlines()) == 2

@@ -52,6 +52,39 @@ def test_a_sweep_killed_midway_loses_and_repeats_nothing(tmp_path):
     assert (out / "tables" / "table1.md").exists()
 
 
+def test_an_episode_that_raises_is_a_row_not_the_end_of_the_sweep(tmp_path, monkeypatch):
+    import agentchord.bench.sweep as sweep
+
+    real = sweep.run_episode
+
+    def buggy(spec, *args, **kwargs):
+        if spec.seed == 1:
+            raise KeyError("a bug in one episode")
+        return real(spec, *args, **kwargs)
+
+    monkeypatch.setattr(sweep, "run_episode", buggy)
+    out = tmp_path / "sweep"
+    args = ["bench", "--tasks", "single_arm_pour_water", "--methods", "agentchord", "--p", "0", "--trials", "3",
+            "--workers", "1", "--out", str(out)]
+    result = CliRunner().invoke(main, args)
+    assert result.exit_code == 3, result.output
+    assert "1 episode(s) stopped on an internal error" in " ".join(result.output.split())
+    records = [json.loads(line) for line in (out / "records.jsonl").read_text().splitlines()]
+    assert [r["seed"] for r in records if "error" in r] == [1]
+    error = next(r for r in records if "error" in r)
+    assert error["error"] == "KeyError: 'a bug in one episode'" and "buggy" in error["traceback"]
+    # The tables count the two finished episodes only, and say why.
+    summary = (out / "tables" / "summary.csv").read_text().splitlines()
+    assert summary[1].split(",")[3:5] == ["2", "2"]  # episodes, successes
+    assert "1 episode(s) that stopped on an internal error are left out" in (out / "tables" / "table1.md").read_text()
+    # Fixed: a rerun runs only that episode again.
+    monkeypatch.setattr(sweep, "run_episode", real)
+    again = CliRunner().invoke(main, args)
+    assert again.exit_code == 0, again.output
+    assert "2 already in" in " ".join(again.output.split())
+    assert _ids(out) == [r["id"] for r in records] + ["single_arm_pour_water|agentchord|p=0|1"]
+
+
 def test_an_llm_sweep_needs_the_llm_settings_before_any_episode(tmp_path, monkeypatch):
     for name in [k for k in os.environ if k.startswith("AGENTCHORD_LLM_")]:
         monkeypatch.delenv(name)

@@ -8,11 +8,21 @@ from pathlib import Path
 
 import click
 from rich.console import Console
+from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
-from agentchord.cli_support import BadInput
+from agentchord.cli_support import EXIT_INTERNAL, BadInput
 
 TABLE_I_TASKS = "single_arm_pour_water,dual_arm_pour_water,rearrange_table"
+
+
+class EpisodesStoppedOnErrors(click.ClickException):
+    """Some episodes stopped on an internal error (recorded, left out of the tables): exit status 3."""
+
+    exit_code = EXIT_INTERNAL
+
+    def show(self, file=None) -> None:
+        click.echo(f"agentchord: {self.format_message()}", err=True)
 
 
 def _csv_list(value: str) -> list[str]:
@@ -75,7 +85,7 @@ def bench_command(tasks, methods, ps, protocol, trials, first_seed, out_dir, bac
     """
     from agentchord.bench.exceptions import BenchError  # noqa: PLC0415
     from agentchord.bench.store import RecordStore  # noqa: PLC0415
-    from agentchord.bench.sweep import Condition, SweepConfig, describe, sweep_keys  # noqa: PLC0415
+    from agentchord.bench.sweep import Condition, SweepConfig, describe, is_error, sweep_keys  # noqa: PLC0415
     from agentchord.execution.methods import METHODS  # noqa: PLC0415
     from agentchord.execution.reasoning import ReasoningConfig  # noqa: PLC0415
     from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: PLC0415
@@ -120,14 +130,23 @@ def bench_command(tasks, methods, ps, protocol, trials, first_seed, out_dir, bac
     started = time.perf_counter()
     if todo:
         _run(todo, config, store, backend, ray_address, workers, console)
-    records = [store.records[key.id] for key in keys]
-    written = write_report(records, Path(out_dir), config, console, trials, first_seed)
-    console.print(f"{len(todo)} episode(s) in {time.perf_counter() - started:.0f} s; written: " + ", ".join(str(p) for p in written))
+    records = [store.records[key.id] for key in keys if key.id in store.records]
+    errors = [record for record in records if is_error(record)]
+    finished = [record for record in records if not is_error(record)]
+    written = write_report(finished, Path(out_dir), config, console, trials, first_seed, left_out=len(errors)) if finished else []
+    console.print(f"{len(todo)} episode(s) in {time.perf_counter() - started:.0f} s; written: " + (", ".join(str(p) for p in written) or "nothing"))
+    if errors:
+        listed = "; ".join(f"{r['id']}: {r['error'][:160]}" for r in errors[:5]) + ("; ..." if len(errors) > 5 else "")
+        raise EpisodesStoppedOnErrors(
+            f"{len(errors)} episode(s) stopped on an internal error (a bug, not a failed task) and are left out of "
+            f"every table: {listed}. Each record in {store.path} holds its traceback; rerun with the same --out "
+            "to run them again.")
 
 
 def _run(todo, config, store, backend, ray_address, workers, console) -> None:
     from agentchord.bench.backends import run_local, run_ray  # noqa: PLC0415
     from agentchord.bench.exceptions import BackendError  # noqa: PLC0415
+    from agentchord.bench.sweep import is_error  # noqa: PLC0415
 
     stream = run_ray(todo, config, ray_address, workers) if backend == "ray" else run_local(todo, config, workers)
     columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
@@ -137,13 +156,19 @@ def _run(todo, config, store, backend, ray_address, workers, console) -> None:
         try:
             for _key, record in stream:
                 store.append(record)
+                if is_error(record):
+                    bar.console.print(f"[red]{escape(record['id'])}[/red]: internal error: {escape(record['error'][:200])}", highlight=False)
                 bar.advance(job)
         except BackendError as error:
             raise BadInput(str(error)) from None
 
 
-def write_report(records: list[dict], out: Path, config, console: Console | None, trials: int, first_seed: int) -> list[Path]:
-    """Tables (Markdown and CSV) and figures (PNG) of a sweep's records, written atomically under ``out``."""
+def write_report(records: list[dict], out: Path, config, console: Console | None, trials: int, first_seed: int,
+                 left_out: int = 0) -> list[Path]:
+    """Tables (Markdown and CSV) and figures (PNG) of a sweep's records, written atomically under ``out``.
+
+    ``left_out`` episodes stopped on an internal error; the caption says so (the cells have fewer seeds).
+    """
     from agentchord.bench.figures import steps_figure, stress_figure  # noqa: PLC0415
     from agentchord.bench.paired import REFERENCE, paired_csv, paired_markdown  # noqa: PLC0415
     from agentchord.bench.sweep import describe  # noqa: PLC0415
@@ -160,6 +185,8 @@ def write_report(records: list[dict], out: Path, config, console: Console | None
     caption = (f"{trials} seeds per cell (from {first_seed}); success % [95% Wilson CI]; execution time = robot + compute + "
                f"reasoning latency, mean ± 95% t-interval half-width over successful episodes; steps = control ticks, "
                f"mean over successful episodes with a disturbance. {describe(config)}.")
+    if left_out:
+        caption += f" {left_out} episode(s) that stopped on an internal error are left out (see records.jsonl)."
     drops = [r for r in records if r["protocol"] is None]
     protocols = [r for r in records if r["protocol"] is not None]
     tables: list[tuple[str, str, list[dict], dict]] = []

@@ -3,7 +3,9 @@
 A sweep's directory holds ``sweep.json`` (the configuration its records depend on) and
 ``records.jsonl`` (one record per line). A record is appended with one ``write`` and an
 ``fsync`` before the next episode is counted, so a kill -9 loses at most the line being
-written; reopening drops that torn tail. Rerunning the sweep skips every key already there.
+written; reopening drops that torn tail. Rerunning the sweep skips every key already there,
+except an episode that stopped on an internal error: it runs again, and its new record,
+appended later, is the one that counts.
 """
 
 from __future__ import annotations
@@ -13,7 +15,7 @@ import os
 from pathlib import Path
 
 from agentchord.bench.exceptions import SweepStoreError
-from agentchord.bench.sweep import RECORD_VERSION, SweepConfig
+from agentchord.bench.sweep import RECORD_VERSION, SweepConfig, is_error
 from agentchord.guard.outputs import atomic_write_text, finite_json
 
 MANIFEST = "sweep.json"
@@ -89,17 +91,20 @@ class RecordStore:
                 raise SweepStoreError(f"{self.path}: line {number}: a record needs a string 'id'")
             if record.get("version") != RECORD_VERSION:
                 raise SweepStoreError(f"{self.path}: line {number}: record version {record.get('version')!r}, expected {RECORD_VERSION}")
-            self.records[record["id"]] = record
+            if not (is_error(record) and record["id"] in self):  # a verdict is never replaced by an error
+                self.records[record["id"]] = record
 
     def __contains__(self, key_id: str) -> bool:
-        return key_id in self.records
+        """Whether the episode has run to a verdict (an internal error's record does not count)."""
+        record = self.records.get(key_id)
+        return record is not None and not is_error(record)
 
     def __len__(self) -> int:
         return len(self.records)
 
     def append(self, record: dict) -> None:
-        """Write one record durably (one write, then fsync); a key already stored is not written twice."""
-        if record["id"] in self.records:
+        """Write one record durably (one write, then fsync); a finished key is not written twice."""
+        if record["id"] in self:
             return
         line = (finite_json(record, separators=(",", ":")) + "\n").encode()
         with open(self.path, "ab") as handle:

@@ -9,6 +9,7 @@ run again skips what it already has (:mod:`agentchord.bench.store`).
 from __future__ import annotations
 
 import time
+import traceback
 from dataclasses import dataclass, field
 
 from agentchord.execution.episode import EpisodeSpec, run_episode
@@ -114,12 +115,8 @@ def episode_spec(key: EpisodeKey, config: SweepConfig) -> EpisodeSpec:
     )
 
 
-def run_record(key: EpisodeKey, config: SweepConfig) -> dict:
-    """Run one episode and return its record (DESIGN section 7's metrics and the reasoning calls)."""
-    started = time.perf_counter()
-    result = run_episode(episode_spec(key, config))
-    summary = result.summary()
-    injected = sum(counts[0] for counts in summary["disturbances"].values())
+def _key_fields(key: EpisodeKey) -> dict:
+    """The fields every record starts with: what episode it is."""
     return {
         "id": key.id,
         "version": RECORD_VERSION,
@@ -129,6 +126,24 @@ def run_record(key: EpisodeKey, config: SweepConfig) -> dict:
         "p": key.condition.p if key.condition.protocol is None else None,
         "protocol": key.condition.protocol,
         "seed": key.seed,
+    }
+
+
+def run_record(key: EpisodeKey, config: SweepConfig) -> dict:
+    """Run one episode and return its record (DESIGN section 7's metrics and the reasoning calls).
+
+    An episode that stops on an unexpected exception returns an :func:`error_record` instead:
+    one bug must not end a sweep of hundreds of episodes (records are rows, not crashes).
+    """
+    started = time.perf_counter()
+    try:
+        result = run_episode(episode_spec(key, config))
+    except Exception as error:  # noqa: BLE001  (recorded with its traceback; the sweep goes on)
+        return error_record(key, error, time.perf_counter() - started)
+    summary = result.summary()
+    injected = sum(counts[0] for counts in summary["disturbances"].values())
+    return {
+        **_key_fields(key),
         **{name: summary[name] for name in (
             "success", "reason", "steps", "exec_time_s", "robot_time_s", "compute_s", "reasoning_s", "reasoning_calls",
             "replans", "failures_detected", "recoveries", "drops_injected", "drops_detected", "drops_recovered",
@@ -136,6 +151,28 @@ def run_record(key: EpisodeKey, config: SweepConfig) -> dict:
         "disturbances_injected": injected,
         "wall_s": round(time.perf_counter() - started, 3),
     }
+
+
+def error_record(key: EpisodeKey, error: BaseException, wall_s: float) -> dict:
+    """The record of an episode that stopped on an internal error: a bug to fix, not a result.
+
+    It has no metrics: the tables leave it out (neither a success nor a failure of the method),
+    the sweep says how many there were, and a rerun with the same ``--out`` runs it again.
+    """
+    message = f"{type(error).__name__}: {error}"
+    return {
+        **_key_fields(key),
+        "success": False,
+        "reason": f"internal error: {message}",
+        "error": message,
+        "traceback": "".join(traceback.format_exception(type(error), error, error.__traceback__)),
+        "wall_s": round(wall_s, 3),
+    }
+
+
+def is_error(record: dict) -> bool:
+    """Whether a record is an :func:`error_record` (the episode did not run to a verdict)."""
+    return "error" in record
 
 
 def describe(config: SweepConfig) -> str:
