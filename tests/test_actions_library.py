@@ -64,12 +64,12 @@ def test_interrupted_action_leaves_the_arm_holding_still(pour_scene):
     assert np.linalg.norm(world.tcp_pose("right")[0] - held) < 0.005
 
 
-def _lay_bottle_down(world, scene, extractor) -> None:
-    """The bottle lying on the table, its top turned 1.2 rad about z, at rest."""
+def _lay_bottle_down(world, scene, extractor, at=(0.08, 0.5), yaw=1.2) -> None:
+    """The bottle lying on the table at ``at``, its top turned ``yaw`` rad about z, at rest."""
     adr = world.model.joint("bottle_free").qposadr[0]
     radius = scene.objects[0].size[0]
-    x, y, z, w = (Rotation.from_euler("z", 1.2) * Rotation.from_euler("y", 90, degrees=True)).as_quat()
-    world.data.qpos[adr : adr + 7] = [0.08, 0.5, radius + 0.001, w, x, y, z]
+    x, y, z, w = (Rotation.from_euler("z", yaw) * Rotation.from_euler("y", 90, degrees=True)).as_quat()
+    world.data.qpos[adr : adr + 7] = [*at, radius + 0.001, w, x, y, z]
     for _ in range(40):
         world.step()
     extractor.update()
@@ -83,6 +83,43 @@ def test_grasp_of_a_fallen_bottle_sets_it_upright_in_hand(pour_scene):
     assert status == Status.SUCCESS, make_action
     assert world.holding("right", "bottle")
     assert extractor.frame.objects["bottle"].axis[2] > np.cos(np.radians(20))
+
+
+ARM_LINKS = ("shoulder_link", "upper_arm_link", "upper_forearm_link", "lower_forearm_link", "wrist_link")
+
+
+def _arm_struck(world, arm: str = "vx300s_right") -> set[str]:
+    """Which of the arm's links (not its gripper) touch the bottle or another of its own links now."""
+    model, data = world.model, world.data
+    struck = set()
+    for contact in data.contact[: data.ncon]:
+        a, b = (model.body(model.geom_bodyid[g]).name for g in (contact.geom1, contact.geom2))
+        links = [n for n in (a, b) if n.startswith(arm) and n.split("/")[1] in ARM_LINKS]
+        if links and ("bottle" in (a, b) or (a.startswith(arm) and b.startswith(arm))):
+            struck.update(links)
+    return struck
+
+
+@pytest.mark.parametrize("yaw", [0.0, 1.6, 3.0])
+def test_a_fallen_bottle_beside_the_arms_own_base_is_turned_upright_clear_of_the_arm(pour_scene, yaw):
+    # Lying 21 cm from the right arm's shoulder (Table II, single-arm pour, seed 4): turned upright where
+    # it was picked up, the arm folds its forearm onto its own upper arm and flings the bottle off the
+    # table. It is carried out to 30 cm from the shoulder first.
+    world, robot, extractor = _setup(pour_scene)
+    _lay_bottle_down(world, pour_scene, extractor, at=(0.26, 0.476), yaw=yaw)
+    grasp = make_action("grasp", "right", {"obj": "bottle"})
+    grasp.initialise(robot)
+    struck: set[str] = set()
+    for _ in range(1500):
+        if grasp.update(robot) != Status.RUNNING:
+            break
+        robot.step()
+        extractor.update()
+        struck |= _arm_struck(world)
+    assert grasp.status == Status.SUCCESS, grasp.failure_reason
+    assert world.holding("right", "bottle")
+    assert extractor.frame.objects["bottle"].axis[2] > np.cos(np.radians(20))
+    assert not struck
 
 
 def test_a_side_grasp_refuses_an_object_knocked_over_meanwhile(pour_scene):

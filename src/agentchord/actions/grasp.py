@@ -17,9 +17,11 @@ from agentchord.actions.base import ActionFailed, ArmAction
 from agentchord.actions.controller import RobotController
 from agentchord.actions.geometry import _matrix, _wrist_margin
 from agentchord.actions.motion import (
+    ANGULAR_SPEED,
     approach,
     grasp_frame,
     grip,
+    min_jerk,
     move_joints,
     move_to,
     pose_from_matrix,
@@ -82,6 +84,9 @@ class Grasp(ArmAction):
     #: distance, rise of the pre-grasp pose in m, grasp height as a share of the object's or
     #: None for the asked one; a higher one is only ever taken).
     SIDE_VARIANTS = ((1.0, 0.0, None), (1.0, 0.03, None), (0.5, 0.0, None), (0.5, 0.03, None), (0.5, 0.03, 0.8))
+    #: A fallen object is turned upright at least this far (m, horizontally) from the arm's own
+    #: shoulder: its ends sweep a circle as it turns, and beside the base they strike the arm.
+    TURN_FROM_BASE = 0.30
 
     #: The place of the same object by the same arm later in the edge (set when the edge is compiled):
     #: with ``skip_if_placed``, a grasp of an object already lying where that place puts it is not made.
@@ -392,13 +397,21 @@ class Grasp(ArmAction):
         yield from self._close_and_check(robot)
         half_length = 0.5 * float(np.linalg.norm(feats.top - feats.bottom))
         lifted = point + np.array([0.0, 0.0, half_length + 0.06])
+        base = robot.world.arm_base(arm)
+        out = lifted[:2] - base[:2]
+        if 1e-6 < float(np.linalg.norm(out)) < self.TURN_FROM_BASE:
+            lifted[:2] = base[:2] + self.TURN_FROM_BASE * out / np.linalg.norm(out)
         yield from move_to(robot, arm, pose_from_matrix(lifted, rotation), speed=0.15)
-        # Swing the object's top to point away from the robot, then pitch it up: the tool
-        # ends in the usual side-grasp frame with the object upright between the fingers.
+        # Swing the object's top to point away from the robot and pitch it up, both at once: the
+        # swing about the vertical, the pitch about the fingers' axis, so the top only rises. The
+        # tool ends in the usual side-grasp frame with the object upright between the fingers.
         outward = grasp_frame(lifted - robot.world.arm_base(arm))[:, 0]
         yaw = np.arctan2(np.cross(top_dir, outward)[2], float(np.dot(top_dir, outward)))
-        swung = Rotation.from_euler("z", yaw).as_matrix() @ rotation
-        yield from move_to(robot, arm, pose_from_matrix(lifted, swung))
-        upright = swung @ Rotation.from_euler("y", -90.0, degrees=True).as_matrix()
-        yield from move_to(robot, arm, pose_from_matrix(lifted, upright), speed=0.15)
+        pitch = -0.5 * np.pi
+        ticks = max(int(np.ceil(1.875 * max(abs(yaw), abs(pitch)) / ANGULAR_SPEED * 50)), 5)
+        for k in range(1, ticks + 1):
+            s = min_jerk(k / ticks)
+            turned = Rotation.from_euler("z", s * yaw).as_matrix() @ rotation @ Rotation.from_euler("y", s * pitch).as_matrix()
+            robot.set_pose(arm, pose_from_matrix(lifted, turned))
+            yield
         yield from settle(robot, arm)
