@@ -185,3 +185,14 @@ def test_a_place_knows_when_its_object_already_lies_at_the_target(spoon, placed)
     assert place.lies_at_target(robot) is placed
     robot.frame.holding = {("right", "spoon")}
     assert place.lies_at_target(robot) is False  # still in the hand: not placed yet
+
+
+def test_a_place_with_a_sub_goal_check_takes_an_object_released_where_it_holds_as_placed():
+    # 5 cm off the place's own target, but where the recovery's merge node wants it.
+    spoon = {"pos": (0.22, 0.5, 0.01), "axis": (0.0, 1.0, 0.0), "extent": (0.005, 0.15, 0.02)}
+    place, robot = _placing({"spoon": spoon})
+    assert place.lies_at_target(robot) is False
+    place.meets_subgoal = lambda frame: frame.objects["spoon"].pos[0] > 0.2
+    assert place.lies_at_target(robot) is True
+    robot.frame.holding = {("right", "spoon")}
+    assert place.lies_at_target(robot) is False  # in the hand: never placed, whatever the check says

@@ -1,7 +1,10 @@
 """Where a recovery stops short: sub-goals met already, nodes passed before the failure."""
 
 from agentchord.execution.edge_program import EdgeProgram
-from agentchord.execution.shortcuts import Ahead, Shortcuts
+from agentchord.execution.shortcuts import Ahead, Shortcuts, attach_subgoal_checks
+from agentchord.expr.compiler import compile_expr
+from agentchord.expr.vocabulary import Vocabulary
+from agentchord.features.frame import make_static_frame
 from agentchord.graph.progress import nominal_path
 from agentchord.tasks import load_task_graph
 
@@ -50,3 +53,32 @@ def test_a_merge_goes_on_past_a_passed_node_when_the_node_after_it_holds():
 def test_a_merge_never_skips_into_the_goal():
     shortcuts = Shortcuts(passed={"v5"})
     assert shortcuts.ahead(GRAPH, NOMINAL_NEXT, "v4", _holding("v6")) is None
+
+
+def test_a_recovery_place_is_given_what_its_merge_node_asks_of_its_object():
+
+    towel = load_task_graph("fold_towel")
+    program = EdgeProgram.from_edge(towel.edge("e4_r_bl_slipped"))
+    vocabulary = Vocabulary(frozenset(towel.objects))
+    attach_subgoal_checks(program, [compile_expr(c, vocabulary) for c in towel.node("v4").constraints])
+    places = {a.args.obj: a for step in program.steps for a in step if a.name == "place"}
+    corner = {"extent": (0.005, 0.005, 0.005)}
+
+    def frame(bl):
+        return make_static_frame(objects={"towel_bl": {**corner, "pos": bl}, "towel_tl": {**corner, "pos": (0.0, 0.6, 0.0)},
+                                          "towel_br": {**corner, "pos": (0.3, 0.3, 0.0)}, "towel_tr": {**corner, "pos": (0.3, 0.6, 0.0)}})
+
+    # v4 reads towel_bl in two constraints: released, and within 4.5 cm of towel_tl. The far corner
+    # (towel_br, 30 cm from its top corner) is not the left place's concern.
+    left = places["towel_bl"].meets_subgoal
+    assert left(frame((0.0, 0.59, 0.008))) is True
+    assert left(frame((0.0, 0.55, 0.008))) is False  # 5 cm short
+    held = frame((0.0, 0.59, 0.008))
+    held.holding = {("left", "towel_bl")}
+    assert left(held) is False
+
+
+def test_a_place_whose_object_no_merge_constraint_reads_gets_no_check():
+    program = _program("e5_r_bottle_dropped")
+    attach_subgoal_checks(program, [compile_expr("tilt(cup) - 15", Vocabulary(frozenset(GRAPH.objects)))])
+    assert all(a.meets_subgoal is None for step in program.steps for a in step if a.name == "place")

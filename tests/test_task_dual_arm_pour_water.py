@@ -8,7 +8,7 @@ from agentchord.actions.base import Status
 from agentchord.actions.controller import RobotController
 from agentchord.actions.library import make_action
 from agentchord.execution.episode import EpisodeSpec, run_episode
-from agentchord.features.frame import make_static_frame
+from agentchord.features.frame import make_static_frame, tilt_deg
 from agentchord.features.oracle import OracleExtractor
 from agentchord.graph.progress import forward_filter, nominal_path
 from agentchord.graph.validation import check_graph
@@ -169,21 +169,38 @@ def test_skip_if_held_keeps_a_finished_grasp_and_skip_if_placed_only_retreats():
     assert robot.commanded_pose("right").pos[2] > before[2]
 
 
-def test_reseat_turns_a_fallen_bottle_into_a_nominal_side_grasp():
+@pytest.mark.parametrize(("x", "y", "yaw", "reseated"), [
+    (0.2, 0.45, 2.0, True),    # turned upright only to within ~8 deg: put down and taken again
+    (0.05, 0.5, 0.3, False),   # turned upright to within ~1 deg: the fallen-grasp hold is kept
+])
+def test_reseat_turns_a_fallen_bottle_left_askew_into_a_nominal_side_grasp(x, y, yaw, reseated, monkeypatch):
+    from agentchord.actions.grasp import Grasp
+
+    calls = []
+    reseat = Grasp._reseat
+
+    def counted(self, robot):
+        calls.append(tilt_deg(robot.frame.objects[self.args.obj].axis))
+        return (yield from reseat(self, robot))
+
+    monkeypatch.setattr(Grasp, "_reseat", counted)
     scene = _scene(0)
     world, robot, extractor = _robot(scene)
     bottle = scene.objects[0]
     adr = world.model.joint("bottle_free").qposadr[0]
-    x, y, z, w = (Rotation.from_euler("z", 0.3) * Rotation.from_euler("y", 90, degrees=True)).as_quat()
-    world.data.qpos[adr : adr + 7] = [0.05, 0.5, bottle.size[0] + 0.001, w, x, y, z]
+    qx, qy, qz, qw = (Rotation.from_euler("z", yaw) * Rotation.from_euler("y", 90, degrees=True)).as_quat()
+    world.data.qpos[adr : adr + 7] = [x, y, bottle.size[0] + 0.001, qw, qx, qy, qz]
     for _ in range(40):
         world.step()
     assert extractor.update().objects["bottle"].axis[2] < 0.2  # lying down
     status, _ = _run(robot, extractor, make_action("grasp", "right", {"obj": "bottle", "reseat": True}), max_ticks=2500)
     assert status == Status.SUCCESS
+    assert bool(calls) is reseated and all(t > Grasp.RESEAT_TILT_DEG for t in calls)
     frame = extractor.frame
     feats, tool = frame.objects["bottle"], frame.arms["right"].ee
-    assert frame.is_holding("right", "bottle") and feats.axis[2] > np.cos(np.radians(5))
-    # Held at mid-height on its axis, as a side grasp of a standing bottle is (not off-centre).
+    assert frame.is_holding("right", "bottle") and tilt_deg(feats.axis) <= Grasp.RESEAT_TILT_DEG
+    # Re-seated: held at mid-height on its axis, as a side grasp of a standing bottle is. Kept: the
+    # fallen-object hold, off the axis.
     offset = feats.pos - tool
-    assert np.linalg.norm(offset - np.dot(offset, feats.axis) * feats.axis) < 0.01
+    off_axis = np.linalg.norm(offset - np.dot(offset, feats.axis) * feats.axis)
+    assert bool(off_axis < 0.01) is reseated

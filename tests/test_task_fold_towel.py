@@ -8,7 +8,7 @@ from agentchord.features.oracle import OracleExtractor
 from agentchord.graph.progress import forward_filter
 from agentchord.graph.validation import check_graph
 from agentchord.tasks import load_task_graph
-from agentchord.worlds.sim.disturbances import ScriptedDrop
+from agentchord.worlds.sim.disturbances import ScriptedDisturbance, ScriptedDrop
 from agentchord.worlds.sim.scene import SceneSpec
 from agentchord.worlds.sim.tasks import SIM_TASKS
 from agentchord.worlds.sim.world import SimWorld
@@ -75,3 +75,23 @@ def test_a_corner_dropped_while_carried_over_is_regrasped_and_the_towel_folded()
     assert "e3_r_br_slipped" in result.path
     # The success check passes on the recovered episode's end state.
     assert result.success, result.reason
+
+
+def test_a_corner_pulled_out_as_it_is_laid_down_and_fallen_onto_its_top_corner_is_not_taken_again():
+    # The left corner is pulled out of the pinch 38 ticks into the place, 4-5 cm above its top
+    # corner, and falls onto it while the right arm is still laying its own corner (so v4 as a
+    # whole does not hold yet). The recovery finds it where v4 wants it: the left hand only opens.
+    pull = ScriptedDisturbance("place", kind="pull", nth=0, after=38)
+    held_after = []
+
+    def watch(executor):
+        if pull.events and executor.frame.is_holding("left", "towel_bl"):
+            held_after.append(executor.world.tick)
+
+    result = run_episode(EpisodeSpec(task="fold_towel", seed=0, disturbance=pull), on_tick=watch)
+    assert [e.kind for e in pull.events] == ["pull"] and pull.events[0].obj == "towel_bl"
+    assert result.success, result.reason
+    switch = result.trace.of("recovery_switch")[0]
+    assert switch["to"] == "e4_r_bl_slipped"
+    assert [t for t in held_after if t >= switch["tick"]] == []  # never pinched again
+    assert not any(p.startswith("e5_r") for p in result.path)  # and it stayed on its top corner

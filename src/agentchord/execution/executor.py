@@ -31,7 +31,7 @@ from agentchord.execution.harness import Disturbance, SuccessTracker
 from agentchord.execution.ledger import DisturbanceLedger
 from agentchord.execution.repair import Repairer
 from agentchord.execution.result import UNRECOVERABLE, EpisodeResult
-from agentchord.execution.shortcuts import Shortcuts
+from agentchord.execution.shortcuts import Shortcuts, attach_subgoal_checks
 from agentchord.execution.switching import RecoverySwitching
 from agentchord.execution.strategies import RecoveryStrategy
 from agentchord.execution.trace import Trace
@@ -380,6 +380,8 @@ class Executor(RecoverySwitching):
         """Start an edge program from the robot's current state."""
         self._fallbacks = []
         self.program = program
+        if program.kind == "recovery" and self.strategy.merges_met_subgoals and self.graph.node(program.target).kind == "nominal":
+            attach_subgoal_checks(program, self.constraints[program.target])
         program.on_action_start = self._action_started
         program.on_action_end = self._action_ended
         self._arm_monitors(program)

@@ -10,17 +10,25 @@ Two checks, both made with the graph's own node constraints (the sub-goals' defi
   just before a passed node goes on past it when the node after it holds: a bottle taken out of
   the hand after the pour reached the cup, once regrasped upright, is put down, not poured again.
 
+- **Placed by the fall.** The same test per object: a recovery's place of an object gets the merge
+  node's constraints that read that object (:func:`attach_subgoal_checks`). With ``skip_if_placed``,
+  the regrasp of an object that fell and settled where they all hold is not made and its place only
+  retreats: a towel corner pulled out of the pinch as it was being laid on its top corner, which
+  fell onto it, while the other arm is still laying its own corner (so the node as a whole does not
+  hold yet).
+
 A re-planning baseline judges what is achieved itself; a backtrack returns regardless. Only the
 strategies with ``merges_met_subgoals`` use this.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from typing import NamedTuple
 
 from agentchord.execution.edge_program import EdgeProgram
+from agentchord.expr.compiler import CompiledExpr
 from agentchord.graph.models import TaskGraph
 
 #: Whether a node's constraints all hold now (False for a node without constraints: nothing to judge by).
@@ -85,3 +93,20 @@ class Shortcuts:
             passed.append(middle)
             skipped.extend([into, out])
         return Ahead(here, passed, skipped) if here != node_id else None
+
+
+def attach_subgoal_checks(program: EdgeProgram, constraints: Sequence[CompiledExpr]) -> None:
+    """Give each place in ``program`` the test of what its merge node's ``constraints`` ask of its object.
+
+    Only the constraints that read the placed object count (``dist(towel_bl.pos, towel_tl.pos) -
+    0.045``, ``holding(left, towel_bl) - 0.5``); a place whose object no constraint reads gets no
+    test (nothing to judge by). The place consults it only with ``skip_if_placed``, and only for an
+    object no arm holds.
+    """
+    for step in program.steps:
+        for action in step:
+            if action.name != "place":
+                continue
+            reading = [c for c in constraints if action.args.obj in c.objects]
+            if reading:
+                action.meets_subgoal = lambda frame, reading=reading: all(c.scalar(frame) <= 0.0 for c in reading)

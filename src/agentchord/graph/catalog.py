@@ -49,8 +49,9 @@ class GraspArgs(_Args):
     )
     reseat: bool = Field(
         False,
-        description="A fallen object, once set upright in hand, is put down upright, the arm goes home and grasps it again "
-        "from the side: the nominal grasp geometry (a pour needs it) instead of the off-centre fallen-grasp hold.",
+        description="A fallen object that the turn upright in hand left more than 5 deg askew is put down upright, the arm "
+        "goes home and grasps it again from the side: the nominal grasp geometry (a pour needs it) instead of the "
+        "off-centre fallen-grasp hold. One left within 5 deg keeps the fallen-grasp hold.",
     )
 
 
