@@ -8,7 +8,7 @@ from agentchord.execution.edge_program import EdgeProgram
 from agentchord.execution.episode import EpisodeSpec, run_episode
 from agentchord.execution.executor import ExecutorConfig
 from agentchord.tasks import load_task_graph
-from agentchord.worlds.sim.disturbances import ScriptedDisturbance, ScriptedDrop
+from agentchord.worlds.sim.disturbances import KINDS, ScriptedDisturbance, ScriptedDrop
 
 TASK = "single_arm_pour_water"
 
@@ -253,3 +253,16 @@ def test_a_recovery_made_at_run_time_is_bound_again_from_its_own_edge():
     failed = result.trace.of("recovery_failed")
     assert [f["edge"] for f in failed][:1] == ["made_at_run_time"]
     assert any(e["edge"] == "made_at_run_time" for e in result.trace.of("recovery_bound"))
+
+
+def test_a_recovery_is_not_skipped_to_a_merge_node_whose_edge_out_would_fire_at_once():
+    # Stress protocol, seed 4: the cup is knocked over as the bottle is carried to it, and its righting
+    # is cut short by a pull of the bottle. The bottle's regrasp merges at v2, whose constraints do not
+    # read the cup, and e3's cup_tipped fires at once. v2 holds, but skipping e3_r_cup_tipped to it
+    # would fire cup_tipped again, round and round until the failure budget ended the episode.
+    result = run_episode(EpisodeSpec(TASK, seed=4, protocol=True, disturb=KINDS))
+    assert result.success, result.reason
+    tipped = [(s["edge"], s["to"]) for s in result.trace.of("recovery_switch") if s["failure"] == "cup_tipped"]
+    assert tipped == [("e2", "e2_r_cup_tipped"), ("e3", "e3_r_cup_tipped")]
+    assert result.trace.of("subgoal_met") == []
+    assert "e3_r_cup_tipped" in [b["edge"] for b in result.trace.of("recovery_bound")]

@@ -54,6 +54,7 @@ class RecoverySwitching:
     disturbances: DisturbanceLedger
     repairer: Repairer | None
     monitors: dict[str, EdgeMonitors]
+    nominal_next: dict[str, str]
     program: EdgeProgram | None
     binding: Binding | None
     armed: EdgeMonitors | None
@@ -98,6 +99,11 @@ class RecoverySwitching:
         met = None
         if self.strategy.merges_met_subgoals:
             met = Shortcuts.met_merge(self.graph, binding.candidates[0], binding.objects, self.frame.holding, self._node_holds)
+        if met is not None and self._fires_leaving(met):
+            # The merge node holds, but the edge out of it would fire at once (a knocked-over cup
+            # its constraints do not read, whose righting a second failure cut short): skipping
+            # would go round node, edge, failure until the budget ends the episode.
+            met = None
         if met is not None:
             # What the recovery was for already holds (a bottle pulled out of the hand as it was being
             # put down, set down upright by the person): nothing to redo, go on from the merge node.
@@ -120,6 +126,12 @@ class RecoverySwitching:
             if outcome is not None:
                 return outcome
         return False, f"no feasible recovery for {', '.join(binding.objects)} at {self.feasibility.where(binding.objects[0])}: {summary}"
+
+    def _fires_leaving(self, node_id: str) -> bool:
+        """Whether a monitor of the nominal edge out of ``node_id`` is violated on this frame."""
+        out = self.nominal_next.get(node_id)
+        edge_monitors = self.monitors.get(out) if out is not None else None
+        return edge_monitors is not None and any(m.expr.scalar(self.frame) > 0.0 for m in edge_monitors.monitors)
 
     def _resume(self, binding: Binding) -> None:
         """The lost holds came back as they were: the failure cleared, the interrupted edge goes on."""
