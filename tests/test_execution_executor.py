@@ -255,14 +255,15 @@ def test_a_recovery_made_at_run_time_is_bound_again_from_its_own_edge():
     assert any(e["edge"] == "made_at_run_time" for e in result.trace.of("recovery_bound"))
 
 
-def test_a_recovery_is_not_skipped_to_a_merge_node_whose_edge_out_would_fire_at_once():
+def test_a_recovery_is_skipped_to_its_merge_node_once_not_round_and_round():
     # Stress protocol, seed 4: the cup is knocked over as the bottle is carried to it, and its righting
     # is cut short by a pull of the bottle. The bottle's regrasp merges at v2, whose constraints do not
-    # read the cup, and e3's cup_tipped fires at once. v2 holds, but skipping e3_r_cup_tipped to it
-    # would fire cup_tipped again, round and round until the failure budget ended the episode.
+    # read the cup, and e3's cup_tipped fires at once. v2 holds, so e3_r_cup_tipped is skipped to it;
+    # e3 fires again before it ends, and this time the recovery runs (skipping again and again went
+    # round node, edge, failure until the failure budget ended the episode).
     result = run_episode(EpisodeSpec(TASK, seed=4, protocol=True, disturb=KINDS))
     assert result.success, result.reason
     tipped = [(s["edge"], s["to"]) for s in result.trace.of("recovery_switch") if s["failure"] == "cup_tipped"]
-    assert tipped == [("e2", "e2_r_cup_tipped"), ("e3", "e3_r_cup_tipped")]
-    assert result.trace.of("subgoal_met") == []
+    assert tipped == [("e2", "e2_r_cup_tipped"), ("e3", "e3_r_cup_tipped"), ("e3", "e3_r_cup_tipped")]
+    assert [(m["edge"], m["node"]) for m in result.trace.of("subgoal_met")] == [("e3_r_cup_tipped", "v2")]
     assert "e3_r_cup_tipped" in [b["edge"] for b in result.trace.of("recovery_bound")]

@@ -129,6 +129,8 @@ class Executor(RecoverySwitching):
         self.disturbances = DisturbanceLedger()
         # (edge, target) pairs a repair was attempted for: one attempt each.
         self._repair_attempts: set[tuple[str, str]] = set()
+        # The last recovery skipped because its merge node held, until an edge next runs to its end.
+        self._skipped: tuple[str, str] | None = None
         # Reasoning charged so far (see charge()).
         self.reasoning_s = 0.0
         self.compute_s = 0.0
@@ -403,6 +405,7 @@ class Executor(RecoverySwitching):
 
     def _on_program_done(self) -> tuple[bool, str] | None:
         program = self.program
+        self._skipped = None
         self.trace.add(self.world.tick, "edge_end", edge=program.edge_id)
         self.program = None
         # The strategy's check at a sub-goal's completion (a VQA success query), if it has one.

@@ -54,7 +54,6 @@ class RecoverySwitching:
     disturbances: DisturbanceLedger
     repairer: Repairer | None
     monitors: dict[str, EdgeMonitors]
-    nominal_next: dict[str, str]
     program: EdgeProgram | None
     binding: Binding | None
     armed: EdgeMonitors | None
@@ -63,6 +62,7 @@ class RecoverySwitching:
     reasoning_s: float
     _fallbacks: list[EdgeProgram]
     _repair_attempts: set[tuple[str, str]]
+    _skipped: tuple[str, str] | None
 
     def _beyond_every_arm(self, obj: str, confirm_ik: bool) -> tuple[bool, str] | None:
         """The unrecoverable outcome when no arm can take ``obj`` where it is (else None)."""
@@ -99,12 +99,15 @@ class RecoverySwitching:
         met = None
         if self.strategy.merges_met_subgoals:
             met = Shortcuts.met_merge(self.graph, binding.candidates[0], binding.objects, self.frame.holding, self._node_holds)
-        if met is not None and self._fires_leaving(met):
-            # The merge node holds, but the edge out of it would fire at once (a knocked-over cup
-            # its constraints do not read, whose righting a second failure cut short): skipping
-            # would go round node, edge, failure until the budget ends the episode.
+        skip = (binding.candidates[0].edge_id, met)
+        if met is not None and self._skipped == skip:
+            # Skipped to this node already, and the edge out of it failed before it ended: the node's
+            # constraints do not read what that edge watches (a knocked-over cup whose righting a
+            # second failure cut short). Skipping again would go round node, edge, failure until the
+            # budget ended the episode; the recovery runs instead.
             met = None
         if met is not None:
+            self._skipped = skip
             # What the recovery was for already holds (a bottle pulled out of the hand as it was being
             # put down, set down upright by the person): nothing to redo, go on from the merge node.
             self.trace.add(self.world.tick, "subgoal_met", edge=binding.candidates[0].edge_id, node=met,
@@ -126,12 +129,6 @@ class RecoverySwitching:
             if outcome is not None:
                 return outcome
         return False, f"no feasible recovery for {', '.join(binding.objects)} at {self.feasibility.where(binding.objects[0])}: {summary}"
-
-    def _fires_leaving(self, node_id: str) -> bool:
-        """Whether a monitor of the nominal edge out of ``node_id`` is violated on this frame."""
-        out = self.nominal_next.get(node_id)
-        edge_monitors = self.monitors.get(out) if out is not None else None
-        return edge_monitors is not None and any(m.expr.scalar(self.frame) > 0.0 for m in edge_monitors.monitors)
 
     def _resume(self, binding: Binding) -> None:
         """The lost holds came back as they were: the failure cleared, the interrupted edge goes on."""
