@@ -196,3 +196,53 @@ def test_a_place_with_a_sub_goal_check_takes_an_object_released_where_it_holds_a
     assert place.lies_at_target(robot) is True
     robot.frame.holding = {("right", "spoon")}
     assert place.lies_at_target(robot) is False  # in the hand: never placed, whatever the check says
+
+
+@pytest.mark.parametrize("offset", [(0.03, 0.026), (0.02, -0.04)])
+def test_a_side_grasp_from_a_hand_right_over_the_object_goes_round_its_top(pour_scene, offset):
+    # The bottle set upright under the hand (Table II, dual-arm pour, seed 1): the straight line down
+    # to the pre-grasp drove the open fingers into its top and knocked it over.
+    from agentchord.features.frame import tilt_deg
+
+    world, robot, extractor = _setup(pour_scene)
+    bottle = extractor.frame.objects["bottle"]
+    over = [bottle.pos[0] + offset[0], bottle.pos[1] + offset[1], bottle.top[2] + 0.065]
+    status, _ = _run(robot, extractor, make_action("move_to_target", "right", {"pos": over, "yaw": 180.0}))
+    assert status == Status.SUCCESS
+    grasp = make_action("grasp", "right", {"obj": "bottle"})
+    grasp.initialise(robot)
+    tilt = 0.0
+    while grasp.update(robot) == Status.RUNNING:
+        robot.step()
+        extractor.update()
+        tilt = max(tilt, tilt_deg(extractor.frame.objects["bottle"].axis))
+    assert grasp.status == Status.SUCCESS, grasp.failure_reason
+    assert world.holding("right", "bottle")
+    assert tilt < 5.0
+
+
+@pytest.mark.parametrize("holding", [False, True])
+def test_back_opens_a_hand_closed_on_nothing_and_keeps_a_held_object(pour_scene, holding):
+    # A towel corner that slipped out of the pinch as its place ended rests in the closed fingers;
+    # going home with them closed dragged it off its top corner (Table II, fold towel, seed 6).
+    world, robot, extractor = _setup(pour_scene)
+    if holding:
+        assert _run(robot, extractor, make_action("grasp", "right", {"obj": "bottle"}))[0] == Status.SUCCESS
+    else:
+        away = make_action("move_to_target", "right", {"pos": [0.2, 0.45, 0.2], "yaw": 180.0})
+        assert _run(robot, extractor, away)[0] == Status.SUCCESS
+        assert _run(robot, extractor, make_action("close_gripper", "right", {}))[0] == Status.SUCCESS
+    back = make_action("back", "right", {})
+    back.initialise(robot)
+    start = robot.commanded_pose("right").pos.copy()
+    grip_when_moving = None
+    while back.update(robot) == Status.RUNNING:
+        if grip_when_moving is None and np.linalg.norm(robot.commanded_pose("right").pos - start) > 0.005:
+            grip_when_moving = robot.targets["right"].grip
+        robot.step()
+        extractor.update()
+    assert back.status == Status.SUCCESS
+    if holding:
+        assert grip_when_moving == 1.0 and world.holding("right", "bottle")
+    else:
+        assert grip_when_moving == 0.0

@@ -424,6 +424,8 @@ def _print_episode(console: Console, result) -> None:
         elif kind == "subgoal_met":
             console.print(f"{tick}  [green]sub-goal met[/green]: {event['node']} already holds once at rest "
                           f"(after {event['waited_ticks']} ticks): {event['edge']} skipped")
+        elif kind == "goal_settling":
+            console.print(f"{tick}  [yellow]goal reached, judged once at rest[/yellow]: {event['reason']}")
         elif kind == "merged_ahead":
             console.print(f"{tick}  [green]merged ahead[/green]: at {event['node']}, {', '.join(event['passed'])} reached before "
                           f"the failure and {event['to']} holds: {', '.join(event['skipped'])} skipped")

@@ -42,6 +42,12 @@ MOVED_DURING_APPROACH = 0.01
 BLOCKED_CLEARANCE = 2 * ARM_CLEARANCE
 #: A closed grasp whose grasp point is farther than this (m) from where the tool aimed is off-centre.
 OFF_CENTRE_TOLERANCE = 0.025
+#: The open gripper's footprint around the tool centre (m): from the palm behind it to the finger
+#: tips ahead of it, and across the open fingers.
+PALM_BEHIND = 0.06
+FINGERS_ACROSS = 0.05
+#: The band (m) around an object's top in which a descending gripper over it strikes it.
+TOP_BAND = (-0.03, 0.015)
 
 
 class PlacedCheck(Protocol):
@@ -308,6 +314,7 @@ class Grasp(ArmAction):
         pre, point, rotation = self._side_plan(robot)
         if np.linalg.norm(robot.commanded_pose(arm).pos[:2] - pre[:2]) > 0.05:
             yield from self._clear_from_below(robot, pre[2] + 0.08)
+        yield from self._pass_over(robot, pre, rotation)
         yield from approach(robot, arm, pose_from_matrix(pre, rotation))
         self._still_standing(robot, "during the approach")
         # Re-observe: the object may have moved while the arm approached.
@@ -316,6 +323,40 @@ class Grasp(ArmAction):
         yield from self._close_and_check(robot)
         lift = robot.commanded_pose(arm).pos + np.array([0.0, 0.0, self.args.lift])
         yield from move_to(robot, arm, pose_from_matrix(lift, rotation), speed=0.15)
+
+    def _pass_over(self, robot: RobotController, pre: np.ndarray, rotation: np.ndarray) -> Iterator[None]:
+        """Come to the side pre-grasp from above it, not down through the object's top.
+
+        A regrasp often starts with the hand right over the object (it dropped or was set upright
+        under the hand): the straight line down to the pre-grasp drives the gripper into its top and
+        knocks it over (Table II, dual-arm pour, seed 1). Then the tool first moves level to above
+        the pre-grasp, clear of the top, and the approach descends from there, beside the object.
+        """
+        start = robot.commanded_pose(self.arm).pos
+        feats = robot.frame.objects[self.args.obj]
+        top = max(feats.top[2], feats.bottom[2])
+        if start[2] <= top or not self._strikes_top(start, pre, rotation[:, 0], feats):
+            return
+        above = np.r_[pre[:2], max(start[2], top + 0.05)]
+        yield from move_to(robot, self.arm, pose_from_matrix(above, rotation))
+
+    def _strikes_top(self, start: np.ndarray, end: np.ndarray, approach_dir: np.ndarray, feats) -> bool:
+        """Whether the open gripper, moved in a straight line from ``start`` to ``end``, crosses the
+        object's top with its footprint over it."""
+        top = max(feats.top[2], feats.bottom[2])
+        radius = 0.5 * float(max(feats.extent[0], feats.extent[1]))
+        ahead = np.array([approach_dir[0], approach_dir[1], 0.0])
+        ahead /= max(float(np.linalg.norm(ahead)), 1e-9)
+        across = np.array([-ahead[1], ahead[0], 0.0])
+        for s in np.linspace(0.0, 1.0, 41):
+            tool = start + s * (end - start)
+            if not TOP_BAND[0] <= tool[2] - top <= TOP_BAND[1]:
+                continue
+            to_axis = feats.pos - tool
+            along, side = float(np.dot(to_axis, ahead)), float(np.dot(to_axis, across))
+            if -PALM_BEHIND - radius < along < self.FINGERTIP_REACH + radius and abs(side) < FINGERS_ACROSS + radius:
+                return True
+        return False
 
     def _top_frame(self, robot: RobotController) -> tuple[np.ndarray, np.ndarray]:
         """Tool rotation (approach down, fingers across the narrow side) and grasp point."""

@@ -20,10 +20,17 @@ from agentchord.worlds.sim.world import SimWorld
 
 @dataclass
 class Verdict:
-    """Whether the task succeeded, and why not."""
+    """Whether the task succeeded, and why not.
+
+    Attributes:
+        success: Whether it succeeded.
+        reason: What holds, or what does not.
+        settling: It failed only because something is still moving: judged again once at rest.
+    """
 
     success: bool
     reason: str
+    settling: bool = False
 
 
 class SuccessTracker(Protocol):

@@ -57,7 +57,7 @@ class FoldTracker:
                 return Verdict(False, f"the {arm} gripper still touches the towel")
         speed = world.cloth_speed()
         if speed > self.max_speed:
-            return Verdict(False, f"the towel is still moving ({100 * speed:.1f} cm/s)")
+            return Verdict(False, f"the towel is still moving ({100 * speed:.1f} cm/s)", settling=True)
         return Verdict(True, "bottom corners folded onto the top corners, towel released and at rest")
 
 

@@ -24,6 +24,8 @@ from agentchord.worlds.sim.world import SimWorld
 
 #: Largest speed (m/s) of an object at rest.
 REST_SPEED = 0.02
+#: How a predicate that fails only because its object still moves ends its reason.
+STILL_MOVING = "is still moving"
 #: How far (m) a placed object's centre may lie from a stated table point (the handover
 #: task's target region has the same radius).
 POINT_TOLERANCE = 0.04
@@ -84,7 +86,9 @@ class GoalTracker:
         if not judged_all and self.constraints:
             failures += self._constraints(frame)
         if failures:
-            return Verdict(False, "; ".join(failures))
+            # Only motion wrong: the executor judges again once things are at rest.
+            settling = all(f.endswith(STILL_MOVING) for f in failures)
+            return Verdict(False, "; ".join(failures), settling=settling)
         return Verdict(True, "every goal predicate holds at the end")
 
     def _judge(self, goal, frame: FeatureFrame, world: SimWorld) -> str | None:
@@ -104,7 +108,7 @@ class GoalTracker:
         if held:
             return f"the {goal.obj} is still held"
         if world.object_velocity(goal.obj) > REST_SPEED:
-            return f"the {goal.obj} is still moving"
+            return f"the {goal.obj} {STILL_MOVING}"
         if kind in ("inside", "on_top_of"):
             host_name = goal.container if kind == "inside" else goal.support
             host = frame.objects[host_name]

@@ -120,7 +120,7 @@ class CoffeeTrayTracker:
             return Verdict(False, "the tray is not on the table")
         for name in ("tray", "capsule"):
             if world.object_velocity(name) > self.max_speed:
-                return Verdict(False, f"the {name} is still moving")
+                return Verdict(False, f"the {name} is still moving", settling=True)
         return Verdict(True, "capsule inside the tray, tray placed flat at the forward position")
 
 
