@@ -302,20 +302,21 @@ class Executor(RecoverySwitching):
                 outcome = self._on_program_done()
                 if outcome is not None:
                     return outcome
+        self._step()
+        return None
+
+    def _step(self) -> None:
+        """Advance the world a tick (the arms follow their targets), then call the tick watcher."""
         self.robot.step()
         if self.on_tick is not None:
             self.on_tick(self)
-        return None
 
     def _settle(self) -> tuple[bool, str] | None:
         """One tick at the goal waiting for the scene to come to rest: nothing runs, nothing is injected."""
         outcome = self._judge_goal()
-        if outcome is not None:
-            return outcome
-        self.robot.step()
-        if self.on_tick is not None:
-            self.on_tick(self)
-        return None
+        if outcome is None:
+            self._step()
+        return outcome
 
     def _judge_goal(self) -> tuple[bool, str] | None:
         """The verdict on the goal; None while the scene is only still moving and may yet come to rest.
