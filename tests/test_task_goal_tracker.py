@@ -95,3 +95,18 @@ def test_a_block_set_on_a_side_of_the_table_in_the_handover_scene_succeeds_by_it
     result = run_episode(EpisodeSpec(task="handover_block", seed=1, instruction="Put the block on the left side of the table."))
     assert result.success, result.reason
     assert result.reason == "every goal predicate holds at the end"
+
+
+def test_a_goal_wrong_only_in_that_its_object_still_moves_is_judged_again_at_rest():
+    # The executor waits for a settling verdict (up to its settle time) and judges again; a goal that
+    # also fails for another reason is final at once.
+    world, frame = _handover_world(block_xy=(-0.15, 0.5))
+    adr = world.model.joint("block_free").dofadr[0]
+    world.data.qvel[adr : adr + 3] = [0.0, 0.2, 0.0]  # pushed: sliding at 20 cm/s
+    world.step()
+    near = GoalSpec(goals=[Placed(obj="block", at=(-0.15, 0.5))])
+    far = GoalSpec(goals=[Placed(obj="block", at=(0.2, 0.5)), HandedOver(obj="block")])
+    moving = _judge(near, world, frame)
+    assert not moving.success and moving.settling and moving.reason == "the block is still moving"
+    other = _judge(far, world, frame)
+    assert not other.success and not other.settling
