@@ -8,6 +8,7 @@ from agentchord.actions.base import Status
 from agentchord.actions.controller import RobotController
 from agentchord.actions.grasp import GraspMissed
 from agentchord.actions.library import make_action
+from agentchord.features.frame import tilt_deg
 from agentchord.features.oracle import OracleExtractor
 from agentchord.worlds.sim.world import SimWorld
 
@@ -202,8 +203,6 @@ def test_a_place_with_a_sub_goal_check_takes_an_object_released_where_it_holds_a
 def test_a_side_grasp_from_a_hand_right_over_the_object_goes_round_its_top(pour_scene, offset):
     # The bottle set upright under the hand (Table II, dual-arm pour, seed 1): the straight line down
     # to the pre-grasp drove the open fingers into its top and knocked it over.
-    from agentchord.features.frame import tilt_deg
-
     world, robot, extractor = _setup(pour_scene)
     bottle = extractor.frame.objects["bottle"]
     over = [bottle.pos[0] + offset[0], bottle.pos[1] + offset[1], bottle.top[2] + 0.065]

@@ -171,7 +171,7 @@ def test_skip_if_held_keeps_a_finished_grasp_and_skip_if_placed_only_retreats():
 
 @pytest.mark.parametrize(("x", "y", "yaw", "reseated"), [
     (0.2, 0.45, 2.0, True),    # left more than 5 deg askew by the turn: put down and taken again
-    (0.05, 0.5, 0.3, False),   # turned upright to within ~1 deg: the fallen-grasp hold is kept
+    (0.05, 0.5, 0.3, False),   # left within 5 deg of upright by the turn: the fallen-grasp hold is kept
 ])
 def test_reseat_turns_a_fallen_bottle_left_askew_into_a_nominal_side_grasp(x, y, yaw, reseated, monkeypatch):
     from agentchord.actions.grasp import Grasp

@@ -335,15 +335,14 @@ class Grasp(ArmAction):
         start = robot.commanded_pose(self.arm).pos
         feats = robot.frame.objects[self.args.obj]
         top = max(feats.top[2], feats.bottom[2])
-        if start[2] <= top or not self._strikes_top(start, pre, rotation[:, 0], feats):
+        if start[2] <= top or not self._strikes_top(start, pre, rotation[:, 0], feats, top):
             return
         above = np.r_[pre[:2], max(start[2], top + 0.05)]
         yield from move_to(robot, self.arm, pose_from_matrix(above, rotation))
 
-    def _strikes_top(self, start: np.ndarray, end: np.ndarray, approach_dir: np.ndarray, feats) -> bool:
+    def _strikes_top(self, start: np.ndarray, end: np.ndarray, approach_dir: np.ndarray, feats, top: float) -> bool:
         """Whether the open gripper, moved in a straight line from ``start`` to ``end``, crosses the
-        object's top with its footprint over it."""
-        top = max(feats.top[2], feats.bottom[2])
+        object's top (at height ``top``) with its footprint over it."""
         radius = 0.5 * float(max(feats.extent[0], feats.extent[1]))
         ahead = np.array([approach_dir[0], approach_dir[1], 0.0])
         ahead /= max(float(np.linalg.norm(ahead)), 1e-9)

@@ -116,7 +116,7 @@ class MoveByOffset(ArmAction):
 
 
 class Back(ArmAction):
-    """Return the arm to its home configuration (joint space); a hand closed on nothing opens first."""
+    """Return the arm to its home configuration (joint space); a hand closed on nothing opens as it sets off."""
 
     name = "back"
 
