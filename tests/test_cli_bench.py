@@ -128,7 +128,7 @@ def test_an_llm_sweep_plans_every_episode_and_charges_what_the_calls_measured(tm
 
 def test_the_report_of_several_methods_has_the_paired_table(tmp_path):
     from agentchord.bench.sweep import SweepConfig
-    from agentchord.cli_bench import write_report
+    from agentchord.cli.bench import write_report
 
     def record(method, seed, success, exec_time, steps):
         return {"id": f"single_arm_pour_water|{method}|protocol=real|{seed}", "task": "single_arm_pour_water",

@@ -369,8 +369,8 @@ def test_a_failed_atomic_write_keeps_the_previous_file(tmp_path, monkeypatch):
 def test_one_failing_output_does_not_lose_the_others(tmp_path):
     from rich.console import Console
 
-    from agentchord.cli import _write_outputs
-    from agentchord.cli_support import BadInput
+    from agentchord.cli.episode import _write_outputs
+    from agentchord.cli.support import BadInput
 
     good = tmp_path / "summary.json"
 
@@ -598,7 +598,7 @@ def test_the_document_guards_directly(tmp_path):
 
 
 def test_an_unexpected_error_is_one_line_and_a_log(tmp_path, monkeypatch):
-    import agentchord.cli_graph as graph_cli
+    import agentchord.cli.graph as graph_cli
 
     def broken(graph):
         raise ZeroDivisionError("a bug")
@@ -612,7 +612,7 @@ def test_an_unexpected_error_is_one_line_and_a_log(tmp_path, monkeypatch):
 
 
 def test_an_interrupt_is_not_a_task_failure(monkeypatch):
-    import agentchord.cli_graph as graph_cli
+    import agentchord.cli.graph as graph_cli
 
     def interrupted(graph):
         raise KeyboardInterrupt

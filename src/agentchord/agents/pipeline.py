@@ -185,10 +185,10 @@ class Replanner:
             arm.model_copy(update={"home": arm.name not in homes or _distance(arm.ee, homes[arm.name]) < HOME_TOLERANCE})
             for arm in scene.arms]})
         if self.reasoner_kind == "rules":
-            from agentchord.agents.rules import skills  # noqa: PLC0415
+            from agentchord.agents.rules import facts  # noqa: PLC0415
 
-            state = skills.initial_state(scene, remaining)
-            if skills.goal_facts(remaining, scene)[-1] <= state:
+            state = facts.initial_state(scene, remaining)
+            if facts.goal_facts(remaining, scene)[-1] <= state:
                 return None  # what is left already holds in this observation
             reasoner = make_reasoner("rules", goal=remaining)
         else:

@@ -15,7 +15,6 @@ Example:
     -20.0
 """
 
-from agentchord.expr.builder import MAX_EXPONENT
 from agentchord.expr.compiler import CompiledExpr, compile_expr
 from agentchord.expr.exceptions import (
     ExprError,
@@ -30,6 +29,7 @@ from agentchord.expr.library import ArgKind, Function, Param
 from agentchord.expr.parse import MAX_DEPTH, MAX_SOURCE_LENGTH
 from agentchord.expr.templates import TEMPLATES, TemplateInfo
 from agentchord.expr.vocabulary import CALLABLES, FUNCTIONS, Vocabulary
+from agentchord.expr.whitelist import MAX_EXPONENT
 
 __all__ = [
     "CALLABLES",

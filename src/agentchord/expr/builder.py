@@ -1,26 +1,25 @@
 """The checker and builder behind :func:`~agentchord.expr.compiler.compile_expr`.
 
-It walks a parsed expression, checks every node against a whitelist, tracks kinds at compile
-time (scalar, vector of known length, object name, arm name) so that wrong calls and
-non-scalar results are refused before a robot runs them, folds literal subexpressions, and
-turns each allowed node into a small closure over a feature frame.
+It walks a parsed expression, checks every node against the whitelist (:mod:`~agentchord.expr.whitelist`),
+tracks kinds at compile time (scalar, vector of known length, object name, arm name) so that
+wrong calls and non-scalar results are refused before a robot runs them, folds literal
+subexpressions, and turns each allowed node into a small closure over a feature frame. Its
+errors point at the offending part of the source (:mod:`~agentchord.expr.diagnostics`).
 """
 
 from __future__ import annotations
 
 import ast
-import difflib
 import enum
 import operator
-from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any, NoReturn
 
 import numpy as np
 
 from agentchord.expr import ops
+from agentchord.expr.diagnostics import SourceLocator, shorten, suggest
 from agentchord.expr.exceptions import (
-    ExprError,
     ExprForbiddenError,
     ExprNameError,
     ExprTypeError,
@@ -29,75 +28,8 @@ from agentchord.expr.exceptions import (
 from agentchord.expr.library import ArgKind, Function, Value
 from agentchord.expr.parse import MAX_DEPTH
 from agentchord.expr.vocabulary import CALLABLES, Vocabulary, is_dunder
+from agentchord.expr.whitelist import ALLOWED_OPERATORS, FEATURE_SIZES, FORBIDDEN, MAX_EXPONENT, OPERATORS, REFUSED_OPERATORS
 from agentchord.features.frame import ARM_ATTRIBUTES, OBJECT_ATTRIBUTES, FeatureFrame
-
-#: Largest accepted |exponent| of ``**``: bounds the cost and size of powers.
-MAX_EXPONENT = 10.0
-
-# Vector lengths of the frame's features (0 = scalar); see features/frame.py.
-_FEATURE_SIZES = {
-    "pos": 3,
-    "quat": 4,
-    "axis": 3,
-    "extent": 3,
-    "top": 3,
-    "bottom": 3,
-    "points": 0,
-    "ee": 3,
-    "ee_quat": 4,
-    "q": 6,
-    "width": 0,
-    "closed": 0,
-}
-
-_OPERATORS: dict[type[ast.operator], str] = {
-    ast.Add: "+",
-    ast.Sub: "-",
-    ast.Mult: "*",
-    ast.Div: "/",
-    ast.Pow: "**",
-}
-_REFUSED_OPERATORS: dict[type[ast.AST], str] = {
-    ast.FloorDiv: "//",
-    ast.Mod: "%",
-    ast.MatMult: "@",
-    ast.LShift: "<<",
-    ast.RShift: ">>",
-    ast.BitOr: "|",
-    ast.BitXor: "^",
-    ast.BitAnd: "&",
-    ast.Invert: "~",
-    ast.Not: "not",
-}
-_ALLOWED_OPERATORS = "+ - * / ** and unary -"
-
-# Constructs refused outright, with a hint that says what to write instead.
-_FORBIDDEN: dict[type[ast.AST], str] = {
-    ast.Compare: "comparison {part!r} is not allowed: write constraints as 'lhs - rhs' (<= 0 when satisfied)",
-    ast.BoolOp: (
-        "boolean operator {part!r} is not allowed: combine conditions as max(a, b) (both must hold) "
-        "or min(a, b) (either holds)"
-    ),
-    ast.IfExp: (
-        "conditional expression {part!r} is not allowed: use min/max/clip, or gate with a 0/1 feature "
-        "as in right.closed * (...)"
-    ),
-    ast.NamedExpr: "assignment expression {part!r} is not allowed",
-    ast.Lambda: "lambda {part!r} is not allowed",
-    ast.ListComp: "comprehension {part!r} is not allowed",
-    ast.SetComp: "comprehension {part!r} is not allowed",
-    ast.DictComp: "comprehension {part!r} is not allowed",
-    ast.GeneratorExp: "generator expression {part!r} is not allowed",
-    ast.Dict: "dict literal {part!r} is not allowed: vectors are written [x, y, z]",
-    ast.Set: "set literal {part!r} is not allowed: vectors are written [x, y, z]",
-    ast.JoinedStr: "f-string {part!r} is not allowed: expressions are numeric",
-    ast.FormattedValue: "f-string {part!r} is not allowed: expressions are numeric",
-    ast.Starred: "starred expression {part!r} is not allowed",
-    ast.Slice: "slice {part!r} is not allowed: index one component, as in v[0]",
-    ast.Await: "await {part!r} is not allowed",
-    ast.Yield: "yield {part!r} is not allowed",
-    ast.YieldFrom: "yield {part!r} is not allowed",
-}
 
 
 class Kind(enum.Enum):
@@ -136,61 +68,23 @@ class Node:
         return (self.fn, None) if self.fn is not None else (None, self.const)
 
 
-class ClosureBuilder:
-    """Checks and compiles one parsed expression."""
+class ClosureBuilder(SourceLocator):
+    """Checks and compiles one parsed expression (its errors located by :class:`SourceLocator`)."""
 
     def __init__(
         self, source: str, text: str, shift: int, vocabulary: Vocabulary, finite_constants: bool = False
     ) -> None:
-        self.source = source
+        super().__init__(source, text, shift)
         self.finite_constants = finite_constants
-        self.text = text  # what was parsed: ast positions refer to it
-        self.shift = shift  # column of text's first character in source
         self.vocabulary = vocabulary
         self.objects: set[str] = set()
         self.arms: set[str] = set()
 
     # --- errors -------------------------------------------------------------------------
 
-    def segment(self, node: ast.AST) -> str:
-        """Source text of ``node``."""
-        return ast.get_source_segment(self.text, node) or type(node).__name__
-
-    def column(self, node: ast.AST) -> int | None:
-        lineno, offset = getattr(node, "lineno", None), getattr(node, "col_offset", None)
-        if lineno is None or offset is None:
-            return None
-        line = self.text.splitlines()[lineno - 1]
-        col = len(line.encode()[:offset].decode(errors="ignore"))  # ast offsets are UTF-8 bytes
-        return col + (self.shift if lineno == 1 else 0)
-
-    def attr_column(self, node: ast.Attribute) -> int | None:
-        """Column of the attribute name itself (``mass`` in ``bottle.mass``)."""
-        lineno, end = node.end_lineno, node.end_col_offset
-        if lineno is None or end is None:
-            return self.column(node)
-        line = self.text.splitlines()[lineno - 1]
-        col = len(line.encode()[:end].decode(errors="ignore")) - len(node.attr)
-        return col + (self.shift if lineno == 1 else 0)
-
-    def fail(
-        self,
-        cls: type[ExprError],
-        message: str,
-        node: ast.AST,
-        part: str | None = None,
-        col: int | None = None,
-    ) -> NoReturn:
-        raise cls(
-            message,
-            source=self.source,
-            part=part if part is not None else self.segment(node),
-            col=col if col is not None else self.column(node),
-        )
-
     def unknown_name(self, node: ast.AST, name: str) -> NoReturn:
         known = sorted(self.vocabulary.objects | self.vocabulary.arms)
-        message = f"unknown name {name!r}{_suggest(name, known)} ({self.vocabulary.describe()})"
+        message = f"unknown name {name!r}{suggest(name, known)} ({self.vocabulary.describe()})"
         self.fail(ExprNameError, message, node, name)
 
     # --- whole-tree checks ----------------------------------------------------------------
@@ -228,7 +122,7 @@ class ClosureBuilder:
             if self.finite_constants and out.is_const and out.kind in (Kind.SCALAR, Kind.VECTOR, Kind.ANY):
                 self.check_finite(out)
             return out
-        template = _FORBIDDEN.get(type(node))
+        template = FORBIDDEN.get(type(node))
         if template is not None:
             part = self.segment(node)
             if isinstance(node, ast.BoolOp):
@@ -317,14 +211,14 @@ class ClosureBuilder:
             kind = "" if table == "objects" else "arm "
             self.fail(
                 ExprNameError,
-                f"attribute {attr!r} of {kind}{owner!r} is not a feature{_suggest(attr, allowed)} "
+                f"attribute {attr!r} of {kind}{owner!r} is not a feature{suggest(attr, allowed)} "
                 f"(allowed: {', '.join(allowed)})",
                 node,
                 attr,
                 self.attr_column(node),
             )
         group.add(owner)
-        size = _FEATURE_SIZES.get(attr)
+        size = FEATURE_SIZES.get(attr)
         kind = Kind.ANY if size is None else (Kind.SCALAR if size == 0 else Kind.VECTOR)
         get = operator.attrgetter(attr)
 
@@ -338,11 +232,11 @@ class ClosureBuilder:
         return Node(kind, node, fn=fn, size=size or None, feature=(table, owner, attr))
 
     def unary(self, node: ast.UnaryOp) -> Node:
-        if type(node.op) in _REFUSED_OPERATORS:
-            symbol = _REFUSED_OPERATORS[type(node.op)]
+        if type(node.op) in REFUSED_OPERATORS:
+            symbol = REFUSED_OPERATORS[type(node.op)]
             self.fail(
                 ExprForbiddenError,
-                f"operator {symbol!r} in {self.segment(node)!r} is not allowed (allowed: {_ALLOWED_OPERATORS})",
+                f"operator {symbol!r} in {self.segment(node)!r} is not allowed (allowed: {ALLOWED_OPERATORS})",
                 node,
                 symbol,
             )
@@ -355,12 +249,12 @@ class ClosureBuilder:
         return Node(operand.kind, node, fn=lambda f: -a(f), size=operand.size)
 
     def binary(self, node: ast.BinOp) -> Node:
-        symbol = _OPERATORS.get(type(node.op))
+        symbol = OPERATORS.get(type(node.op))
         if symbol is None:
-            refused = _REFUSED_OPERATORS.get(type(node.op), type(node.op).__name__)
+            refused = REFUSED_OPERATORS.get(type(node.op), type(node.op).__name__)
             self.fail(
                 ExprForbiddenError,
-                f"operator {refused!r} in {self.segment(node)!r} is not allowed (allowed: {_ALLOWED_OPERATORS})",
+                f"operator {refused!r} in {self.segment(node)!r} is not allowed (allowed: {ALLOWED_OPERATORS})",
                 node,
                 refused,
             )
@@ -434,7 +328,7 @@ class ClosureBuilder:
     def subscript(self, node: ast.Subscript) -> Node:
         index_node = node.slice
         if isinstance(index_node, ast.Slice):
-            self.fail(ExprForbiddenError, _FORBIDDEN[ast.Slice].format(part=self.segment(index_node)), index_node)
+            self.fail(ExprForbiddenError, FORBIDDEN[ast.Slice].format(part=self.segment(index_node)), index_node)
         index = _integer_literal(index_node)
         if index is None:
             if isinstance(index_node, ast.Constant) and isinstance(index_node.value, (int, float)):
@@ -481,7 +375,7 @@ class ClosureBuilder:
         if function is None:
             self.fail(
                 ExprNameError,
-                f"call to {name!r} is not allowed{_suggest(name, CALLABLES)} (allowed: {', '.join(CALLABLES)})",
+                f"call to {name!r} is not allowed{suggest(name, CALLABLES)} (allowed: {', '.join(CALLABLES)})",
                 node.func,
                 name,
             )
@@ -604,12 +498,3 @@ def _freeze(value: Value) -> Value:
         value.flags.writeable = False
         return value
     return float(value)
-
-
-def shorten(text: str, limit: int = 40) -> str:
-    return text if len(text) <= limit else text[: limit - 3] + "..."
-
-
-def _suggest(name: str, known: Iterable[str]) -> str:
-    close = difflib.get_close_matches(name, list(known), n=1)
-    return f" (did you mean {close[0]!r}?)" if close else ""

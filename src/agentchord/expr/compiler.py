@@ -19,7 +19,8 @@ from typing import Any
 import numpy as np
 
 from agentchord.expr import ops
-from agentchord.expr.builder import ClosureBuilder, Kind, shorten
+from agentchord.expr.builder import ClosureBuilder, Kind
+from agentchord.expr.diagnostics import shorten
 from agentchord.expr.exceptions import ExprEvalError, ExprTypeError
 from agentchord.expr.library import Value
 from agentchord.expr.parse import parse_bounded

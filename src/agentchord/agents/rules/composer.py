@@ -3,7 +3,7 @@
 Plan each goal predicate in order with the STRIPS planner over the scene's skills
 (keeping what earlier goals achieved), schedule the plan into rounds where the two arms
 work at once, and write one node per round: its semantic from the skills, its
-constraints from the facts that hold there (:func:`~agentchord.agents.rules.skills.fact_constraints`).
+constraints from the facts that hold there (:func:`~agentchord.agents.rules.constraints.fact_constraints`).
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from agentchord.agents.scene import Scene
-from agentchord.agents.rules import skills
+from agentchord.agents.rules import constraints, facts, skills
 from agentchord.agents.rules.goals import GoalSpec
 from agentchord.agents.rules.planner import Operator, Plan, Round, State, plan, schedule
 from agentchord.graph.models import Edge, Node, TaskGraph
@@ -41,12 +41,12 @@ def compose(goal: GoalSpec, scene: Scene, task: str = "", instruction: str = "")
         PlanningError: A goal cannot be reached with the scene's skills.
     """
     operators = skills.ground(scene, goal)
-    state = skills.initial_state(scene, goal)
+    state = facts.initial_state(scene, goal)
     initial = state
     ops: list[Operator] = []
     states = [state]
     expanded = 0
-    for wanted in skills.goal_facts(goal, scene):
+    for wanted in facts.goal_facts(goal, scene):
         part: Plan = plan(state, wanted, operators)
         ops += part.operators
         states += part.states[1:]
@@ -88,14 +88,14 @@ def _initial_semantic(scene: Scene, goal: GoalSpec) -> str:
 def _constraints(state: State, added: frozenset, scene: Scene, initial: bool = False) -> list[str]:
     out: list[str] = []
     for fact in sorted(state):
-        if fact[0] in skills.EVENT_FACTS and fact not in added:
+        if fact[0] in facts.EVENT_FACTS and fact not in added:
             continue
         if initial and fact[0] == "on_table":
             continue
-        for expr in skills.fact_constraints(fact, scene):
+        for expr in constraints.fact_constraints(fact, scene):
             if expr not in out:
                 out.append(expr)
-    return out + [c for c in skills.upright_constraints(state) if c not in out]
+    return out + [c for c in constraints.upright_constraints(state) if c not in out]
 
 
 def _path_constraints(rnd: Round, before: State, scene: Scene) -> list[str]:

@@ -3,33 +3,18 @@
 Each skill is grounded over the scene's arms and objects, filtered by category
 (:mod:`~agentchord.agents.rules.knowledge`): a wide object takes both arms, a flat one
 is lifted clear before it is carried, a pour needs a vessel and a container. Every
-ground operator carries the atomic-action steps of its edge. :func:`fact_constraints`
-turns the facts of a state into the node constraints (Eq. 3) of the language.
-
-Facts (tuples of strings):
-
-- ``free a`` / ``home a``: arm ``a`` holds nothing / is at home;
-- ``holding a o``; ``lifted a``: the held object lifted clear of the table;
-- ``on_table o``; ``upright o``; ``fallen o``;
-- ``at o KEY``: ``o`` released at a destination: ``spot`` (where it was taken from),
-  ``region:NAME``, ``rel:ANCHOR:DX:DY:YAW``, ``in:C``, ``on:S``, ``fold:FAR``;
-- ``presented a c``: a container held up to be poured into;
-- ``pour_ready a s c`` / ``tilted a``; ``poured s c MODE`` (``table`` or ``held``);
-- ``handover_ready a o``; ``handed o GIVER RECEIVER``; ``over a corner``.
+ground operator carries the atomic-action steps of its edge. Operators read and write
+the facts of :mod:`~agentchord.agents.rules.facts`.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable
-
 from agentchord.agents.scene import Scene, SceneObject
 from agentchord.agents.rules import knowledge as kb
-from agentchord.agents.rules.goals import Folded, GoalSpec, HandedOver, Inside, On, Placed, Poured
+from agentchord.agents.rules.constraints import rounded
+from agentchord.agents.rules.facts import ARMS, placed_key
+from agentchord.agents.rules.goals import GoalSpec, HandedOver, Inside, On, Placed, Poured
 from agentchord.agents.rules.planner import Fact, Operator
-
-ARMS = ("left", "right")
-#: Facts that record an event: a constraint of the node where they became true only.
-EVENT_FACTS = frozenset({"poured", "handed"})
 
 
 def other(arm: str) -> str:
@@ -39,136 +24,6 @@ def other(arm: str) -> str:
 
 def _call(fn: str, **args) -> dict:
     return {"fn": fn, "args": args} if args else {"fn": fn}
-
-
-def _r(values: Iterable[float]) -> list[float]:
-    return [round(float(v), 4) for v in values]
-
-
-def initial_state(scene: Scene, goal: GoalSpec | None = None) -> frozenset[Fact]:
-    """The facts of an observation: the first one, or one taken mid-task (a re-plan).
-
-    A held object that must stay upright is upright in the hand (``tilted`` for its arm
-    when it is held tipped, as in the middle of a pour). With ``goal``, a destination the
-    goal asks for that already holds in the scene (an object released at its place, a
-    cloth corner laid on its partner) is a fact, so a re-plan does not do it again.
-    """
-    facts: set[Fact] = set()
-    objects = {o.name: o for o in scene.objects}
-    held = {arm.holding: arm.name for arm in scene.arms if arm.holding}
-    for arm in ARMS:
-        holder = next((a for a in scene.arms if a.name == arm), None)
-        if holder is not None and holder.holding:
-            facts.add(("holding", arm, holder.holding))
-            obj = objects.get(holder.holding)
-            if obj is not None and kb.keeps_upright(obj):
-                facts.add(("upright", obj.name))
-                if obj.axis[2] < HELD_TILTED_Z:
-                    facts.add(("tilted", arm))
-        else:
-            facts.add(("free", arm))
-            if holder is None or holder.home:
-                facts.add(("home", arm))
-    for obj in scene.objects:
-        if obj.name in held:
-            continue
-        facts.add(("on_table", obj.name))
-        if kb.keeps_upright(obj):
-            facts.add(("upright", obj.name) if obj.axis[2] > 0.8 else ("fallen", obj.name))
-    if goal is not None:
-        for name, key in _destinations(goal):
-            if name not in held and _already_at(name, key, objects, scene):
-                facts.add(("at", name, key))
-    return frozenset(facts)
-
-
-#: Axis height (cos 45 deg) under which a held upright object counts as tipped in the hand.
-HELD_TILTED_Z = 0.707
-
-
-def _destinations(goal: GoalSpec) -> list[tuple[str, str]]:
-    out: list[tuple[str, str]] = []
-    for g in goal.goals:
-        if isinstance(g, Placed):
-            out.append((g.obj, placed_key(g)))
-        elif isinstance(g, Inside):
-            out.append((g.obj, f"in:{g.container}"))
-        elif isinstance(g, On):
-            out.append((g.obj, f"on:{g.support}"))
-        elif isinstance(g, Folded):
-            out += [(f"{g.cloth}_bl", f"fold:{g.cloth}_tl"), (f"{g.cloth}_br", f"fold:{g.cloth}_tr")]
-    return out
-
-
-def _already_at(name: str, key: str, objects: dict[str, SceneObject], scene: Scene) -> bool:
-    """Whether a released object already rests at a destination (the tolerances of :func:`fact_constraints`)."""
-    obj = objects.get(name)
-    if obj is None:
-        return False
-    kind, _, rest = key.partition(":")
-    parts = rest.split(":")
-
-    def xy_dist(x: float, y: float) -> float:
-        return float(((obj.pos[0] - x) ** 2 + (obj.pos[1] - y) ** 2) ** 0.5)
-
-    upright = not kb.keeps_upright(obj) or obj.axis[2] >= UPRIGHT_PLACED_Z
-    if kind == "fold":
-        far = objects.get(parts[0])
-        return far is not None and sum((a - b) ** 2 for a, b in zip(obj.pos, far.pos, strict=True)) ** 0.5 <= 0.045
-    if kind == "region":
-        region = next((r for r in scene.regions if r.name == parts[0]), None)
-        return region is not None and upright and xy_dist(*region.center) <= region.radius
-    if kind == "xy":
-        return upright and xy_dist(float(parts[0]), float(parts[1])) <= 0.03
-    if kind == "rel":
-        anchor = objects.get(parts[0])
-        return anchor is not None and upright and xy_dist(anchor.pos[0] + float(parts[1]), anchor.pos[1] + float(parts[2])) <= 0.03
-    if kind in ("in", "on"):
-        host = objects.get(parts[0])
-        if host is None or xy_dist(host.pos[0], host.pos[1]) > 0.5 * min(host.extent[0], host.extent[1]):
-            return False
-        rim = host.pos[2] + 0.5 * host.extent[2]
-        return obj.pos[2] < rim if kind == "in" else obj.pos[2] > rim
-    return False  # "spot": where it was taken from is not in an observation
-
-
-#: Axis height (cos 10 deg) of an object placed upright.
-UPRIGHT_PLACED_Z = 0.985
-
-
-def goal_facts(goal: GoalSpec, scene: Scene) -> list[frozenset[Fact]]:
-    """The facts each goal predicate asks for, in the goal's order (cumulative), then home."""
-    stages: list[frozenset[Fact]] = []
-    wanted: set[Fact] = set()
-    for g in goal.goals:
-        if isinstance(g, Poured):
-            wanted.add(("poured", g.source, g.target, "held" if g.hold_target else "table"))
-        elif isinstance(g, Placed):
-            wanted.add(("at", g.obj, placed_key(g)))
-        elif isinstance(g, Inside):
-            wanted.add(("at", g.obj, f"in:{g.container}"))
-        elif isinstance(g, On):
-            wanted.add(("at", g.obj, f"on:{g.support}"))
-        elif isinstance(g, HandedOver):
-            wanted.add(("handed", g.obj, g.giver, g.receiver))
-        elif isinstance(g, Folded):
-            wanted |= {("at", f"{g.cloth}_bl", f"fold:{g.cloth}_tl"), ("at", f"{g.cloth}_br", f"fold:{g.cloth}_tr")}
-        stages.append(frozenset(wanted))
-    if goal.home:
-        stages.append(frozenset(wanted | {("home", "left"), ("home", "right")}))
-    return stages
-
-
-def placed_key(goal: Placed) -> str:
-    """The destination key of a placed goal."""
-    if goal.region:
-        return f"region:{goal.region}"
-    if goal.at is not None:
-        return f"xy:{goal.at[0]:g}:{goal.at[1]:g}"
-    if goal.relative_to:
-        yaw = "" if goal.yaw is None else f"{goal.yaw:g}"
-        return f"rel:{goal.relative_to}:{goal.offset[0]:g}:{goal.offset[1]:g}:{yaw}"
-    return "spot"
 
 
 def ground(scene: Scene, goal: GoalSpec) -> list[Operator]:
@@ -308,10 +163,10 @@ def _place_args(obj: SceneObject, key: str, scene: Scene) -> tuple[dict, set[Fac
     parts = rest.split(":")
     objects = {o.name: o for o in scene.objects}
     if kind == "spot":
-        return {"obj": obj.name, "target": _r(obj.pos[:2])}, set()
+        return {"obj": obj.name, "target": rounded(obj.pos[:2])}, set()
     if kind == "region":
         region = next(r for r in scene.regions if r.name == parts[0])
-        return {"obj": obj.name, "target": _r(region.center)}, set()
+        return {"obj": obj.name, "target": rounded(region.center)}, set()
     if kind == "xy":
         return {"obj": obj.name, "target": [float(parts[0]), float(parts[1])]}, set()
     if kind == "rel":
@@ -488,70 +343,3 @@ def _set_upright_ops(obj: SceneObject) -> list[Operator]:
             )
         )
     return ops
-
-
-def fact_constraints(fact: Fact, scene: Scene) -> list[str]:
-    """The node constraints (<= 0 when the fact holds) of one fact, in the expression language."""
-    objects = {o.name: o for o in scene.objects}
-    kind = fact[0]
-    if kind == "holding":
-        return [f"0.5 - holding({fact[1]}, {fact[2]})"]
-    if kind == "upright":
-        return []  # see upright_constraints: only while it stands on the table
-    if kind == "lifted":
-        return []
-    if kind == "at":
-        return _at_constraints(fact[1], fact[2], objects, scene)
-    if kind == "presented":
-        return [f"dist({fact[1]}.ee, {_r(kb.RECEIVE_POSE)}) - 0.03", f"tilt({fact[2]}) - 15"]
-    if kind == "pour_ready":
-        _, arm, s, c = fact
-        return [f"dist({arm}.ee, {c}.top + {list(kb.POUR_OFFSET)}) - 0.03", f"tilt({s}) - 15"]
-    if kind == "poured":
-        _, s, c, _ = fact
-        return [f"{kb.POUR_MIN_TILT:g} - tilt({s})", f"norm(xy({s}.top - {c}.top)) - 0.5 * {c}.extent[0] - 0.01"]
-    if kind == "handover_ready":
-        return [f"dist({fact[1]}.ee, {_r(kb.HANDOVER_POSE)}) - 0.03"]
-    if kind == "handed":
-        _, o, g, r = fact
-        return [f"holding({g}, {o}) - 0.5"]
-    if kind == "over":
-        far = _fold_partner(fact[2])
-        return [f"norm(xy({fact[2]}.pos - {far}.pos)) - 0.06"]
-    return []
-
-
-def upright_constraints(state: frozenset[Fact]) -> list[str]:
-    """Objects that must stand upright and stand on the table, not yet placed anywhere."""
-    placed = {f[1] for f in state if f[0] == "at"}
-    return [f"tilt({f[1]}) - 15" for f in sorted(state) if f[0] == "upright" and ("on_table", f[1]) in state and f[1] not in placed]
-
-
-def _fold_partner(near: str) -> str:
-    stem, corner = near.rsplit("_", 1)
-    return f"{stem}_t{corner[1]}"
-
-
-def _at_constraints(name: str, key: str, objects: dict[str, SceneObject], scene: Scene) -> list[str]:
-    kind, _, rest = key.partition(":")
-    parts = rest.split(":")
-    released = [f"holding(left, {name}) - 0.5", f"holding(right, {name}) - 0.5"]
-    obj = objects.get(name)
-    upright = [f"tilt({name}) - 10"] if obj is not None and kb.keeps_upright(obj) else []
-    if kind == "fold":
-        return released + [f"dist({name}.pos, {parts[0]}.pos) - 0.045"]
-    if kind == "spot":
-        return released + upright + [f"{name}.bottom[2] - 0.01"]
-    if kind == "region":
-        region = next(r for r in scene.regions if r.name == parts[0])
-        return released + upright + [f"norm(xy({name}.pos - {_r([*region.center, 0.0])})) - {region.radius:g}"]
-    if kind == "xy":
-        return released + upright + [f"norm(xy({name}.pos - [{parts[0]}, {parts[1]}, 0.0])) - 0.03"]
-    if kind == "rel":
-        anchor, dx, dy = parts[0], parts[1], parts[2]
-        return released + [f"norm(xy({name}.pos - {anchor}.pos) - [{dx}, {dy}, 0.0]) - 0.03"] + ([f"tilt({name}) - 15"] if obj is not None and kb.is_flat(obj) else upright)
-    if kind in ("in", "on"):
-        host = objects[parts[0]]
-        radius = round(0.5 * min(host.extent[0], host.extent[1]), 4)
-        return released + [f"norm(xy({name}.pos - {parts[0]}.pos)) - {radius:g}"]
-    return released

@@ -7,7 +7,7 @@ from pathlib import Path
 import click
 from rich.console import Console
 
-from agentchord.cli_support import BadInput, FiniteFloatRange
+from agentchord.cli.support import BadInput, FiniteFloatRange
 
 
 def _kinds(ctx, param, value: str) -> tuple[str, ...]:
@@ -93,18 +93,3 @@ def record_command(task, episodes, out, p, disturb, protocol, only_recovered, ke
                   f"{len(report.skipped)} seeds not written)")
     sys.exit(0 if len(report.written) >= episodes else 1)
 
-
-def open_rerun(path: str | None, task: str):
-    """The Rerun logger of ``run --rerun PATH`` (None without the option).
-
-    Raises:
-        BadInput: rerun-sdk is not installed.
-    """
-    if path is None:
-        return None
-    try:
-        from agentchord.data.rerun_log import RerunLogger  # noqa: PLC0415
-
-        return RerunLogger(path, task)
-    except ImportError as exc:
-        raise BadInput(f"--rerun needs rerun-sdk (pip install 'agentchord[data]'): {exc}") from exc

@@ -1,9 +1,5 @@
-"""The ``agentchord`` command line.
-
-Exit statuses (:mod:`agentchord.cli_support`): 0 success, 1 the task failed (``run``),
-2 bad input (usage errors, unreadable or invalid files, unwritable output paths),
-3 internal error (one line, the traceback in a log file it names).
-"""
+"""The episode commands: ``agentchord run`` (one episode, its path through the graph) and
+``agentchord demo`` (seeded episodes of each strategy, a table per strategy)."""
 
 from __future__ import annotations
 
@@ -14,18 +10,21 @@ import click
 from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
-from agentchord import __version__
-from agentchord.cli_support import BadInput, FiniteFloatRange, GuardedGroup, check_outputs
-from agentchord.cli_bench import bench_command
-from agentchord.cli_data import open_rerun, record_command
-from agentchord.cli_graph import graph_group, import_release_command, schema_command
+from agentchord.cli.support import (
+    PERCEPTION_NAMES,
+    REASONER_NAMES,
+    BadInput,
+    FiniteFloatRange,
+    check_outputs,
+    check_task_name,
+    failed_calls_trace,
+    load_goal_option,
+)
 from agentchord.guard.outputs import atomic_write_text, finite_json
 
 STRATEGY_NAMES = ("agentchord", "agentchord-bt")
 #: Every method `run` and `demo` accept: AgentChord, its ablation and the four baselines (`bench` compares them).
 METHOD_NAMES = (*STRATEGY_NAMES, "inner-monologue", "doremi", "rekep", "code-as-monitor")
-REASONER_NAMES = ("rules", "llm")
-PERCEPTION_NAMES = ("oracle", "rgbd")
 DISTURB_HELP = "Disturbance kinds, comma-separated: drop, pull, perturb, shift, knock."
 PROTOCOL_NAMES = ("real", "stress", "custom")
 PROTOCOL_HELP = ("1-2 disturbances at random moments of each trial (ignores --p): 'real' = perturb + pull (the paper's "
@@ -63,150 +62,7 @@ def _world_address(ctx, param, value: str | None) -> str | None:
         raise click.BadParameter(str(exc)) from exc
 
 
-def _task_name(task: str, param_hint: str) -> None:
-    from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: PLC0415
-
-    if task not in SIM_TASKS:
-        raise click.BadParameter(f"unknown task {task!r} (tasks: {', '.join(SIM_TASKS)})", param_hint=param_hint)
-
-
-@click.group(cls=GuardedGroup)
-@click.version_option(__version__, prog_name="agentchord")
-def main() -> None:
-    """AgentChord: recovery-augmented task graphs for robot manipulation."""
-
-
-main.add_command(schema_command)
-main.add_command(graph_group)
-main.add_command(import_release_command)
-main.add_command(bench_command)
-main.add_command(record_command)
-
-
-@main.command()
-def tasks() -> None:
-    """List the simulated tasks, with a one-line description each."""
-    from agentchord.tasks import library_tasks  # noqa: PLC0415
-    from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: PLC0415
-
-    graphs = set(library_tasks())
-    width = max(len(name) for name in SIM_TASKS)
-    for name, task in sorted(SIM_TASKS.items()):
-        if getattr(task, "goal_defined", False):
-            mark = "  (no library graph: plan it with --instruction)"
-        else:
-            mark = "" if name in graphs else "  (no library graph yet)"
-        click.echo(f"{name:<{width}}  {task.description}{mark}")
-
-
-@main.command()
-@click.option("--task", required=True, help="The simulated task served.")
-@click.option("--port", type=click.IntRange(0, 65535), default=5555, show_default=True, help="TCP port (0: any free one, printed).")
-@click.option("--host", default="127.0.0.1", show_default=True, help="Interface to listen on (0.0.0.0: every one).")
-@click.option("--seed", type=click.IntRange(0), default=0, show_default=True, help="Seed of a trial a client opens without one.")
-def serve(task, port, host, seed) -> None:
-    """Serve TASK's simulator over the world protocol (ZeroMQ) until interrupted.
-
-    `run`/`demo --world tcp://HOST:PORT` drive it as a remote world, the way they would drive a
-    real robot's driver: docs/world_protocol.md lists the messages. One client at a time.
-    """
-    _task_name(task, "--task")
-    import zmq  # noqa: PLC0415
-
-    from agentchord.worlds.sim.serve import WorldServer  # noqa: PLC0415
-
-    def ready(endpoint: str) -> None:
-        click.echo(f"serving {task} on {endpoint} (Ctrl-C to stop)")
-        sys.stdout.flush()
-
-    try:
-        WorldServer(task, seed).serve(f"tcp://{host}:{port or '*'}", ready=ready)
-    except zmq.ZMQError as exc:
-        raise BadInput(f"cannot listen on {host}:{port}: {exc}") from exc
-
-
-def _load_graph_option(graph_path: str | None):
-    if graph_path is None:
-        return None
-    from agentchord.graph.exceptions import GraphFileError  # noqa: PLC0415
-    from agentchord.graph.loader import load_graph  # noqa: PLC0415
-    from agentchord.graph.validation import check_graph  # noqa: PLC0415
-
-    try:
-        graph = load_graph(graph_path)
-    except GraphFileError as exc:
-        raise click.UsageError(str(exc)) from exc
-    problems = check_graph(graph)
-    if problems:
-        lines = "\n".join(f"{graph_path}: {p.path}: {p.message}" for p in problems)
-        raise click.UsageError(f"the graph is not valid:\n{lines}")
-    return graph
-
-
-@main.command()
-@click.argument("instruction", required=False)
-@click.option("--task", required=True, help="Simulated task whose seeded scene is the first observation.")
-@click.option("--seed", type=click.IntRange(0), default=0, show_default=True, help="Seed of the scene.")
-@click.option("--goal", "goal_path", type=click.Path(exists=True, dir_okay=False), help="A goal spec (YAML/JSON) instead of reading INSTRUCTION.")
-@click.option("--reasoner", type=click.Choice(REASONER_NAMES), default="rules", show_default=True)
-@click.option("--perception", type=click.Choice(PERCEPTION_NAMES), default="oracle", show_default=True)
-@click.option("-o", "--output", type=click.Path(dir_okay=False), required=True, help="Where to write the augmented graph (.yaml/.json).")
-@click.option("--render", "render_path", type=click.Path(dir_okay=False), help="Also draw it (.svg, .png, .pdf, .dot, .mmd).")
-@click.option("--trace", "trace_path", type=click.Path(dir_okay=False), help="Write the agents' calls as JSON lines.")
-@click.option("--explain", is_flag=True, help="Print the parse: clauses -> goal predicates -> skills -> graph (rules reasoner).")
-def plan(instruction, task, seed, goal_path, reasoner, perception, output, render_path, trace_path, explain) -> None:
-    """Compose, arrange and conduct the graph for INSTRUCTION in TASK's scene; write it to --output.
-
-    Exit status 0 when a valid graph was written, 2 when the instruction cannot be planned.
-    """
-    from agentchord.agents.exceptions import ReasonerError  # noqa: PLC0415
-    from agentchord.agents.observe import observe, task_regions  # noqa: PLC0415
-    from agentchord.agents.pipeline import make_reasoner, plan_task  # noqa: PLC0415
-    from agentchord.execution.trace import Trace  # noqa: PLC0415
-    from agentchord.graph.loader import dump_graph  # noqa: PLC0415
-    from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: PLC0415
-    from agentchord.worlds.sim.trial import open_world  # noqa: PLC0415
-
-    _task_name(task, "--task")
-    _check_plan_outputs(output, render_path, trace_path)
-    goal = _load_goal_option(goal_path)
-    if not instruction and goal is None:
-        raise click.UsageError("give an INSTRUCTION or --goal")
-    sim_task = SIM_TASKS[task]
-    world = open_world(task, seed)
-    scene = observe(world, task_regions(sim_task), perception)
-    if explain:
-        from agentchord.agents.rules.explain import explain_plan  # noqa: PLC0415
-
-        click.echo(explain_plan(instruction or "", scene, goal))
-    try:
-        agent = make_reasoner(reasoner, goal=goal, watch_visibility=perception == "rgbd")
-        result = plan_task(instruction or "", scene, agent, task=task)
-    except ReasonerError as exc:
-        raise click.UsageError(str(exc) + _failed_calls_trace(exc, trace_path)) from exc
-    console = Console()
-    graph = result.graph
-    dump_graph(graph, output)
-    modes = sum(len(e.failures) for e in graph.edges)
-    console.print(f"[bold]{task}[/bold] (seed {seed}): {len(result.nominal.edges)} nominal edges, {modes} failure modes, "
-                  f"{len(graph.recovery_edges())} recovery edges, {len(graph.recovery_nodes())} recovery nodes")
-    for removed in result.filtered.removed:
-        console.print(f"  forward-moving filter removed {removed.failure} on {removed.edge}: {removed.reason}")
-    timing = ", ".join(f"{agent} {1000 * s:.0f} ms" for agent, s in result.seconds.items())
-    console.print(f"  {timing} ({reasoner} reasoner)")
-    console.print(f"graph: {output}")
-    if render_path:
-        from agentchord.graph.render import render  # noqa: PLC0415
-
-        console.print(f"figure: {render(graph, render_path)}")
-    if trace_path:
-        trace = Trace()
-        for call in result.calls:
-            trace.add(0, "reasoner_call", **call.to_trace_event())
-        console.print(f"trace: {trace.write(trace_path)}")
-
-
-@main.command()
+@click.command()
 @click.argument("task")
 @click.option("--strategy", type=click.Choice(METHOD_NAMES), default="agentchord", show_default=True)
 @click.option("--p", "p", type=FiniteFloatRange(0.0, 1.0), default=0.0, show_default=True, help="Disturbance probability per atomic action.")
@@ -234,7 +90,7 @@ def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, inst
     """
     from agentchord.execution.episode import EpisodeSpec  # noqa: PLC0415
 
-    _task_name(task, "TASK")
+    check_task_name(task, "TASK")
     if world is not None and video_path is not None:
         raise click.UsageError("--video renders the simulator in this process: it cannot be used with --world")
     if world is not None and rerun_path is not None:
@@ -244,7 +100,7 @@ def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, inst
     _check_camera(task, camera, video_path)
     rerun_log = open_rerun(rerun_path, task)
     graph = _load_graph_option(graph_path)
-    goal = _load_goal_option(goal_path)
+    goal = load_goal_option(goal_path)
     if graph is not None and (instruction or goal):
         raise click.UsageError("give either --graph or --instruction/--goal, not both")
     console = Console()
@@ -294,6 +150,24 @@ def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, inst
     sys.exit(0 if result.success else 1)
 
 
+def _load_graph_option(graph_path: str | None):
+    if graph_path is None:
+        return None
+    from agentchord.graph.exceptions import GraphFileError  # noqa: PLC0415
+    from agentchord.graph.loader import load_graph  # noqa: PLC0415
+    from agentchord.graph.validation import check_graph  # noqa: PLC0415
+
+    try:
+        graph = load_graph(graph_path)
+    except GraphFileError as exc:
+        raise click.UsageError(str(exc)) from exc
+    problems = check_graph(graph)
+    if problems:
+        lines = "\n".join(f"{graph_path}: {p.path}: {p.message}" for p in problems)
+        raise click.UsageError(f"the graph is not valid:\n{lines}")
+    return graph
+
+
 def _run_or_explain(spec, on_tick=None, trace_path=None, graph_path=None):
     """Run an episode; a reasoner that cannot plan, or a graph that cannot run here, is bad input (exit 2)."""
     from agentchord.agents.exceptions import ReasonerError  # noqa: PLC0415
@@ -306,7 +180,7 @@ def _run_or_explain(spec, on_tick=None, trace_path=None, graph_path=None):
     except RemoteWorldError as exc:
         raise BadInput(str(exc)) from exc
     except ReasonerError as exc:
-        raise click.UsageError(str(exc) + _failed_calls_trace(exc, trace_path)) from exc
+        raise click.UsageError(str(exc) + failed_calls_trace(exc, trace_path)) from exc
     except GraphNotRunnableError as exc:
         source = graph_path or exc.source
         raise BadInput("the graph cannot run:\n" + "\n".join(f"{source}: {line}" for line in exc.lines)) from exc
@@ -324,27 +198,20 @@ def _check_camera(task: str, camera: str, video_path) -> None:
                                  param_hint="--camera")
 
 
-def _check_plan_outputs(output, render_path, trace_path) -> None:
-    from agentchord.graph.loader import JSON_SUFFIXES, YAML_SUFFIXES  # noqa: PLC0415
-    from agentchord.graph.render import FORMATS  # noqa: PLC0415
+def open_rerun(path: str | None, task: str):
+    """The Rerun logger of ``run --rerun PATH`` (None without the option).
 
-    check_outputs(("-o", output, YAML_SUFFIXES + JSON_SUFFIXES), ("--render", render_path, FORMATS), ("--trace", trace_path, ()))
-
-
-def _failed_calls_trace(error, trace_path) -> str:
-    """Write the agents' calls of a failed plan (the replies that were refused) to the trace; say where."""
-    from agentchord.execution.trace import Trace  # noqa: PLC0415
-
-    calls = list(getattr(error, "calls", None) or ([error.call] if getattr(error, "call", None) else []))
-    if not trace_path or not calls:
-        return ""
-    trace = Trace()
-    for call in calls:
-        trace.add(0, "reasoner_call", **call.to_trace_event())
+    Raises:
+        BadInput: rerun-sdk is not installed.
+    """
+    if path is None:
+        return None
     try:
-        return f"\n(the agents' calls, refused replies included: {trace.write(trace_path)})"
-    except OSError as exc:
-        return f"\n(the agents' calls could not be written to {trace_path}: {exc})"
+        from agentchord.data.rerun_log import RerunLogger  # noqa: PLC0415
+
+        return RerunLogger(path, task)
+    except ImportError as exc:
+        raise BadInput(f"--rerun needs rerun-sdk (pip install 'agentchord[data]'): {exc}") from exc
 
 
 def _write_video(video, path) -> Path:
@@ -380,19 +247,6 @@ def _write_outputs(console: Console, outputs) -> None:
             failed.append(f"cannot write {label} {path}: {exc}")
     if failed:
         raise BadInput("\n".join(failed))
-
-
-def _load_goal_option(goal_path: str | None):
-    if goal_path is None:
-        return None
-    from agentchord.agents.rules.goals import GoalSpec  # noqa: PLC0415
-    from agentchord.graph.exceptions import GraphFileError  # noqa: PLC0415
-    from agentchord.graph.loader import load_model  # noqa: PLC0415
-
-    try:
-        return load_model(goal_path, GoalSpec)
-    except GraphFileError as exc:
-        raise click.UsageError(str(exc)) from exc
 
 
 def _print_episode(console: Console, result) -> None:
@@ -452,7 +306,7 @@ def _print_episode(console: Console, result) -> None:
     console.print("path: " + " -> ".join(result.path))
 
 
-@main.command()
+@click.command()
 @click.option("--task", default="single_arm_pour_water", show_default=True)
 @click.option("--trials", type=click.IntRange(1, 10000), default=20, show_default=True)
 @click.option("--seed", "first_seed", type=click.IntRange(0, 2**31), default=0, show_default=True, help="Seeds run from here: --seed N --trials T runs seeds N .. N+T-1.")
@@ -480,7 +334,7 @@ def demo(task, trials, first_seed, p, disturb, protocol, perception, strategies,
     unknown = [s for s in names if s not in METHOD_NAMES]
     if unknown or not names:
         raise click.BadParameter(f"unknown strategy {unknown} (choose from {', '.join(METHOD_NAMES)})", param_hint="--strategies")
-    _task_name(task, "--task")
+    check_task_name(task, "--task")
     if world is not None and workers not in (None, 1):
         raise click.BadParameter("one remote world runs one episode at a time: use --workers 1 with --world", param_hint="--workers")
     check_outputs(("--json", json_path, ()))
@@ -520,7 +374,3 @@ def demo(task, trials, first_seed, p, disturb, protocol, perception, strategies,
                    "world": world, "runs": summaries}
         atomic_write_text(json_path, finite_json(payload, indent=2) + "\n")
         console.print(f"aggregates: {json_path}")
-
-
-if __name__ == "__main__":  # pragma: no cover
-    main()

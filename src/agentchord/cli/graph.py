@@ -1,6 +1,6 @@
 """The `agentchord schema` and `agentchord graph ...` commands (the graph package's command line).
 
-Exit statuses as everywhere (:mod:`agentchord.cli_support`): 0 valid / written, 2 an
+Exit statuses as everywhere (:mod:`agentchord.cli.support`): 0 valid / written, 2 an
 unreadable or invalid file or an output that cannot be written.
 """
 
@@ -12,7 +12,7 @@ from pathlib import Path
 
 import click
 
-from agentchord.cli_support import EXIT_BAD_INPUT, BadInput, check_outputs
+from agentchord.cli.support import EXIT_BAD_INPUT, BadInput, check_outputs
 from agentchord.graph.exceptions import GraphError, GraphFileError
 from agentchord.graph.grounding import check_scene
 from agentchord.graph.loader import JSON_SUFFIXES, YAML_SUFFIXES, dump_graph, load_graph

@@ -11,7 +11,7 @@ from rich.console import Console
 from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
-from agentchord.cli_support import EXIT_INTERNAL, BadInput
+from agentchord.cli.support import EXIT_INTERNAL, BadInput
 
 TABLE_I_TASKS = "single_arm_pour_water,dual_arm_pour_water,rearrange_table"
 

@@ -1,4 +1,5 @@
-"""Command-line plumbing: exit statuses, the top-level error handler, output checks, number options.
+"""Command-line plumbing: exit statuses, the top-level error handler, output checks, number options,
+and what several commands share (reasoner and perception names, the task check, goal files).
 
 Exit statuses of every ``agentchord`` command:
 
@@ -168,3 +169,47 @@ class FiniteFloatRange(click.FloatRange):
         if isinstance(number, float) and math.isnan(number):
             self.fail("NaN is not a number: give a finite value", param, ctx)
         return number
+
+
+#: The reasoners ``plan``, ``run`` and ``demo`` plan with.
+REASONER_NAMES = ("rules", "llm")
+#: How the agents see the scene: the simulator's ground truth, or RGB-D cameras.
+PERCEPTION_NAMES = ("oracle", "rgbd")
+
+
+def check_task_name(task: str, param_hint: str) -> None:
+    """Refuse a task that is not simulated, naming the ones that are (a usage error on ``param_hint``)."""
+    from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: PLC0415
+
+    if task not in SIM_TASKS:
+        raise click.BadParameter(f"unknown task {task!r} (tasks: {', '.join(SIM_TASKS)})", param_hint=param_hint)
+
+
+def load_goal_option(goal_path: str | None):
+    """The goal spec of ``--goal`` (None without the option); an unreadable or invalid file is a usage error."""
+    if goal_path is None:
+        return None
+    from agentchord.agents.rules.goals import GoalSpec  # noqa: PLC0415
+    from agentchord.graph.exceptions import GraphFileError  # noqa: PLC0415
+    from agentchord.graph.loader import load_model  # noqa: PLC0415
+
+    try:
+        return load_model(goal_path, GoalSpec)
+    except GraphFileError as exc:
+        raise click.UsageError(str(exc)) from exc
+
+
+def failed_calls_trace(error, trace_path) -> str:
+    """Write the agents' calls of a failed plan (the replies that were refused) to the trace; say where."""
+    from agentchord.execution.trace import Trace  # noqa: PLC0415
+
+    calls = list(getattr(error, "calls", None) or ([error.call] if getattr(error, "call", None) else []))
+    if not trace_path or not calls:
+        return ""
+    trace = Trace()
+    for call in calls:
+        trace.add(0, "reasoner_call", **call.to_trace_event())
+    try:
+        return f"\n(the agents' calls, refused replies included: {trace.write(trace_path)})"
+    except OSError as exc:
+        return f"\n(the agents' calls could not be written to {trace_path}: {exc})"

@@ -1,0 +1,155 @@
+"""The ``agentchord`` group and its small commands: ``tasks``, ``serve``, ``plan``.
+
+The other commands are defined beside it (``episode``: ``run``, ``demo``; ``graph``; ``bench``;
+``data``: ``record``) and registered here.
+"""
+
+from __future__ import annotations
+
+import sys
+
+import click
+from rich.console import Console
+
+from agentchord import __version__
+from agentchord.cli.bench import bench_command
+from agentchord.cli.data import record_command
+from agentchord.cli.episode import demo, run
+from agentchord.cli.graph import graph_group, import_release_command, schema_command
+from agentchord.cli.support import (
+    PERCEPTION_NAMES,
+    REASONER_NAMES,
+    BadInput,
+    GuardedGroup,
+    check_outputs,
+    check_task_name,
+    failed_calls_trace,
+    load_goal_option,
+)
+
+
+@click.group(cls=GuardedGroup)
+@click.version_option(__version__, prog_name="agentchord")
+def main() -> None:
+    """AgentChord: recovery-augmented task graphs for robot manipulation."""
+
+
+main.add_command(schema_command)
+main.add_command(graph_group)
+main.add_command(import_release_command)
+main.add_command(bench_command)
+main.add_command(record_command)
+main.add_command(run)
+main.add_command(demo)
+
+
+@main.command()
+def tasks() -> None:
+    """List the simulated tasks, with a one-line description each."""
+    from agentchord.tasks import library_tasks  # noqa: PLC0415
+    from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: PLC0415
+
+    graphs = set(library_tasks())
+    width = max(len(name) for name in SIM_TASKS)
+    for name, task in sorted(SIM_TASKS.items()):
+        if getattr(task, "goal_defined", False):
+            mark = "  (no library graph: plan it with --instruction)"
+        else:
+            mark = "" if name in graphs else "  (no library graph yet)"
+        click.echo(f"{name:<{width}}  {task.description}{mark}")
+
+
+@main.command()
+@click.option("--task", required=True, help="The simulated task served.")
+@click.option("--port", type=click.IntRange(0, 65535), default=5555, show_default=True, help="TCP port (0: any free one, printed).")
+@click.option("--host", default="127.0.0.1", show_default=True, help="Interface to listen on (0.0.0.0: every one).")
+@click.option("--seed", type=click.IntRange(0), default=0, show_default=True, help="Seed of a trial a client opens without one.")
+def serve(task, port, host, seed) -> None:
+    """Serve TASK's simulator over the world protocol (ZeroMQ) until interrupted.
+
+    `run`/`demo --world tcp://HOST:PORT` drive it as a remote world, the way they would drive a
+    real robot's driver: docs/world_protocol.md lists the messages. One client at a time.
+    """
+    check_task_name(task, "--task")
+    import zmq  # noqa: PLC0415
+
+    from agentchord.worlds.sim.serve import WorldServer  # noqa: PLC0415
+
+    def ready(endpoint: str) -> None:
+        click.echo(f"serving {task} on {endpoint} (Ctrl-C to stop)")
+        sys.stdout.flush()
+
+    try:
+        WorldServer(task, seed).serve(f"tcp://{host}:{port or '*'}", ready=ready)
+    except zmq.ZMQError as exc:
+        raise BadInput(f"cannot listen on {host}:{port}: {exc}") from exc
+
+
+@main.command()
+@click.argument("instruction", required=False)
+@click.option("--task", required=True, help="Simulated task whose seeded scene is the first observation.")
+@click.option("--seed", type=click.IntRange(0), default=0, show_default=True, help="Seed of the scene.")
+@click.option("--goal", "goal_path", type=click.Path(exists=True, dir_okay=False), help="A goal spec (YAML/JSON) instead of reading INSTRUCTION.")
+@click.option("--reasoner", type=click.Choice(REASONER_NAMES), default="rules", show_default=True)
+@click.option("--perception", type=click.Choice(PERCEPTION_NAMES), default="oracle", show_default=True)
+@click.option("-o", "--output", type=click.Path(dir_okay=False), required=True, help="Where to write the augmented graph (.yaml/.json).")
+@click.option("--render", "render_path", type=click.Path(dir_okay=False), help="Also draw it (.svg, .png, .pdf, .dot, .mmd).")
+@click.option("--trace", "trace_path", type=click.Path(dir_okay=False), help="Write the agents' calls as JSON lines.")
+@click.option("--explain", is_flag=True, help="Print the parse: clauses -> goal predicates -> skills -> graph (rules reasoner).")
+def plan(instruction, task, seed, goal_path, reasoner, perception, output, render_path, trace_path, explain) -> None:
+    """Compose, arrange and conduct the graph for INSTRUCTION in TASK's scene; write it to --output.
+
+    Exit status 0 when a valid graph was written, 2 when the instruction cannot be planned.
+    """
+    from agentchord.agents.exceptions import ReasonerError  # noqa: PLC0415
+    from agentchord.agents.observe import observe, task_regions  # noqa: PLC0415
+    from agentchord.agents.pipeline import make_reasoner, plan_task  # noqa: PLC0415
+    from agentchord.execution.trace import Trace  # noqa: PLC0415
+    from agentchord.graph.loader import dump_graph  # noqa: PLC0415
+    from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: PLC0415
+    from agentchord.worlds.sim.trial import open_world  # noqa: PLC0415
+
+    check_task_name(task, "--task")
+    _check_plan_outputs(output, render_path, trace_path)
+    goal = load_goal_option(goal_path)
+    if not instruction and goal is None:
+        raise click.UsageError("give an INSTRUCTION or --goal")
+    sim_task = SIM_TASKS[task]
+    world = open_world(task, seed)
+    scene = observe(world, task_regions(sim_task), perception)
+    if explain:
+        from agentchord.agents.rules.explain import explain_plan  # noqa: PLC0415
+
+        click.echo(explain_plan(instruction or "", scene, goal))
+    try:
+        agent = make_reasoner(reasoner, goal=goal, watch_visibility=perception == "rgbd")
+        result = plan_task(instruction or "", scene, agent, task=task)
+    except ReasonerError as exc:
+        raise click.UsageError(str(exc) + failed_calls_trace(exc, trace_path)) from exc
+    console = Console()
+    graph = result.graph
+    dump_graph(graph, output)
+    modes = sum(len(e.failures) for e in graph.edges)
+    console.print(f"[bold]{task}[/bold] (seed {seed}): {len(result.nominal.edges)} nominal edges, {modes} failure modes, "
+                  f"{len(graph.recovery_edges())} recovery edges, {len(graph.recovery_nodes())} recovery nodes")
+    for removed in result.filtered.removed:
+        console.print(f"  forward-moving filter removed {removed.failure} on {removed.edge}: {removed.reason}")
+    timing = ", ".join(f"{agent} {1000 * s:.0f} ms" for agent, s in result.seconds.items())
+    console.print(f"  {timing} ({reasoner} reasoner)")
+    console.print(f"graph: {output}")
+    if render_path:
+        from agentchord.graph.render import render  # noqa: PLC0415
+
+        console.print(f"figure: {render(graph, render_path)}")
+    if trace_path:
+        trace = Trace()
+        for call in result.calls:
+            trace.add(0, "reasoner_call", **call.to_trace_event())
+        console.print(f"trace: {trace.write(trace_path)}")
+
+
+def _check_plan_outputs(output, render_path, trace_path) -> None:
+    from agentchord.graph.loader import JSON_SUFFIXES, YAML_SUFFIXES  # noqa: PLC0415
+    from agentchord.graph.render import FORMATS  # noqa: PLC0415
+
+    check_outputs(("-o", output, YAML_SUFFIXES + JSON_SUFFIXES), ("--render", render_path, FORMATS), ("--trace", trace_path, ()))
