@@ -119,3 +119,38 @@ def test_a_recovery_whose_scene_changed_under_it_is_bound_once_more():
     failed = result.trace.of("recovery_failed")
     assert [f["edge"] for f in failed] == ["e6_r_cup_dropped"]
     assert result.path.count("e6_r_cup_dropped") == 2
+
+
+@pytest.mark.parametrize(("disturbance_seed", "victim"), [(0, "bottle"), (3, "cup")])
+def test_a_cup_or_bottle_knocked_over_as_the_arms_go_home_is_stood_up_again(disturbance_seed, victim):
+    # The task's last edge sends both arms home; a person knocking the cup or the bottle over then
+    # left it lying, and the goal (both upright) failed with no recovery to run.
+    knock = ScriptedDisturbance("back", "knock", nth=0, after=20, seed=disturbance_seed)
+    result = run_episode(EpisodeSpec("dual_arm_pour_water", seed=disturbance_seed, disturbance=knock))
+    assert [e["obj"] for e in result.trace.of("disturbance")] == [victim]
+    assert result.success, result.reason
+    assert _recoveries(result) == [f"e7_r_{victim}_knocked"]
+
+
+def test_a_tray_pushed_off_its_spot_as_the_arms_go_home_is_carried_back():
+    # The right arm's return home (the third `back`) is when a person slides the released tray 5-8 cm.
+    shift = ScriptedDisturbance("back", "shift", nth=2, after=20, seed=0)
+    result = run_episode(EpisodeSpec("setup_coffee_tray", seed=0, disturbance=shift))
+    assert [e["obj"] for e in result.trace.of("disturbance")] == ["tray"]
+    assert result.success, result.reason
+    assert _recoveries(result) == ["e5_r_tray_moved"]
+
+
+def test_a_bottle_knocked_over_just_before_the_arm_gets_home_is_caught_as_it_falls():
+    # Knocked 6 ticks before the last edge ends, the bottle is still falling (about 30 deg) when the
+    # goal is first judged: the verdict waits for the scene to come to rest, the last edge's monitor
+    # sees the bottle go over, and its recovery stands it up again (the verdict on the falling
+    # bottle used to end the episode).
+    clean = run_episode(EpisodeSpec("single_arm_pour_water", seed=0))
+    back_start = [e["tick"] for e in clean.trace.of("action_start") if ".back" in e["action"]][-1]
+    knock = ScriptedDisturbance("back", "knock", nth=0, after=clean.steps - back_start - 6, seed=0)
+    result = run_episode(EpisodeSpec("single_arm_pour_water", seed=0, disturbance=knock))
+    assert [e["obj"] for e in result.trace.of("disturbance")] == ["bottle"]
+    assert [e["tick"] for e in result.trace.of("goal_settling")] == [clean.steps]
+    assert result.success, result.reason
+    assert _recoveries(result) == ["e6_r_bottle_knocked"]

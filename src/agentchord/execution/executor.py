@@ -29,6 +29,7 @@ from agentchord.execution.edge_program import EdgeProgram
 from agentchord.execution.feasibility import FeasibilityChecker, first_grasps, off_table
 from agentchord.execution.harness import Disturbance, SuccessTracker
 from agentchord.execution.ledger import DisturbanceLedger
+from agentchord.execution.motion_watch import MotionWatch
 from agentchord.execution.repair import Repairer
 from agentchord.execution.result import UNRECOVERABLE, EpisodeResult
 from agentchord.execution.shortcuts import Shortcuts, attach_subgoal_checks
@@ -62,8 +63,9 @@ class ExecutorConfig:
     off_table_ticks: int = 5
     #: Ticks a recovery waits for the objects it grasps to come to rest before binding its arm.
     bind_wait_ticks: int = 100
-    #: Ticks the goal's verdict waits, arms still, for a scene that is only still moving (a cloth's
-    #: vertices jittering in contact, a tray rocking after release) to come to rest.
+    #: Ticks a failing goal verdict waits, arms still, for a scene that still moves (a cloth's vertices
+    #: jittering in contact, a tray rocking after release, a bottle knocked over as the arm got home)
+    #: to come to rest; the last edge's monitors keep watching meanwhile.
     settle_ticks: int = 25
 
 
@@ -136,6 +138,7 @@ class Executor(RecoverySwitching):
         self._skipped: tuple[str, str] | None = None
         # Tick the goal was reached with a scene still moving (its verdict waits for rest), else None.
         self.settling_since: int | None = None
+        self.motion = MotionWatch(self.graph.objects)
         # Reasoning charged so far (see charge()).
         self.reasoning_s = 0.0
         self.compute_s = 0.0
@@ -240,7 +243,14 @@ class Executor(RecoverySwitching):
     def _tick(self) -> tuple[bool, str] | None:
         frame = self.extractor.update()
         self.tracker.observe(frame)
+        self.motion.observe(frame)
         if self.settling_since is not None:
+            # The last edge's failure modes hold until the scene is at rest: a bottle knocked over
+            # as the arm reached home is still falling when the goal is first judged.
+            detection = self.armed.evaluate(frame) if self.armed is not None else None
+            if detection is not None:
+                self.settling_since = None
+                return self._on_failure(detection)
             return self._settle()
         if self.strategy.resumes_cleared_failures:
             self.holds.observe(frame)
@@ -319,14 +329,16 @@ class Executor(RecoverySwitching):
         return outcome
 
     def _judge_goal(self) -> tuple[bool, str] | None:
-        """The verdict on the goal; None while the scene is only still moving and may yet come to rest.
+        """The verdict on the goal; None while it fails with the scene still moving, which may yet come to rest.
 
         A verdict taken on the tick the last edge ends can catch a single cloth vertex jittering at
-        16 cm/s in a towel that is otherwise at rest (Table II, fold towel, seed 16): the judge waits,
-        the arms holding still, up to ``settle_ticks``; those ticks count as the episode's.
+        16 cm/s in a towel that is otherwise at rest (Table II, fold towel, seed 16), or a bottle
+        knocked over a few ticks before the arm got home, still falling (24 deg and on its way
+        down). The judge waits, the arms holding still, up to ``settle_ticks``; those ticks count
+        as the episode's.
         """
         verdict = self.tracker.verdict(self.frame, self.world)
-        if verdict.settling:
+        if verdict.settling or (not verdict.success and self.motion.moving()):
             if self.settling_since is None:
                 self.settling_since = self.world.tick
                 self.trace.add(self.world.tick, "goal_settling", node=self.node, reason=verdict.reason)
