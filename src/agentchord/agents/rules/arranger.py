@@ -14,6 +14,8 @@ what, which motions since the last grasp, what each arm's pose is relative to). 
   with a free arm while the busy arm parks, then ``e`` again;
 - an object released inside or on another one can fall out when that one is carried (Eq. 19):
   ``re-place`` it and take the carried one again;
+- an object put down earlier can be knocked over or pushed off its spot while the arms go home
+  (:mod:`.left_behind`): ``put back``, then go home again;
 - with RGB-D perception, a tracked object can be lost from view (Eq. 18): ``re-observe``;
 - a regrasp the busy arm cannot reach gets the other arm's alternative (``arm_switch``).
 
@@ -44,6 +46,7 @@ from agentchord.agents.rules.accounts import (
     side_by_side,
 )
 from agentchord.agents.rules.arm_switch import add_arm_switch_alternatives
+from agentchord.agents.rules.left_behind import left_behind_branches
 from agentchord.features.frame import tilt_deg
 from agentchord.graph.models import ActionCall, Edge, FailureMode, Step, TaskGraph
 from agentchord.graph.progress import forward_filter, nominal_path
@@ -183,6 +186,7 @@ class Arranger:
         out += self._upright_in_hand(edge, account, after)
         out += self._relations(graph, edge, account, after)
         out += self._misplaced(graph, edge, account)
+        out += left_behind_branches(graph, edge, self.objects)
         return out
 
     def _misplaced(self, graph: TaskGraph, edge: Edge, before: Account) -> list[tuple[FailureMode, Edge]]:
