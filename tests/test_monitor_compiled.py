@@ -1,7 +1,10 @@
 """Compiled monitors of an edge and the recovery map (Eq. 11-13)."""
 
+import pytest
+
 from agentchord.expr import Vocabulary
 from agentchord.features.frame import make_static_frame
+from agentchord.graph.models import Edge, FailureMode
 from agentchord.monitor import EdgeMonitors, RecoveryMap
 from agentchord.tasks import load_task_graph
 
@@ -44,3 +47,15 @@ def test_recovery_map_returns_the_entry_edge_and_orders_exits_by_cost_to_go():
     assert recovery.entry("e2", "no_such_failure") is None
     exits = recovery.exit_edges("r_bottle_regrasped")
     assert [e.target for e in exits] == ["v2"]
+
+
+def test_violated_now_reports_a_violation_on_one_frame_without_waiting_for_persistence():
+    edge = Edge(id="e9", source="a", target="b", actions={"right": {"fn": "back"}},
+                failures=[FailureMode(name="cup_tipped", monitor="tipped(cup, 30)", window=5, intent="set upright", recovery="r")])
+    monitors = EdgeMonitors.compile(edge, VOCAB)
+    upright = make_static_frame({"cup": {"axis": (0.0, 0.0, 1.0)}})
+    lying = make_static_frame({"cup": {"axis": (1.0, 0.0, 0.0)}})
+    assert monitors.violated_now(upright) is None
+    detection = monitors.violated_now(lying)
+    assert detection is not None and detection.failure.name == "cup_tipped" and detection.value == pytest.approx(60.0)
+    assert monitors.evaluate(lying) is None  # the persistence window still counts one tick

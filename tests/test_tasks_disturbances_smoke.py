@@ -154,3 +154,16 @@ def test_a_bottle_knocked_over_just_before_the_arm_gets_home_is_caught_as_it_fal
     assert [e["tick"] for e in result.trace.of("goal_settling")] == [clean.steps]
     assert result.success, result.reason
     assert _recoveries(result) == ["e6_r_bottle_knocked"]
+
+
+def test_a_bottle_knocked_over_again_on_the_recoverys_way_home_is_stood_up_once_more():
+    # The knock recovery ends by sending the arm home, where no monitor watches the bottle; a second
+    # knock then left it lying and the goal failed. The goal's failure is one the edge into it
+    # watches for (bottle_knocked), so that recovery runs again.
+    twice = _Both(ScriptedDisturbance("back", "knock", nth=0, after=20, seed=0),
+                  ScriptedDisturbance("back", "knock", nth=1, after=20, seed=2))
+    result = run_episode(EpisodeSpec("single_arm_pour_water", seed=0, disturbance=twice))
+    assert [e["obj"] for e in result.trace.of("disturbance")] == ["bottle", "bottle"]
+    assert [e["failure"] for e in result.trace.of("violation_at_goal")] == ["bottle_knocked"]
+    assert result.success, result.reason
+    assert _recoveries(result) == ["e6_r_bottle_knocked", "e6_r_bottle_knocked"]

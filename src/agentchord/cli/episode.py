@@ -280,6 +280,9 @@ def _print_episode(console: Console, result) -> None:
                           f"(after {event['waited_ticks']} ticks): {event['edge']} skipped")
         elif kind == "goal_settling":
             console.print(f"{tick}  [yellow]goal reached, judged once at rest[/yellow]: {event['reason']}")
+        elif kind == "violation_at_goal":
+            console.print(f"{tick}  [red]goal not met[/red] ({event['reason']}), watched for by {event['edge']}: "
+                          f"{event['failure']}")
         elif kind == "merged_ahead":
             console.print(f"{tick}  [green]merged ahead[/green]: at {event['node']}, {', '.join(event['passed'])} reached before "
                           f"the failure and {event['to']} holds: {', '.join(event['skipped'])} skipped")

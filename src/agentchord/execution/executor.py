@@ -344,7 +344,27 @@ class Executor(RecoverySwitching):
                 self.trace.add(self.world.tick, "goal_settling", node=self.node, reason=verdict.reason)
             if self.world.tick - self.settling_since < self.config.settle_ticks:
                 return None
+        if not verdict.success:
+            detection = self._explained_at_goal()
+            if detection is not None:
+                self.settling_since = None
+                self.trace.add(self.world.tick, "violation_at_goal", node=self.node, edge=detection.edge_id,
+                               failure=detection.failure.name, reason=verdict.reason)
+                return self._on_failure(detection)
         return verdict.success, verdict.reason
+
+    def _explained_at_goal(self) -> Detection | None:
+        """A failure mode of the nominal edge into the goal that the scene violates now, if any.
+
+        The goal fails for something that edge watches for (a bottle knocked over again while a
+        recovery took the arm home, where nothing watched it): its recovery runs, as if the edge's
+        monitor had fired; the failure budget bounds the repeats.
+        """
+        if not self.strategy.uses_monitors:
+            return None
+        into_goal = [e for e in nominal_path(self.graph) if self.graph.edge(e).target == self.graph.goal]
+        monitors = self.monitors.get(into_goal[-1]) if into_goal else None
+        return monitors.violated_now(self.frame) if monitors is not None else None
 
     def _where(self) -> str:
         if self.binding is not None:

@@ -66,3 +66,11 @@ class EdgeMonitors:
             if monitor.trigger.update(value, frame.tick) and fired is None:
                 fired = Detection(monitor.edge_id, monitor.failure, frame.tick, monitor.trigger.first_violation_tick, value)
         return fired
+
+    def violated_now(self, frame: FeatureFrame) -> Detection | None:
+        """The first monitor violated on this frame alone, persistence aside (a state to explain, not a transient)."""
+        for monitor in self.monitors:
+            value = monitor.expr.scalar(frame)
+            if value > monitor.failure.margin:
+                return Detection(monitor.edge_id, monitor.failure, frame.tick, frame.tick, value)
+        return None
