@@ -120,16 +120,11 @@ class Back(ArmAction):
 
     name = "back"
 
-    #: Finger pads nearer than this (m) hold no object: the narrowest (cutlery, 1.9 cm across) keeps
-    #: them wider. A hold that flickers off for a tick never opens a hand on an object.
-    CLOSED_ON_NOTHING = 0.01
-
     def script(self, robot: RobotController) -> Iterator[None]:
         # A hand closed on nothing (an object slipped out just as its place ended) would drag
         # whatever still lies in its fingers (a towel corner) along: it has nothing to keep. The
         # fingers open as the arm sets off: 5.5 cm apart before the tool has moved 1.5 mm (min-jerk start).
-        holds = any(arm == self.arm for arm, _ in robot.frame.holding)
-        if not holds and robot.frame.arms[self.arm].width < self.CLOSED_ON_NOTHING:
+        if not any(arm == self.arm for arm, _ in robot.frame.holding):
             robot.set_grip(self.arm, 0.0)
         yield from move_joints(robot, self.arm, HOME_Q)
         robot.set_pose(self.arm, robot.ik.tcp_pose(self.arm))
