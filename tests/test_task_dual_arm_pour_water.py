@@ -90,11 +90,18 @@ def test_library_graph_checks_clean_and_watches_every_held_object():
     assert nominal_path(graph) == ["e1", "e2", "e3", "e4", "e5", "e6", "e7"]
     # Every edge that holds the cup or the bottle -- nominal and recovery -- watches for its drop;
     # an arm-switch alternative watches the object it hands over (the other is set down on purpose).
+    # Once both are put down (v6), the arms going home watch both for a knock, and a knock's
+    # recovery watches the drop of the one object it stands up again.
     for edge in graph.edges:
         names = {f.name for f in edge.failures}
         if edge.alternative_to:
             assert names == {f.name for f in graph.edge(edge.alternative_to).failures if f.recovery == edge.alternative_to}, edge.id
-        elif edge.id != "e7":
+        elif edge.id == "e7":
+            assert names == {"cup_knocked", "bottle_knocked"}
+        elif edge.source == "v6":
+            taken = {call.args["obj"] for _, call in edge.calls if call.fn == "grasp"}
+            assert names == {f"{obj}_dropped" for obj in taken}, edge.id
+        else:
             assert {"cup_dropped", "bottle_dropped"} <= names, edge.id
     # Synchronous grasp and place: both arms in one step.
     assert set(graph.edge("e1").steps[0]) == {"left", "right"}
