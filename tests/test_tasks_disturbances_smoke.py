@@ -62,14 +62,54 @@ def test_a_bottle_knocked_over_as_it_is_taken_again_is_taken_as_a_fallen_one():
 
 
 
-def test_an_arm_that_falls_short_of_a_pushed_object_is_not_blamed_on_the_other_arm():
-    # Stress protocol, seed 2: the fork is pushed during the recovery's grasp to where neither arm
-    # reaches (2 cm short). The right arm stops short with both tools near each other but its
-    # links 12 cm clear of the left arm's: the reason used to say "the other arm was in the way".
+def test_a_fork_pushed_against_the_plate_is_taken_farther_along_its_length():
+    # Stress protocol, seed 2: the fork is pushed against the plate's rim during the recovery's
+    # grasp. Taken at its centre, the left finger came down on the rim and the tool stopped 1.8 cm
+    # above the grasp, for both arms ("stopped short"); the grasp now slides along the fork.
+    result = run_episode(EpisodeSpec("rearrange_table", seed=2, protocol=True, disturb=KINDS))
+    assert result.success, result.reason
+    assert _recoveries(result) == ["e4_r_fork_moved"]
+
+
+def test_a_capsule_dropped_against_the_tray_handle_is_taken_with_the_fingers_turned():
+    # Stress protocol, seed 13: the capsule drops against the tray's handle; taken with the fingers
+    # closing toward the handle, one finger came down on it three times ("fingers closed but capsule
+    # is not held") and the right arm could not reach. The fingers now turn off the handle.
+    result = run_episode(EpisodeSpec("setup_coffee_tray", seed=13, protocol=True, disturb=KINDS))
+    assert result.success, result.reason
+    assert _recoveries(result) == ["e2_r_capsule_dropped"]
+
+
+def _top_grasps_at_the_centre(monkeypatch, report_blocked: bool) -> None:
+    """Make every top grasp the plain one (the behaviour before the fingers' clearance was checked)."""
+    from agentchord.actions import finger_clearance, grasp
+
+    def plain(frame, obj, point, long_dir):
+        hits = finger_clearance.blocking(frame, obj, point, long_dir)
+        return finger_clearance.TopGraspChoice(blocked_by=tuple(sorted(hits)) if report_blocked else ())
+
+    monkeypatch.setattr(grasp, "clear_top_grasp", plain)
+
+
+def test_an_arm_that_falls_short_of_a_pushed_object_is_not_blamed_on_the_other_arm(monkeypatch):
+    # Seed 2 again with the fork taken at its centre and nothing known of what the fingers land on:
+    # the right arm stops short with both tools near each other but its links 12 cm clear of the
+    # left arm's; the reason used to say "the other arm was in the way".
+    _top_grasps_at_the_centre(monkeypatch, report_blocked=False)
     result = run_episode(EpisodeSpec("rearrange_table", seed=2, protocol=True, disturb=KINDS))
     assert not result.success
     assert "stopped short of the grasp of fork" in result.reason
     assert "in the way" not in result.reason
+
+
+def test_fingers_that_come_down_on_a_neighbour_are_named_in_the_reason(monkeypatch):
+    # The same grasp, its fingers known to overlap the plate and no clear one chosen: the reason
+    # says what they came down on.
+    _top_grasps_at_the_centre(monkeypatch, report_blocked=True)
+    result = run_episode(EpisodeSpec("rearrange_table", seed=2, protocol=True, disturb=KINDS))
+    assert not result.success
+    assert "the open fingers came down on plate beside fork" in result.reason
+
 
 class _Both:
     """Two scripted disturbances in one episode (each keeps its own schedule)."""

@@ -15,6 +15,7 @@ from scipy.spatial.transform import Rotation
 from agentchord.actions import catalog
 from agentchord.actions.base import ActionFailed, ArmAction
 from agentchord.actions.controller import RobotController
+from agentchord.actions.finger_clearance import TopGraspChoice, clear_top_grasp
 from agentchord.actions.geometry import _matrix, _wrist_margin
 from agentchord.actions.motion import (
     ANGULAR_SPEED,
@@ -102,6 +103,8 @@ class Grasp(ArmAction):
     #: The place of the same object by the same arm later in the edge (set when the edge is compiled):
     #: with ``skip_if_placed``, a grasp of an object already lying where that place puts it is not made.
     placed_by: PlacedCheck | None = None
+    #: The top grasp's departure from the plain one, chosen at an attempt's first look.
+    _top_choice: TopGraspChoice | None = None
 
     def script(self, robot: RobotController) -> Iterator[None]:
         held = robot.targets[self.arm].grip_closed_settled and robot.frame.is_holding(self.arm, self.args.obj)
@@ -261,6 +264,8 @@ class Grasp(ArmAction):
             moved = float(np.linalg.norm(robot.frame.objects[self.args.obj].pos - self._seen_at))
             if moved > MOVED_DURING_APPROACH:
                 raise GraspMissed(f"{self.args.obj} moved {100 * moved:.1f} cm during the approach") from None
+            # A top grasp whose fingers no slide or turn could clear comes down on that neighbour.
+            blocked = self._top_choice.blocked_by if self._taken_as == "top" and self._top_choice else ()
             if robot.ik.arms_close():
                 # Tools this near, the collision limit may have held this arm back from the other one
                 # (busy beside it): try again. Its proxies clear of the other arm's, nothing did:
@@ -268,9 +273,16 @@ class Grasp(ArmAction):
                 clearance = robot.ik.arm_clearance()
                 if clearance < BLOCKED_CLEARANCE:
                     raise GraspMissed(f"the other arm was in the way of the grasp of {self.args.obj}") from None
-                raise GraspMissed(
-                    f"the arm stopped short of the grasp of {self.args.obj}, "
-                    f"{100 * clearance:.0f} cm clear of the other arm"
+                if not blocked:
+                    raise GraspMissed(
+                        f"the arm stopped short of the grasp of {self.args.obj}, "
+                        f"{100 * clearance:.0f} cm clear of the other arm"
+                    ) from None
+            if blocked:
+                short = float(np.linalg.norm(robot.frame.arms[self.arm].ee - robot.commanded_pose(self.arm).pos))
+                raise ActionFailed(
+                    f"the open fingers came down on {' and '.join(blocked)} beside {self.args.obj}: "
+                    f"the tool stopped {100 * short:.1f} cm short of the grasp"
                 ) from None
             raise
         aimed = robot.commanded_pose(self.arm).pos.copy()
@@ -285,7 +297,7 @@ class Grasp(ArmAction):
         upright = tilt_deg(robot.frame.objects[self.args.obj].axis) <= UPRIGHT_TOLERANCE_DEG
         off = 0.0
         if self._taken_as == "top":
-            off = float(np.linalg.norm(self._top_frame(robot)[1] - aimed))
+            off = float(np.linalg.norm(self._top_frame(robot, keep_choice=True)[1] - aimed))
         elif self._taken_as == "side" and upright and self._upright_at_start:
             off = float(np.linalg.norm(self._side_point(robot, self._height_fraction) - aimed))
         if off > OFF_CENTRE_TOLERANCE:
@@ -357,8 +369,13 @@ class Grasp(ArmAction):
                 return True
         return False
 
-    def _top_frame(self, robot: RobotController) -> tuple[np.ndarray, np.ndarray]:
-        """Tool rotation (approach down, fingers across the narrow side) and grasp point."""
+    def _top_frame(self, robot: RobotController, keep_choice: bool = False) -> tuple[np.ndarray, np.ndarray]:
+        """Tool rotation (approach down, fingers across the narrow side) and grasp point.
+
+        Where the open fingers would come down on a neighbour, the grasp slides along the object
+        or turns about it (:func:`clear_top_grasp`); with ``keep_choice`` the choice made at the
+        attempt's first look is kept, so re-observing the object does not move the grasp around.
+        """
         feats = robot.frame.objects[self.args.obj]
         rot = _matrix(feats.quat)
         # The object's horizontal principal direction: its axis if lying, else its longer side.
@@ -370,6 +387,20 @@ class Grasp(ArmAction):
         if np.linalg.norm(long_dir) < 1e-6:
             long_dir = np.array([1.0, 0.0, 0.0])
         long_dir /= np.linalg.norm(long_dir)
+        lying = tilt_deg(feats.axis) >= self.FALLEN_DEG
+        top_z = feats.pos[2] + 0.5 * feats.extent[0] if lying else max(feats.top[2], feats.bottom[2])
+        height = top_z - min(feats.bottom[2], feats.top[2]) if not lying else float(feats.extent[0])
+        # Finger tips go 70% down the object (at most 3 cm), never closer than 4 mm to the table.
+        tips_z = max(top_z - min(0.7 * height, 0.03), 0.004)
+        point = np.r_[feats.pos[:2], tips_z + self.FINGERTIP_REACH]
+        if np.any(np.asarray(self.args.offset) != 0.0):
+            choice = TopGraspChoice()  # a grasp point the graph asked for (a tray's handle) stays put
+        elif keep_choice and self._top_choice is not None:
+            choice = self._top_choice
+        else:
+            choice = clear_top_grasp(robot.frame, self.args.obj, point, long_dir)
+        self._top_choice = choice
+        long_dir, point = choice.apply(long_dir, point)
         # Of the two equivalent finger orientations, take the one facing away from the arm's base.
         outward = feats.pos - robot.world.arm_base(self.arm)
         if np.dot(long_dir[:2], outward[:2]) < 0:
@@ -387,12 +418,6 @@ class Grasp(ArmAction):
             long_dir = far if keep < 0.0 and _wrist_margin(robot, self.arm, turn(far), feats.pos) > keep else near
         down = np.array([0.0, 0.0, -1.0])
         rotation = np.column_stack([down, np.cross(long_dir, down), long_dir])
-        lying = tilt_deg(feats.axis) >= self.FALLEN_DEG
-        top_z = feats.pos[2] + 0.5 * feats.extent[0] if lying else max(feats.top[2], feats.bottom[2])
-        height = top_z - min(feats.bottom[2], feats.top[2]) if not lying else float(feats.extent[0])
-        # Finger tips go 70% down the object (at most 3 cm), never closer than 4 mm to the table.
-        tips_z = max(top_z - min(0.7 * height, 0.03), 0.004)
-        point = np.r_[feats.pos[:2], tips_z + self.FINGERTIP_REACH]
         return rotation, point + self._offset(feats)
 
     def _offset(self, feats) -> np.ndarray:
@@ -408,7 +433,7 @@ class Grasp(ArmAction):
         yield from approach(robot, arm, pose_from_matrix(above, rotation))
         # A top-down tool often flips the forearm roll: let the IK converge before descending.
         yield from settle(robot, arm, tolerance=0.003, max_ticks=60, required=0.015)
-        rotation, point = self._top_frame(robot)
+        rotation, point = self._top_frame(robot, keep_choice=True)
         yield from move_to(robot, arm, pose_from_matrix(point, rotation), speed=0.08)
         yield from self._close_and_check(robot)
         # lift 0 leaves the object on the table (two arms grasping one tray lift it together afterwards).

@@ -1,0 +1,132 @@
+"""Top grasps whose open fingers would come down on a neighbour slide along the object or turn about it."""
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from agentchord.actions.finger_clearance import (
+    END_MARGIN,
+    FINGER_ACROSS,
+    TopGraspChoice,
+    blocking,
+    clear_top_grasp,
+    finger_points,
+)
+from agentchord.actions.library import make_action
+from agentchord.features.frame import make_static_frame
+
+#: A yaw of 90 deg: the fork's own x axis (its length) along world y.
+ALONG_Y = (np.cos(np.pi / 4), 0.0, 0.0, np.sin(np.pi / 4))
+#: The rearrange scene of the stress protocol's seed 2: a fork pushed against the plate's rim.
+PLATE = {"pos": (0.03, 0.604, 0.011), "extent": (0.184, 0.184, 0.022)}
+GRASP_Z = 0.043  # the tool centre of a top grasp of the flat fork: finger tips 4 mm over the table
+
+
+def _fork(x: float = -0.075, y: float = 0.662) -> dict:
+    return {"pos": (x, y, 0.005), "quat": ALONG_Y, "extent": (0.165, 0.016, 0.011)}
+
+
+def _frame(**objects):
+    return make_static_frame(objects=objects)
+
+
+def _plain(frame, obj: str = "fork", long_dir=(0.0, 1.0, 0.0)):
+    pos = frame.objects[obj].pos
+    return np.array([pos[0], pos[1], GRASP_Z]), np.asarray(long_dir, dtype=float)
+
+
+def test_the_open_fingers_lie_across_the_long_direction_on_both_sides():
+    points = finger_points(np.zeros(3), np.array([0.0, 1.0, 0.0]))
+    across = np.abs(points[:, 0])
+    assert across.min() == pytest.approx(FINGER_ACROSS[0]) and across.max() == pytest.approx(FINGER_ACROSS[1])
+    assert (points[:, 0] > 0).sum() == (points[:, 0] < 0).sum()  # both fingers
+    assert points[:, 2].min() == pytest.approx(-0.0387)  # the tips, the tool's reach below its centre
+
+
+def test_a_fork_alone_is_grasped_at_its_centre():
+    frame = _frame(fork=_fork())
+    assert clear_top_grasp(frame, "fork", *_plain(frame)) == TopGraspChoice()
+
+
+def test_a_fork_against_the_plate_rim_is_grasped_farther_along_its_length():
+    frame = _frame(plate=PLATE, fork=_fork())
+    point, long_dir = _plain(frame)
+    plain_hits = blocking(frame, "fork", point, long_dir)
+    assert set(plain_hits) == {"plate"}
+    choice = clear_top_grasp(frame, "fork", point, long_dir)
+    assert choice.turn_deg == 0.0  # a long object is slid, never turned off its narrow side
+    assert 0.0 < choice.slide <= 0.5 * 0.165 - END_MARGIN  # away from the plate, still on the fork
+    turned, moved = choice.apply(long_dir, point)
+    assert sum(blocking(frame, "fork", moved, turned).values()) < sum(plain_hits.values())
+
+
+def test_a_fork_a_little_off_the_rim_is_slid_until_its_fingers_clear():
+    frame = _frame(plate=PLATE, fork=_fork(x=-0.085))
+    point, long_dir = _plain(frame)
+    assert blocking(frame, "fork", point, long_dir)
+    choice = clear_top_grasp(frame, "fork", point, long_dir)
+    assert choice.blocked_by == ()
+    turned, moved = choice.apply(long_dir, point)
+    assert blocking(frame, "fork", moved, turned) == {}
+    # The nearest clear slide: one step less is still blocked.
+    shorter = TopGraspChoice(slide=choice.slide - 0.005).apply(long_dir, point)
+    assert blocking(frame, "fork", shorter[1], shorter[0])
+
+
+def test_a_capsule_beside_a_cup_is_taken_with_the_fingers_turned_away_from_the_cup():
+    capsule = {"pos": (0.0, 0.5, 0.014), "extent": (0.037, 0.037, 0.027)}
+    cup = {"pos": (0.0, 0.57, 0.05), "extent": (0.06, 0.06, 0.1)}
+    frame = _frame(capsule=capsule, cup=cup)
+    point, long_dir = _plain(frame, "capsule", long_dir=(1.0, 0.0, 0.0))  # fingers close along y, onto the cup
+    assert set(blocking(frame, "capsule", point, long_dir)) == {"cup"}
+    choice = clear_top_grasp(frame, "capsule", point, long_dir)
+    assert choice.slide == 0.0 and choice.turn_deg != 0.0 and choice.blocked_by == ()
+    turned, moved = choice.apply(long_dir, point)
+    assert np.allclose(moved, point)  # turned about its centre
+
+
+def test_an_object_resting_in_a_container_is_reached_into():
+    # A capsule on the tray's floor: the fingers go down inside the tray's box, as they must.
+    tray = {"pos": (0.0, 0.55, 0.014), "extent": (0.33, 0.135, 0.027)}
+    capsule = {"pos": (0.05, 0.55, 0.016), "extent": (0.037, 0.037, 0.027)}
+    frame = _frame(tray=tray, capsule=capsule)
+    assert clear_top_grasp(frame, "capsule", *_plain(frame, "capsule")) == TopGraspChoice()
+
+
+def test_point_features_and_things_below_the_finger_tips_are_not_in_the_way():
+    corner = {"pos": (-0.035, 0.662, 0.002), "extent": (0.005, 0.005, 0.004)}  # a cloth corner under a finger
+    mat = {"pos": (-0.2, 0.662, -0.004), "extent": (0.2, 0.3, 0.002)}  # sunk in the table top, beside the fork
+    frame = _frame(fork=_fork(), corner=corner, mat=mat)
+    assert blocking(frame, "fork", *_plain(frame)) == {}
+
+
+def _robot(frame, base=(-0.469, 0.5, 0.079)):
+    return SimpleNamespace(
+        frame=frame,
+        world=SimpleNamespace(arm_base=lambda arm: np.asarray(base, dtype=float)),
+        rotation=lambda arm: np.eye(3),  # a level tool: no wrist-rotate preference
+    )
+
+
+def test_the_grasp_aims_at_the_clear_point_and_keeps_it_when_it_looks_again():
+    frame = _frame(plate=PLATE, fork=_fork(x=-0.085))
+    grasp = make_action("grasp", "left", {"obj": "fork", "mode": "top"})
+    robot = _robot(frame)
+    _, point = grasp._top_frame(robot)
+    assert point[1] > 0.662 + 0.01  # slid along the fork, away from the plate
+    # The plate is nudged (the approach touched it): the choice made at the first look is kept,
+    # where a fresh look would slide the grasp farther.
+    frame.objects["plate"].pos = np.array([0.03, 0.625, 0.011])
+    _, again = grasp._top_frame(robot, keep_choice=True)
+    assert again[1] == pytest.approx(point[1])
+    _, fresh = grasp._top_frame(robot)
+    assert fresh[1] > point[1] + 0.004
+
+
+def test_a_grasp_point_the_graph_asked_for_is_not_moved():
+    # A handle given by an offset stays where the graph put it, whatever stands beside it.
+    frame = _frame(plate=PLATE, fork=_fork(x=-0.085))
+    grasp = make_action("grasp", "left", {"obj": "fork", "mode": "top", "offset": [0.0, 0.01, 0.0]})
+    _, point = grasp._top_frame(_robot(frame))
+    assert point[:2] == pytest.approx([-0.085, 0.672])
