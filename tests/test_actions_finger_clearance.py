@@ -12,6 +12,7 @@ from agentchord.actions.finger_clearance import (
     blocking,
     clear_top_grasp,
     finger_points,
+    horizontal_sizes,
 )
 from agentchord.actions.library import make_action
 from agentchord.features.frame import make_static_frame
@@ -84,6 +85,21 @@ def test_a_capsule_beside_a_cup_is_taken_with_the_fingers_turned_away_from_the_c
     assert choice.slide == 0.0 and choice.turn_deg != 0.0 and choice.blocked_by == ()
     turned, moved = choice.apply(long_dir, point)
     assert np.allclose(moved, point)  # turned about its centre
+
+
+def test_an_object_lying_along_its_axis_is_slid_along_it_not_turned():
+    # A 19 cm bottle lying along world y (its own axis, the quat's z, horizontal), a cup beside it
+    # where the plain grasp's finger comes down: the bottle's length is along y, not in extent[:2].
+    lying = (np.cos(np.pi / 4), -np.sin(np.pi / 4), 0.0, 0.0)  # its z axis turned onto world y
+    bottle = {"pos": (0.0, 0.5, 0.025), "quat": lying, "axis": (0.0, 1.0, 0.0), "extent": (0.05, 0.05, 0.19)}
+    cup = {"pos": (0.075, 0.47, 0.05), "extent": (0.06, 0.06, 0.1)}
+    frame = _frame(bottle=bottle, cup=cup)
+    along, across = horizontal_sizes(frame.objects["bottle"], np.array([0.0, 1.0, 0.0]))
+    assert (along, across) == (pytest.approx(0.19), pytest.approx(0.05))
+    point, long_dir = _plain(frame, "bottle")
+    assert set(blocking(frame, "bottle", point, long_dir)) == {"cup"}
+    choice = clear_top_grasp(frame, "bottle", point, long_dir)
+    assert choice.turn_deg == 0.0 and choice.slide > 0.0 and choice.blocked_by == ()
 
 
 def test_an_object_resting_in_a_container_is_reached_into():

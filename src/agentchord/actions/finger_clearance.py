@@ -20,7 +20,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from agentchord.actions.geometry import _matrix
-from agentchord.features.frame import FeatureFrame, ObjectFeatures
+from agentchord.features.frame import UP, FeatureFrame, ObjectFeatures
 
 #: The open fingers in the tool frame of a top grasp (m; measured on the ViperX gripper's meshes):
 #: along the approach (down), from the palm side to the tips, the tips being at the tool's reach;
@@ -110,6 +110,15 @@ def blocking(frame: FeatureFrame, obj: str, point: np.ndarray, long_dir: np.ndar
     return hits
 
 
+def horizontal_sizes(feats: ObjectFeatures, long_dir: np.ndarray) -> tuple[float, float]:
+    """An object's size (m) along ``long_dir`` and across it on the table: its box seen from above,
+    whether it stands (a fork's length) or lies (a bottle's, along its axis)."""
+    rotation = _matrix(feats.quat)
+    extent = np.asarray(feats.extent, dtype=float)
+    across_dir = np.cross(UP, long_dir)
+    return float(np.abs(long_dir @ rotation) @ extent), float(np.abs(across_dir @ rotation) @ extent)
+
+
 def clear_top_grasp(frame: FeatureFrame, obj: str, point: np.ndarray, long_dir: np.ndarray) -> TopGraspChoice:
     """The top grasp nearest the plain one whose open fingers clear every neighbour of ``obj``.
 
@@ -129,12 +138,10 @@ def clear_top_grasp(frame: FeatureFrame, obj: str, point: np.ndarray, long_dir: 
     hits = blocking(frame, obj, point, long_dir)
     if not hits:
         return TopGraspChoice()
-    feats = frame.objects[obj]
-    extent = np.sort(np.asarray(feats.extent[:2], dtype=float))[::-1]
+    along, across = horizontal_sizes(frame.objects[obj], long_dir)
     candidates: list[TopGraspChoice] = []
-    if extent[0] >= SHORT_RATIO * extent[1]:
-        # The long side is the one along long_dir (the narrow one is what the fingers close on).
-        reach = max(0.5 * float(np.max(feats.extent)) - END_MARGIN, 0.0)
+    if along >= SHORT_RATIO * across:
+        reach = max(0.5 * along - END_MARGIN, 0.0)
         for k in range(1, int(reach / SLIDE_STEP) + 1):
             candidates += [TopGraspChoice(slide=k * SLIDE_STEP), TopGraspChoice(slide=-k * SLIDE_STEP)]
     else:

@@ -74,7 +74,7 @@ def left_behind_branches(graph: TaskGraph, edge: Edge, objects: dict[str, SceneO
     if not is_retreat(edge):
         return []
     target = graph.node(edge.target).constraints
-    out: list[tuple[FailureMode, Edge]] = []
+    out: list[tuple[FailureMode, Edge | None]] = []
     for obj, by_arm in put_down_before(graph, edge).items():
         info = objects.get(obj)
         if info is None or any(p.place.args.get("relative_to") for p in by_arm.values()):
