@@ -34,7 +34,9 @@ def fact_constraints(fact: Fact, scene: Scene) -> list[str]:
         return [f"dist({fact[1]}.ee, {rounded(kb.RECEIVE_POSE)}) - 0.03", f"tilt({fact[2]}) - 15"]
     if kind == "pour_ready":
         _, arm, s, c = fact
-        return [f"dist({arm}.ee, {c}.top + {list(kb.POUR_OFFSET)}) - 0.03", f"tilt({s}) - 15"]
+        # Where the bottle is (a bottle held off centre is carried to where a centred one would be), at the tool's height.
+        return [f"norm(xy({s}.pos - {c}.top - {list(kb.POUR_OFFSET)})) - 0.03",
+                f"abs({arm}.ee[2] - {c}.top[2] - {kb.POUR_OFFSET[2]:g}) - 0.03", f"tilt({s}) - 15"]
     if kind == "poured":
         _, s, c, _ = fact
         return [f"{kb.POUR_MIN_TILT:g} - tilt({s})", f"norm(xy({s}.top - {c}.top)) - 0.5 * {c}.extent[0] - 0.01"]
