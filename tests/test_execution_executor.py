@@ -259,16 +259,33 @@ def test_a_recovery_made_at_run_time_is_bound_again_from_its_own_edge():
     assert any(e["edge"] == "made_at_run_time" for e in result.trace.of("recovery_bound"))
 
 
-def test_a_recovery_is_skipped_to_its_merge_node_once_not_round_and_round():
-    # Stress protocol, seed 4: the cup is knocked over as the bottle is carried to it, and its righting
-    # is cut short by a pull of the bottle. The bottle's regrasp merges at v2, whose constraints do not
-    # read the cup, and e3's cup_tipped fires at once. v2 holds, so e3_r_cup_tipped is skipped to it;
-    # e3 fires again before it ends, and this time the recovery runs (skipping again and again went
-    # round node, edge, failure until the failure budget ended the episode).
-    result = run_episode(EpisodeSpec(TASK, seed=4, protocol=True, disturb=KINDS))
+def _cup_tipped_switches(result) -> list[tuple[str, str]]:
+    return [(s["edge"], s["to"]) for s in result.trace.of("recovery_switch") if s["failure"] == "cup_tipped"]
+
+
+def test_a_recovery_is_not_skipped_to_a_merge_node_the_next_edge_fails_at_once():
+    # p = 0.3, every kind, seed 4: the cup is knocked over as the bottle is carried to it, and its
+    # righting is cut short by a pull of the bottle. The bottle's regrasp merges at v2, whose
+    # constraints do not read the cup, and e3's cup_tipped fires at once. v2 holds, but the cup still
+    # lies: e3_r_cup_tipped runs, and cup_tipped fires once on e3, not again after a skip to v2.
+    result = run_episode(EpisodeSpec(TASK, seed=4, p=0.3, disturb=KINDS))
     assert result.success, result.reason
-    tipped = [(s["edge"], s["to"]) for s in result.trace.of("recovery_switch") if s["failure"] == "cup_tipped"]
-    assert tipped == [("e2", "e2_r_cup_tipped"), ("e3", "e3_r_cup_tipped"), ("e3", "e3_r_cup_tipped")]
+    assert _cup_tipped_switches(result) == [("e2", "e2_r_cup_tipped"), ("e3", "e3_r_cup_tipped")]
+    assert result.trace.of("subgoal_met") == []
+    assert "e3_r_cup_tipped" in [b["edge"] for b in result.trace.of("recovery_bound")]
+
+
+def test_a_recovery_is_skipped_to_its_merge_node_once_not_round_and_round(monkeypatch):
+    # The same episode with the merge judged by its node alone: e3_r_cup_tipped is skipped to v2, e3
+    # fires again, and this time the recovery runs (skipping again and again went round node, edge,
+    # failure until the failure budget ended the episode). The guard for monitors that fire later
+    # in the edge than its first frame.
+    from agentchord.execution.switching import RecoverySwitching
+
+    monkeypatch.setattr(RecoverySwitching, "_leaving_fails_at_once", lambda self, node_id: False)
+    result = run_episode(EpisodeSpec(TASK, seed=4, p=0.3, disturb=KINDS))
+    assert result.success, result.reason
+    assert _cup_tipped_switches(result) == [("e2", "e2_r_cup_tipped"), ("e3", "e3_r_cup_tipped"), ("e3", "e3_r_cup_tipped")]
     assert [(m["edge"], m["node"]) for m in result.trace.of("subgoal_met")] == [("e3_r_cup_tipped", "v2")]
     assert "e3_r_cup_tipped" in [b["edge"] for b in result.trace.of("recovery_bound")]
 

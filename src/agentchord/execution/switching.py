@@ -15,6 +15,7 @@ it reads and sets the executor's episode state, named in the annotations below.
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
 from agentchord.actions.base import Status
@@ -63,6 +64,8 @@ class RecoverySwitching:
     _fallbacks: list[EdgeProgram]
     _repair_attempts: set[tuple[str, str]]
     _skipped: tuple[str, str] | None
+    nominal_next: dict[str, str]
+    frame: FeatureFrame
 
     def _beyond_every_arm(self, obj: str, confirm_ik: bool) -> tuple[bool, str] | None:
         """The unrecoverable outcome when no arm can take ``obj`` where it is (else None)."""
@@ -100,6 +103,8 @@ class RecoverySwitching:
         if self.strategy.merges_met_subgoals:
             met = Shortcuts.met_merge(self.graph, binding.candidates[0], binding.objects, self.frame.holding, self._node_holds)
         skip = (binding.candidates[0].edge_id, met)
+        if met is not None and self._leaving_fails_at_once(met):
+            met = None  # the merge node holds, but not what the recovery was for: it runs
         if met is not None and self._skipped == skip:
             # Skipped to this node already, and the edge out of it failed before it ended: the node's
             # constraints do not read what that edge watches (a knocked-over cup whose righting a
@@ -129,6 +134,25 @@ class RecoverySwitching:
             if outcome is not None:
                 return outcome
         return False, f"no feasible recovery for {', '.join(binding.objects)} at {self.feasibility.where(binding.objects[0])}: {summary}"
+
+    def _leaving_fails_at_once(self, node_id: str) -> bool:
+        """Whether the nominal edge out of ``node_id`` would detect a failure on its first frame.
+
+        A merge node's constraints need not read what its recovery was for: "bottle held beside the
+        cup" says nothing of the cup standing. Skipping there while the cup lies on its side only
+        fires the next edge's monitor again, counted against the failure budget for nothing (p = 0.3,
+        single-arm seed 11 ended so). Only monitors of the scene alone count: one that reads an arm
+        (a closed-gripper monitor of an object the edge is about to grasp) reads as violated until the
+        edge opens the hand, and the binding judges holds. Drift is measured from where the objects
+        are now, as that edge would measure it from its start.
+        """
+        edge_id = self.nominal_next.get(node_id)
+        monitors = self.monitors.get(edge_id) if edge_id is not None else None
+        if monitors is None:
+            return False
+        frame = self.frame
+        as_started = replace(frame, refs={name: feats.pos.copy() for name, feats in frame.objects.items()})
+        return any(m.expr.scalar(as_started) > m.failure.margin for m in monitors.monitors if not m.expr.arms)
 
     def _resume(self, binding: Binding) -> None:
         """The lost holds came back as they were: the failure cleared, the interrupted edge goes on."""
