@@ -106,9 +106,9 @@ class RecoverySwitching:
         if met is not None and self._leaving_fails_at_once(met):
             met = None  # the merge node holds, but not what the recovery was for: it runs
         if met is not None and self._skipped == skip:
-            # Skipped to this node already, and the edge out of it failed before it ended: the node's
-            # constraints do not read what that edge watches (a knocked-over cup whose righting a
-            # second failure cut short). Skipping again would go round node, edge, failure until the
+            # Skipped to this node already, and the edge out of it failed before it ended (later than
+            # its first frame, or by a monitor that reads an arm): the node's constraints do not read
+            # what that edge watches. Skipping again would go round node, edge, failure until the
             # budget ended the episode; the recovery runs instead.
             met = None
         if met is not None:
@@ -141,7 +141,7 @@ class RecoverySwitching:
         A merge node's constraints need not read what its recovery was for: "bottle held beside the
         cup" says nothing of the cup standing. Skipping there while the cup lies on its side only
         fires the next edge's monitor again, counted against the failure budget for nothing (p = 0.3,
-        single-arm seed 11 ended so). Only monitors of the scene alone count: one that reads an arm
+        single-arm seeds 10 and 11 ended so). Only monitors of the scene alone count: one that reads an arm
         (a closed-gripper monitor of an object the edge is about to grasp) reads as violated until the
         edge opens the hand, and the binding judges holds. Drift is measured from where the objects
         are now, as that edge would measure it from its start.
