@@ -59,3 +59,14 @@ def test_violated_now_reports_a_violation_on_one_frame_without_waiting_for_persi
     detection = monitors.violated_now(lying)
     assert detection is not None and detection.failure.name == "cup_tipped" and detection.value == pytest.approx(60.0)
     assert monitors.evaluate(lying) is None  # the persistence window still counts one tick
+
+
+def test_violated_now_scene_only_skips_monitors_that_read_an_arm():
+    edge = Edge(id="e9", source="a", target="b", actions={"right": {"fn": "back"}},
+                failures=[FailureMode(name="bottle_dropped", monitor="right.closed * (0.5 - holding(right, bottle))",
+                                      window=3, intent="regrasp", recovery="r"),
+                          FailureMode(name="cup_tipped", monitor="tipped(cup, 30)", window=3, intent="set upright", recovery="r")])
+    monitors = EdgeMonitors.compile(edge, VOCAB)
+    closed_on_nothing = _frame(False)  # the gripper closed, the bottle not held; the cup upright
+    assert monitors.violated_now(closed_on_nothing).failure.name == "bottle_dropped"
+    assert monitors.violated_now(closed_on_nothing, scene_only=True) is None

@@ -45,9 +45,7 @@ def axis_offset_in_tool(frame: FeatureFrame, arm: str, obj: str, rotation: np.nd
     """
     feats = frame.objects[obj]
     ee = frame.arms[arm].ee
-    axis = feats.top - feats.bottom
-    share = float(np.dot(ee - feats.bottom, axis) / max(float(np.dot(axis, axis)), 1e-12))
-    nearest = feats.bottom + share * axis
+    nearest = feats.bottom + grasp_height_share(frame, arm, obj) * (feats.top - feats.bottom)
     offset = rotation.T @ (nearest - ee)
     offset[2] = 0.0
     return offset

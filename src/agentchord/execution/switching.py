@@ -152,7 +152,7 @@ class RecoverySwitching:
             return False
         frame = self.frame
         as_started = replace(frame, refs={name: feats.pos.copy() for name, feats in frame.objects.items()})
-        return any(m.expr.scalar(as_started) > m.failure.margin for m in monitors.monitors if not m.expr.arms)
+        return monitors.violated_now(as_started, scene_only=True) is not None
 
     def _resume(self, binding: Binding) -> None:
         """The lost holds came back as they were: the failure cleared, the interrupted edge goes on."""

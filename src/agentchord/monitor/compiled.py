@@ -67,9 +67,17 @@ class EdgeMonitors:
                 fired = Detection(monitor.edge_id, monitor.failure, frame.tick, monitor.trigger.first_violation_tick, value)
         return fired
 
-    def violated_now(self, frame: FeatureFrame) -> Detection | None:
-        """The first monitor violated on this frame alone, persistence aside (a state to explain, not a transient)."""
+    def violated_now(self, frame: FeatureFrame, scene_only: bool = False) -> Detection | None:
+        """The first monitor violated on this frame alone, persistence aside (a state to explain, not a transient).
+
+        Args:
+            frame: The frame to read.
+            scene_only: Read only monitors of the objects alone, none that reads an arm (a
+                closed-gripper monitor reads as violated until its edge opens the hand).
+        """
         for monitor in self.monitors:
+            if scene_only and monitor.expr.arms:
+                continue
             value = monitor.expr.scalar(frame)
             if value > monitor.failure.margin:
                 return Detection(monitor.edge_id, monitor.failure, frame.tick, frame.tick, value)
