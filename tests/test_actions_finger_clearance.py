@@ -1,4 +1,5 @@
-"""Top grasps whose open fingers would come down on a neighbour slide along the object or turn about it."""
+"""Top grasps whose open fingers would come down on a neighbour slide along the object or turn about it;
+a side grasp's open fingers are followed along their way in."""
 
 from types import SimpleNamespace
 
@@ -13,7 +14,11 @@ from agentchord.actions.finger_clearance import (
     clear_top_grasp,
     finger_points,
     horizontal_sizes,
+    open_finger_points,
+    side_approach_blocking,
 )
+from scipy.spatial.transform import Rotation
+
 from agentchord.actions.library import make_action
 from agentchord.features.frame import make_static_frame
 
@@ -146,3 +151,46 @@ def test_a_grasp_point_the_graph_asked_for_is_not_moved():
     grasp = make_action("grasp", "left", {"obj": "fork", "mode": "top", "offset": [0.0, 0.01, 0.0]})
     _, point = grasp._top_frame(_robot(frame))
     assert point[:2] == pytest.approx([-0.085, 0.672])
+
+
+# Stress protocol, dual-arm pour, seed 8: the cup beside a bottle lying on the table, the left arm's
+# side grasp approaching the cup along +x.
+CUP = {"pos": (-0.081, 0.405, 0.0535), "extent": (0.048, 0.048, 0.107)}
+
+
+def _lying_bottle(at=(-0.118, 0.478), yaw=-2.69) -> dict:
+    x, y, z, w = (Rotation.from_euler("z", yaw) * Rotation.from_euler("y", 90, degrees=True)).as_quat()
+    axis = Rotation.from_quat([x, y, z, w]).apply([0.0, 0.0, 1.0])
+    return {"pos": (*at, 0.0245), "quat": (w, x, y, z), "axis": tuple(axis), "extent": (0.049, 0.049, 0.187)}
+
+
+def _side_way_in(height: float, approach=(1.0, 0.0, 0.0)):
+    approach = np.asarray(approach, dtype=float)
+    rotation = np.column_stack([approach, np.cross((0.0, 0.0, 1.0), approach), (0.0, 0.0, 1.0)])
+    point = np.array([CUP["pos"][0], CUP["pos"][1], height])
+    return point - 0.08 * approach, point, rotation
+
+
+def test_the_open_fingers_of_a_side_grasp_close_across_the_approach_and_stand_upright():
+    _, point, rotation = _side_way_in(0.05)
+    points = open_finger_points(point, rotation) - point
+    assert np.abs(points[:, 1]).min() == pytest.approx(FINGER_ACROSS[0])  # across the approach (y)
+    assert points[:, 2].max() == pytest.approx(-points[:, 2].min())  # their width is vertical
+    assert points[:, 0].max() == pytest.approx(0.0387)  # the tips reach past the tool centre
+
+
+def test_a_side_grasp_with_nothing_beside_its_way_in_is_clear():
+    frame = _frame(cup=CUP, bottle=_lying_bottle(at=(0.2, 0.6)))
+    assert side_approach_blocking(frame, "cup", *_side_way_in(0.0535)) == {}
+
+
+def test_a_side_grasp_sweeping_into_a_lying_bottle_is_blocked_and_a_higher_one_passes_over_it():
+    frame = _frame(cup=CUP, bottle=_lying_bottle())
+    assert set(side_approach_blocking(frame, "cup", *_side_way_in(0.0535))) == {"bottle"}
+    assert side_approach_blocking(frame, "cup", *_side_way_in(0.8 * 0.107)) == {}
+
+
+def test_only_the_way_in_is_swept_not_what_lies_beyond_the_object():
+    # The bottle lying past the cup, ahead of the fingers' tips at the grasp: not in the way.
+    frame = _frame(cup=CUP, bottle=_lying_bottle(at=(0.02, 0.405), yaw=np.pi / 2))
+    assert side_approach_blocking(frame, "cup", *_side_way_in(0.0535)) == {}

@@ -245,3 +245,37 @@ def test_back_opens_a_hand_closed_on_nothing_and_keeps_a_held_object(pour_scene,
         assert grip_when_moving == 1.0 and world.holding("right", "bottle")
     else:
         assert grip_when_moving == 0.0
+
+
+def _place_cup(world, at) -> None:
+    adr = world.model.joint("cup_free").qposadr[0]
+    world.data.qpos[adr : adr + 2] = at
+
+
+@pytest.mark.parametrize("clearing", [True, False])
+def test_a_side_grasp_does_not_sweep_its_fingers_into_a_bottle_lying_beside_the_cup(pour_scene, clearing, monkeypatch):
+    # Stress protocol, dual-arm pour, seed 8: the cup pulled out of the left hand rests beside the bottle
+    # lying on the table; the plain side grasp's open fingers swept into the bottle, pushed it, and the
+    # cup was caught 3.9 cm off the grasp point, three times. The clearing grasp passes over it.
+    import dataclasses
+
+    from agentchord.actions import side_plan
+
+    if not clearing:
+        monkeypatch.setattr(side_plan, "CLEAR_TURNS_DEG", ())
+        monkeypatch.setattr(side_plan, "CLEAR_HEIGHT", 0.0)
+    sizes = {"bottle": (0.0245, 0.0935), "cup": (0.024, 0.0535)}  # that episode's (radius, half height)
+    scene = dataclasses.replace(pour_scene, objects=[dataclasses.replace(o, size=sizes[o.name]) for o in pour_scene.objects])
+    world, robot, extractor = _setup(scene)
+    _place_cup(world, (-0.081, 0.405))
+    _lay_bottle_down(world, scene, extractor, at=(-0.118, 0.478), yaw=-2.69)
+    bottle_before = extractor.frame.objects["bottle"].pos.copy()
+    grasp = make_action("grasp", "left", {"obj": "cup"})
+    status, _ = _run(robot, extractor, grasp, max_ticks=2500)
+    pushed = float(np.linalg.norm(extractor.frame.objects["bottle"].pos[:2] - bottle_before[:2]))
+    if clearing:
+        assert status == Status.SUCCESS, grasp.failure_reason
+        assert world.holding("left", "cup")
+        assert pushed < 0.01
+    else:
+        assert status == Status.FAILURE or pushed > 0.02

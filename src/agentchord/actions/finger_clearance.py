@@ -1,4 +1,5 @@
-"""Where the open fingers of a top grasp come down, and a top grasp whose fingers clear the neighbours.
+"""Where a grasp's open fingers go: a top grasp's come down, a side grasp's sweep in; and top grasps
+whose fingers clear the neighbours.
 
 A top grasp closes its fingers across the object's narrow side. Open, each finger is a
 2.4 cm x 6.1 cm plate beside the object, 3.5 cm from the tool centre. An object pushed
@@ -7,6 +8,10 @@ a finger on the neighbour: it lands there and the tool stops ~1.8 cm above the g
 (stress protocol: rearrange seeds 2 and 15, coffee tray seed 13). Then the grasp slides
 along a long object's length, or turns about a short one, to the nearest choice whose
 fingers clear what stands beside it.
+
+A side grasp's fingers are followed from the pre-grasp to the grasp point
+(:func:`side_approach_blocking`): a bottle lying beside a cup is swept into and pushed, and the cup
+caught off centre (stress protocol, dual-arm pour seed 8); the grasp action picks a clear one.
 
 Only the feature frame is read (objects as oriented boxes, round ones as cylinders), so the
 check works on any world's perception, not on simulator geometry.
@@ -40,6 +45,8 @@ SLIDE_STEP = 0.005
 END_MARGIN = 0.02
 #: Largest extent (m) of a point feature (a cloth corner) rather than a body.
 POINT_EXTENT = 0.01
+#: A side grasp's sweep from the pre-grasp is sampled at most this far apart (m).
+SWEEP_STEP = 0.01
 #: Neighbours read as round (cylinders) when their horizontal sides differ by less than this share.
 ROUND_SHARE = 0.1
 
@@ -65,38 +72,69 @@ class TopGraspChoice:
         return turned, point + self.slide * long_dir
 
 
-def finger_points(point: np.ndarray, long_dir: np.ndarray) -> np.ndarray:
-    """Sample points (n x 3) inside both open fingers of a top grasp at ``point`` (the tool centre),
-    fingers closing across ``long_dir`` (horizontal, unit)."""
-    down = np.array([0.0, 0.0, -1.0])
-    across = np.cross(long_dir, down)
+def open_finger_points(point: np.ndarray, rotation: np.ndarray) -> np.ndarray:
+    """Sample points (n x 3) inside both open fingers of a gripper whose tool centre is at ``point``.
+
+    Args:
+        point: The tool centre.
+        rotation: The tool frame: columns along the approach, the fingers' closing direction, and
+            the fingers' width (a top grasp: down, across the object, along it; a side grasp:
+            the horizontal approach, across it, up).
+    """
+    approach, closing, width = rotation[:, 0], rotation[:, 1], rotation[:, 2]
     d, a, w = np.meshgrid(
         np.linspace(*FINGER_SPAN_DOWN, 4),
         np.r_[np.linspace(*FINGER_ACROSS, 3), -np.linspace(*FINGER_ACROSS, 3)],
         np.linspace(-FINGER_HALF_WIDTH, FINGER_HALF_WIDTH, 5),
         indexing="ij",
     )
-    return point + np.outer(d.ravel(), down) + np.outer(a.ravel(), across) + np.outer(w.ravel(), long_dir)
+    return point + np.outer(d.ravel(), approach) + np.outer(a.ravel(), closing) + np.outer(w.ravel(), width)
 
 
-def _inside(feats: ObjectFeatures, points: np.ndarray) -> np.ndarray:
-    """Which points lie within ``CLEARANCE`` of an object: its oriented box, or its cylinder when round."""
+def finger_points(point: np.ndarray, long_dir: np.ndarray) -> np.ndarray:
+    """Sample points (n x 3) inside both open fingers of a top grasp at ``point`` (the tool centre),
+    fingers closing across ``long_dir`` (horizontal, unit)."""
+    down = np.array([0.0, 0.0, -1.0])
+    return open_finger_points(point, np.column_stack([down, np.cross(long_dir, down), long_dir]))
+
+
+def _inside(feats: ObjectFeatures, points: np.ndarray, clearance: float = CLEARANCE) -> np.ndarray:
+    """Which points lie within ``clearance`` of an object: its oriented box, or its cylinder when round."""
     local = (points - feats.pos) @ _matrix(feats.quat)
-    half = 0.5 * np.asarray(feats.extent, dtype=float) + CLEARANCE
+    half = 0.5 * np.asarray(feats.extent, dtype=float) + clearance
     ex, ey = float(feats.extent[0]), float(feats.extent[1])
     if abs(ex - ey) <= ROUND_SHARE * max(ex, ey, 1e-9):
-        radius = 0.5 * max(ex, ey) + CLEARANCE
+        radius = 0.5 * max(ex, ey) + clearance
         return (np.hypot(local[:, 0], local[:, 1]) <= radius) & (np.abs(local[:, 2]) <= half[2])
     return np.all(np.abs(local) <= half, axis=1)
 
 
 def blocking(frame: FeatureFrame, obj: str, point: np.ndarray, long_dir: np.ndarray) -> dict[str, int]:
     """The neighbours of ``obj`` that the open fingers of a top grasp at ``point`` come down on,
-    with how many of the fingers' sample points lie in each.
+    with how many of the fingers' sample points lie in each."""
+    return _neighbours_hit(frame, obj, finger_points(point, long_dir), CLEARANCE)
+
+
+def side_approach_blocking(
+    frame: FeatureFrame, obj: str, pre: np.ndarray, point: np.ndarray, rotation: np.ndarray
+) -> dict[str, int]:
+    """The neighbours of ``obj`` that the open fingers of a side grasp sweep into on their way in,
+    from the pre-grasp ``pre`` to the grasp ``point`` (tool frame ``rotation``), with how many of
+    the fingers' sample points lie in each.
+
+    No clearance is kept: a finger passing a neighbour's side at a few millimetres does not move it
+    (stress protocol, single-arm pour, seed 9: 3 mm beside the cup, the grasp holds as planned).
+    """
+    steps = max(2, int(np.ceil(float(np.linalg.norm(point - pre)) / SWEEP_STEP)) + 1)
+    points = np.vstack([open_finger_points(pre + s * (point - pre), rotation) for s in np.linspace(0.0, 1.0, steps)])
+    return _neighbours_hit(frame, obj, points, 0.0)
+
+
+def _neighbours_hit(frame: FeatureFrame, obj: str, points: np.ndarray, clearance: float) -> dict[str, int]:
+    """How many of ``points`` lie within ``clearance`` of each neighbour of ``obj``.
 
     A neighbour under the object's centre is one it rests on or in: the fingers reach in there.
     """
-    points = finger_points(point, long_dir)
     centre = frame.objects[obj].pos
     hits = {}
     for name, feats in frame.objects.items():
@@ -104,7 +142,7 @@ def blocking(frame: FeatureFrame, obj: str, point: np.ndarray, long_dir: np.ndar
             continue  # a point feature (a cloth's corner) lies flat in the cloth: nothing to land on
         if _inside(feats, np.array([[centre[0], centre[1], feats.pos[2]]]))[0]:
             continue  # the object rests on or in it (a fork on the plate, a capsule in the tray): reach in
-        count = int(np.count_nonzero(_inside(feats, points)))
+        count = int(np.count_nonzero(_inside(feats, points, clearance)))
         if count:
             hits[name] = count
     return hits

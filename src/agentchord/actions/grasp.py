@@ -30,8 +30,9 @@ from agentchord.actions.motion import (
     settle,
     wait_for_rest,
 )
+from agentchord.actions.side_plan import SidePlanner, side_point
 from agentchord.features.frame import tilt_deg
-from agentchord.solvers.ik import ARM_CLEARANCE, PoseTarget, solve_from_scratch
+from agentchord.solvers.ik import ARM_CLEARANCE, PoseTarget
 from agentchord.robot.aloha import HOME_Q
 
 #: Joint speed (rad/s, largest joint) of joint-space moves with an empty hand.
@@ -88,10 +89,6 @@ class Grasp(ArmAction):
     SIDE_MIN_HEIGHT = 0.08
     #: The finger tips reach this far past the tool centre (m): keep them off the table.
     FINGERTIP_REACH = 0.039
-    #: Side grasps tried in order where the asked one cannot be made: (share of the pre-grasp
-    #: distance, rise of the pre-grasp pose in m, grasp height as a share of the object's or
-    #: None for the asked one; a higher one is only ever taken).
-    SIDE_VARIANTS = ((1.0, 0.0, None), (1.0, 0.03, None), (0.5, 0.0, None), (0.5, 0.03, None), (0.5, 0.03, 0.8))
     #: A fallen object is turned upright at least this far (m, horizontally) from the arm's own
     #: shoulder: its ends sweep a circle as it turns, and beside the base they strike the arm.
     TURN_FROM_BASE = 0.30
@@ -233,40 +230,15 @@ class Grasp(ArmAction):
         robot.set_grip(arm, 0.0)
 
     def _side_point(self, robot: RobotController, height_fraction: float | None = None) -> np.ndarray:
-        feats = robot.frame.objects[self.args.obj]
-        height = float(np.linalg.norm(feats.top - feats.bottom))
-        fraction = self.args.height if height_fraction is None else height_fraction
-        return feats.bottom + fraction * height * feats.axis + self._offset(feats)
-
-    def _side_variant(self, robot: RobotController, variant: tuple[float, float, float | None]):
-        scale, rise, fraction = variant
-        if fraction is not None:
-            fraction = max(fraction, self.args.height)
-        point = self._side_point(robot, fraction)
-        rotation = self._side_rotation(robot, point)
-        pre = point - scale * self.args.pre_grasp_dis * rotation[:, 0] + np.array([0.0, 0.0, rise])
-        return pre, point, rotation, fraction
+        return side_point(robot, self.args, self._offset(robot.frame.objects[self.args.obj]), height_fraction)
 
     def _side_plan(self, robot: RobotController) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The side grasp's pre-grasp point, grasp point and tool rotation, and remembers its height.
-
-        The asked one, unless the IK reaches it neither from the current configuration nor from
-        home (an object beside the arm's own base: backing off folds the elbow past its limit);
-        then the first of ``SIDE_VARIANTS`` it reaches (a shorter or higher pre-grasp, a higher
-        grasp point).
-        """
-        plans = [self._side_variant(robot, variant) for variant in self.SIDE_VARIANTS]
-        chosen = plans[0]
-        q = robot.ik.configuration.q.copy()
-        ik = robot.scratch_ik(avoid_other_arm=False)
-        for index, (pre, point, rotation, _) in enumerate(plans):
-            poses = [pose_from_matrix(pre, rotation), pose_from_matrix(point, rotation)]
-            # The asked grasp from where the arm is, every grasp from home: the same choice on every frame.
-            if solve_from_scratch(ik, q, self.arm, poses, from_current=index == 0) is not None:
-                chosen = plans[index]
-                break
-        pre, point, rotation, self._height_fraction = chosen
-        return pre, point, rotation
+        """The side grasp's pre-grasp point, grasp point and tool rotation (:class:`SidePlanner`),
+        and remembers its height."""
+        offset = self._offset(robot.frame.objects[self.args.obj])
+        plan = SidePlanner(robot, self.arm, self.args, offset).plan()
+        self._height_fraction = plan.height_fraction
+        return plan.pre, plan.point, plan.rotation
 
     def _clear_from_below(self, robot: RobotController, height: float) -> Iterator[None]:
         # Coming from low (a recovery after a drop): rise first so the fingers clear the object.
@@ -331,13 +303,6 @@ class Grasp(ArmAction):
         tilt = tilt_deg(robot.frame.objects[self.args.obj].axis)
         if tilt >= self.LEANING_AS_FALLEN_DEG:
             raise GraspMissed(f"{self.args.obj} fell over {when} ({tilt:.0f} deg)")
-
-    def _side_rotation(self, robot: RobotController, point: np.ndarray) -> np.ndarray:
-        """The side-grasp tool frame: approach from the arm's base, or at the yaw asked for."""
-        if self.args.yaw is None:
-            return grasp_frame(point - robot.world.arm_base(self.arm))
-        yaw = np.radians(self.args.yaw)
-        return grasp_frame(np.array([np.cos(yaw), np.sin(yaw), 0.0]))
 
     def _side_grasp(self, robot: RobotController) -> Iterator[None]:
         arm = self.arm
