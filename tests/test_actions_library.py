@@ -279,3 +279,29 @@ def test_a_side_grasp_does_not_sweep_its_fingers_into_a_bottle_lying_beside_the_
         assert pushed < 0.01
     else:
         assert status == Status.FAILURE or pushed > 0.02
+
+
+def test_a_side_grasp_is_not_raised_over_a_neighbour_standing_in_its_way(pour_scene):
+    # Table I, dual-arm pour seed 6 (AgentChord-BT's backtrack): the cup stands just behind the bottle
+    # and the bottle's grasp sweeps 1.8 cm into it; no turn clears. A standing neighbour is nudged
+    # and slides, so the bottle is taken at the asked height, not raised over the cup as over a
+    # lying one (a pour follows, which needs the asked hold).
+    import dataclasses
+
+    from agentchord.actions.side_plan import REACH_VARIANTS, SidePlanner
+
+    sizes = {"bottle": (0.0295, 0.0945), "cup": (0.0245, 0.042)}
+    scene = dataclasses.replace(pour_scene, objects=[dataclasses.replace(o, size=sizes[o.name]) for o in pour_scene.objects])
+    world, robot, extractor = _setup(scene)
+    for name, at in (("bottle", (0.0, 0.556)), ("cup", (0.002, 0.621))):
+        adr = world.model.joint(f"{name}_free").qposadr[0]
+        world.data.qpos[adr : adr + 2] = at
+    for _ in range(40):
+        world.step()
+    extractor.update()
+    grasp = make_action("grasp", "right", {"obj": "bottle"})
+    planner = SidePlanner(robot, "right", grasp.args, np.zeros(3))
+    assert planner.blocked(planner.variant(REACH_VARIANTS[0]))  # the asked grasp sweeps into the cup
+    point = grasp.target_poses(robot)[1].pos
+    assert grasp._height_fraction is None
+    assert point[2] == pytest.approx(grasp._side_point(robot)[2])
