@@ -176,11 +176,13 @@ class _Both:
 
 def test_an_arm_switch_whose_busy_hand_already_lost_its_object_goes_on():
     # Both arms lose their objects: the right arm drops the bottle on its way to the cup, then, as the
-    # recovery starts, a person takes the cup out of the left hand and sets it down on the right. The
-    # cup's recovery passes to the right arm, whose bottle already fell: its hand is free already
-    # (place free_hand), and it takes the fallen bottle again before the pour.
+    # recovery starts, a person takes the cup out of the left hand and sets it down far on the right,
+    # beyond the bottle lying there: the left arm's grasp, with no clear way in that it reaches,
+    # sweeps into the bottle and pushes the cup away. The cup's recovery passes to the right arm,
+    # whose bottle already fell: its hand is free already (place free_hand), it takes the cup over
+    # the lying bottle, and takes the fallen bottle again before the pour.
     both = _Both(ScriptedDisturbance("move_to_obj", "drop", nth=0, after=36),
-                 ScriptedDisturbance("move_to_target", "pull", nth=1, after=1, seed=1, spot=(0.2, 0.35), lying=False))
+                 ScriptedDisturbance("move_to_target", "pull", nth=1, after=1, seed=1, spot=(0.25, 0.35), lying=False))
     result = run_episode(EpisodeSpec("dual_arm_pour_water", seed=8, disturbance=both))
     assert [(e["kind"], e["obj"], e["arm"]) for e in result.trace.of("disturbance")] == [("drop", "bottle", "right"), ("pull", "cup", "left")]
     assert result.success, result.reason
