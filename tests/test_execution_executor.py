@@ -9,7 +9,7 @@ from agentchord.execution.episode import EpisodeSpec, run_episode
 from agentchord.execution.executor import Executor, ExecutorConfig
 from agentchord.execution.strategies import make_strategy
 from agentchord.tasks import load_task_graph
-from agentchord.worlds.sim.disturbances import KINDS, ScriptedDisturbance, ScriptedDrop
+from agentchord.worlds.sim.disturbances import KINDS, PRESETS, ScriptedDisturbance, ScriptedDrop
 from agentchord.worlds.sim.tasks import SIM_TASKS
 from agentchord.worlds.sim.tasks.base import Verdict
 from agentchord.worlds.sim.trial import open_world
@@ -263,12 +263,38 @@ def _cup_tipped_switches(result) -> list[tuple[str, str]]:
     return [(s["edge"], s["to"]) for s in result.trace.of("recovery_switch") if s["failure"] == "cup_tipped"]
 
 
+def _continuation_blind_to_the_cup():
+    """The single-arm graph as it was before its continuation edge watched the cup: the bottle,
+    taken again after a drop, is carried on to v2 whatever the cup does."""
+    graph = load_task_graph(TASK)
+    edges = [
+        e.model_copy(update={"failures": [f for f in e.failures if f.name != "cup_tipped"]}) if e.id == "r_bottle_regrasped_to_v2" else e
+        for e in graph.edges if e.id != "r_bottle_regrasped_r_cup_tipped"
+    ]
+    return graph.model_copy(update={"edges": edges})
+
+
+def test_the_bottle_taken_again_is_not_carried_to_a_cup_still_lying_there():
+    # Stress protocol, seed 4: the cup is knocked over as the bottle is carried to it and the bottle
+    # is pulled from the hand as the cup's righting begins. Taken again, the bottle went on to the
+    # lying cup (it struck it and slipped, and the episode ran out of time); the continuation edge
+    # now watches the cup, and the cup is set upright first.
+    result = run_episode(EpisodeSpec(TASK, seed=4, disturb=PRESETS["stress"], protocol=True))
+    assert result.success, result.reason
+    assert _cup_tipped_switches(result) == [("e2", "e2_r_cup_tipped"), ("r_bottle_regrasped_to_v2", "r_bottle_regrasped_r_cup_tipped")]
+    # Without the watch, the same episode fails.
+    blind = run_episode(EpisodeSpec(TASK, seed=4, disturb=PRESETS["stress"], protocol=True, graph=_continuation_blind_to_the_cup()))
+    assert not blind.success
+
+
 def test_a_recovery_is_not_skipped_to_a_merge_node_the_next_edge_fails_at_once():
     # p = 0.3, every kind, seed 4: the cup is knocked over as the bottle is carried to it, and its
     # righting is cut short by a pull of the bottle. The bottle's regrasp merges at v2, whose
     # constraints do not read the cup, and e3's cup_tipped fires at once. v2 holds, but the cup still
     # lies: e3_r_cup_tipped runs, and cup_tipped fires once on e3, not again after a skip to v2.
-    result = run_episode(EpisodeSpec(TASK, seed=4, p=0.3, disturb=KINDS))
+    # (The library graph's continuation edge now catches the lying cup before v2: the graph
+    # without that watch keeps the case the guard is for.)
+    result = run_episode(EpisodeSpec(TASK, seed=4, p=0.3, disturb=KINDS, graph=_continuation_blind_to_the_cup()))
     assert result.success, result.reason
     assert _cup_tipped_switches(result) == [("e2", "e2_r_cup_tipped"), ("e3", "e3_r_cup_tipped")]
     assert result.trace.of("subgoal_met") == []
@@ -283,7 +309,7 @@ def test_a_recovery_is_skipped_to_its_merge_node_once_not_round_and_round(monkey
     from agentchord.execution.switching import RecoverySwitching
 
     monkeypatch.setattr(RecoverySwitching, "_leaving_fails_at_once", lambda self, node_id: False)
-    result = run_episode(EpisodeSpec(TASK, seed=4, p=0.3, disturb=KINDS))
+    result = run_episode(EpisodeSpec(TASK, seed=4, p=0.3, disturb=KINDS, graph=_continuation_blind_to_the_cup()))
     assert result.success, result.reason
     assert _cup_tipped_switches(result) == [("e2", "e2_r_cup_tipped"), ("e3", "e3_r_cup_tipped"), ("e3", "e3_r_cup_tipped")]
     assert [(m["edge"], m["node"]) for m in result.trace.of("subgoal_met")] == [("e3_r_cup_tipped", "v2")]

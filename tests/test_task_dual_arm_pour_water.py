@@ -181,16 +181,28 @@ def test_skip_if_held_keeps_a_finished_grasp_and_skip_if_placed_only_retreats():
     (0.05, 0.5, 0.3, False),   # left within 5 deg of upright by the turn: the fallen-grasp hold is kept
 ])
 def test_reseat_turns_a_fallen_bottle_left_askew_into_a_nominal_side_grasp(x, y, yaw, reseated, monkeypatch):
+    import agentchord.actions.grasp as grasp_module
     from agentchord.actions.grasp import Grasp
+    from agentchord.actions.wrist_branch import is_wound
+    from agentchord.robot.aloha import HOME_Q
 
-    calls = []
-    reseat = Grasp._reseat
+    # The straight turn upright (the unflipped branch's joint-space turn leaves a bottle within
+    # 3 deg: tests/test_actions_wrist_branch.py): this one leaves the first bottle askew.
+    monkeypatch.setattr(grasp_module, "plan_unflipped_fallen_grasp", lambda *args, **kwargs: None)
+    calls, wound, homed = [], [], []
+    reseat, move_joints = Grasp._reseat, grasp_module.move_joints
 
     def counted(self, robot):
         calls.append(tilt_deg(robot.frame.objects[self.args.obj].axis))
+        wound.append(is_wound(robot.ik.arm_q(self.arm)))
         return (yield from reseat(self, robot))
 
+    def recorded(robot, arm, q_goal, speed=1.0):
+        homed.append(np.allclose(q_goal, HOME_Q))
+        return (yield from move_joints(robot, arm, q_goal, speed))
+
     monkeypatch.setattr(Grasp, "_reseat", counted)
+    monkeypatch.setattr(grasp_module, "move_joints", recorded)
     scene = _scene(0)
     world, robot, extractor = _robot(scene)
     bottle = scene.objects[0]
@@ -203,6 +215,8 @@ def test_reseat_turns_a_fallen_bottle_left_askew_into_a_nominal_side_grasp(x, y,
     status, _ = _run(robot, extractor, make_action("grasp", "right", {"obj": "bottle", "reseat": True}), max_ticks=2500)
     assert status == Status.SUCCESS
     assert bool(calls) is reseated and all(t > Grasp.RESEAT_TILT_DEG for t in calls)
+    # The hand goes home between set-down and grasp only to unwind a wound wrist.
+    assert any(homed) is any(wound)
     frame = extractor.frame
     feats, tool = frame.objects["bottle"], frame.arms["right"].ee
     assert frame.is_holding("right", "bottle") and tilt_deg(feats.axis) <= Grasp.RESEAT_TILT_DEG

@@ -87,15 +87,6 @@ def _pour_node(result, node: str) -> dict:
     return [e for e in result.trace.of("node_reached") if e["node"] == node][-1]
 
 
-def test_a_bottle_held_off_centre_after_a_fallen_grasp_is_carried_to_where_a_centred_one_pours():
-    # p = 0.3, all kinds, seed 4: the bottle, pulled out of the hand, is taken lying and set upright
-    # in the hand 3.1 cm out along the approach. Carried to the usual tool pose, its mouth came down
-    # 4.2 cm from the cup's centre (radius 2.9 cm): "never reached a pouring orientation above the cup".
-    result = run_episode(EpisodeSpec("single_arm_pour_water", seed=4, **HEAVY))
-    assert result.success, result.reason
-    assert _pour_node(result, "v3")["constraints_hold"]
-
-
 def test_a_bottle_caught_again_near_its_top_after_a_drop_is_taken_again_before_the_pour():
     # p = 0.3, all kinds, seed 8: the bottle drops out of the closed fingers as the grasp lifts and is
     # caught again as they close, at 82 % of its height. The synchronous grasp's recovery kept that
@@ -106,13 +97,10 @@ def test_a_bottle_caught_again_near_its_top_after_a_drop_is_taken_again_before_t
     assert _pour_node(result, "v4")["constraints_hold"]
 
 
-@pytest.mark.parametrize(("task", "seed", "switched_off"), [
-    ("single_arm_pour_water", 4, "agentchord.actions.move.MoveToObj.CENTRED_WITHIN"),  # carried off centre
-    ("dual_arm_pour_water", 8, "agentchord.actions.grasp.Grasp.HELD_HEIGHT_TOLERANCE"),  # kept near its top
-])
-def test_without_the_in_hand_checks_those_bottles_pour_beside_the_cup(monkeypatch, task, seed, switched_off):
-    monkeypatch.setattr(switched_off, float("inf"))
-    result = run_episode(EpisodeSpec(task, seed=seed, **HEAVY))
+def test_without_the_height_check_that_bottle_pours_beside_the_cup(monkeypatch):
+    # (The off-centre carry of a fallen grasp's hold is checked where it acts: tests/test_actions_library.py.)
+    monkeypatch.setattr("agentchord.actions.grasp.Grasp.HELD_HEIGHT_TOLERANCE", float("inf"))
+    result = run_episode(EpisodeSpec("dual_arm_pour_water", seed=8, **HEAVY))
     assert not result.success
     assert "never reached a pouring orientation above the" in result.reason
 

@@ -20,6 +20,7 @@ from agentchord.actions.geometry import _matrix, _wrist_margin
 from agentchord.actions.in_hand import grasp_height_share
 from agentchord.actions.motion import (
     ANGULAR_SPEED,
+    EMPTY_HAND_JOINT_SPEED,
     approach,
     grasp_frame,
     grip,
@@ -31,12 +32,11 @@ from agentchord.actions.motion import (
     wait_for_rest,
 )
 from agentchord.actions.side_plan import SidePlanner, side_point
-from agentchord.features.frame import tilt_deg
+from agentchord.actions.wrist_branch import is_wound, move_above, plan_unflipped_fallen_grasp, turn_unflipped
+from agentchord.features.frame import ObjectFeatures, tilt_deg
 from agentchord.solvers.ik import ARM_CLEARANCE, PoseTarget
 from agentchord.robot.aloha import HOME_Q
 
-#: Joint speed (rad/s, largest joint) of joint-space moves with an empty hand.
-EMPTY_HAND_JOINT_SPEED = 2.0
 #: Tilt (deg) beyond which an object counts as fallen for a side grasp.
 UPRIGHT_TOLERANCE_DEG = 25.0
 #: An object that moved more than this (m) while the tool approached it is looked at again.
@@ -92,6 +92,8 @@ class Grasp(ArmAction):
     #: A fallen object is turned upright at least this far (m, horizontally) from the arm's own
     #: shoulder: its ends sweep a circle as it turns, and beside the base they strike the arm.
     TURN_FROM_BASE = 0.30
+    #: The empty hand goes over a fallen object, on the unflipped wrist branch, this far (m) above the pre-grasp.
+    ABOVE_PRE_GRASP = 0.06
     #: With ``reseat``, a fallen object the turn left within this (deg) of upright keeps the
     #: fallen-grasp hold; one left more askew is re-seated. Measured on the real-world protocol's
     #: single-arm pours: bottles left 1.3 and 2.9 deg off poured into the cup with that hold, those
@@ -190,10 +192,11 @@ class Grasp(ArmAction):
                 yield from self._reseat(robot)
 
     def _reseat(self, robot: RobotController) -> Iterator[None]:
-        """Put an object just set upright in hand down on the table, go home, side-grasp it again.
+        """Put an object just set upright in hand down on the table, side-grasp it again.
 
-        The fallen grasp leaves the object off-centre in the hand and the wrist wound far from
-        its usual configuration; a fresh side grasp from home restores the nominal grasp.
+        The fallen grasp leaves the object off-centre in the hand, at times askew; a fresh side
+        grasp restores the nominal hold. A wrist left wound (the flipped branch, or the rotate
+        joint far round: a pour's roll would run past its limit) goes home first.
         """
         arm = self.arm
         feats = robot.frame.objects[self.args.obj]
@@ -205,9 +208,10 @@ class Grasp(ArmAction):
         yield from grip(robot, arm, 0.0, ticks=8)
         retreat = down - 0.08 * rotation[:, 0] + np.array([0.0, 0.0, 0.04])
         yield from move_to(robot, arm, pose_from_matrix(retreat, rotation))
-        # The hand is empty: unwind the wrist (wound far by the fallen grasp) at twice the usual speed.
-        yield from move_joints(robot, arm, HOME_Q, speed=EMPTY_HAND_JOINT_SPEED)
-        robot.set_pose(arm, robot.ik.tcp_pose(arm))
+        if is_wound(robot.ik.arm_q(arm)):
+            # The hand is empty: unwind the wrist at twice the usual speed.
+            yield from move_joints(robot, arm, HOME_Q, speed=EMPTY_HAND_JOINT_SPEED)
+            robot.set_pose(arm, robot.ik.tcp_pose(arm))
         yield from wait_for_rest(robot, self.args.obj)
         if tilt_deg(robot.frame.objects[self.args.obj].axis) > UPRIGHT_TOLERANCE_DEG:
             # It fell over when set down: the retry loop grasps it again from where it lies.
@@ -439,32 +443,58 @@ class Grasp(ArmAction):
         arm = self.arm
         feats = robot.frame.objects[self.args.obj]
         rotation, point = self._fallen_frame(robot)
-        top_dir = rotation[:, 2]
         yield from self._clear_from_below(robot, point[2] + self.args.pre_grasp_dis + 0.05)
-        yield from approach(robot, arm, pose_from_matrix(point + np.array([0, 0, self.args.pre_grasp_dis]), rotation))
+        pre = pose_from_matrix(point + np.array([0, 0, self.args.pre_grasp_dis]), rotation)
+        # On the unflipped wrist branch where every move of it is clear: the turn upright then
+        # passes the wrist's singularity without whipping the object round in the hand.
+        lifted, yaw = self._turn_pose(robot, feats, point, rotation)
+        plan = plan_unflipped_fallen_grasp(
+            robot, arm, pre, pose_from_matrix(point, rotation), self.ABOVE_PRE_GRASP, pose_from_matrix(lifted, rotation),
+            _turned(rotation, yaw, 1.0),
+            held=(np.array([feats.bottom, feats.top]) - point) @ rotation, radius=0.5 * float(feats.extent[0]),
+        )
+        if plan is not None:
+            yield from move_above(robot, arm, plan)
+        yield from approach(robot, arm, pre)
         # A top-down tool often flips the forearm roll: let the IK converge before descending.
         yield from settle(robot, arm, tolerance=0.003, max_ticks=60, required=0.015)
         feats = robot.frame.objects[self.args.obj]
         point[:2] = feats.pos[:2]
         yield from move_to(robot, arm, pose_from_matrix(point, rotation), speed=0.08)
         yield from self._close_and_check(robot)
+        lifted, yaw = self._turn_pose(robot, feats, point, rotation)
+        if plan is not None:
+            lifted[2] += plan.rise
+        yield from move_to(robot, arm, pose_from_matrix(lifted, rotation), speed=0.15)
+        if plan is not None and (yield from turn_unflipped(robot, arm, self.args.obj, _turned(rotation, yaw, 1.0))):
+            yield from settle(robot, arm)
+            return
+        # Taken flipped, or no joint-space turn is clear: the straight turn, swing and pitch at once.
+        ticks = max(int(np.ceil(1.875 * max(abs(yaw), 0.5 * np.pi) / ANGULAR_SPEED * 50)), 5)
+        for k in range(1, ticks + 1):
+            robot.set_pose(arm, pose_from_matrix(lifted, _turned(rotation, yaw, min_jerk(k / ticks))))
+            yield
+        yield from settle(robot, arm)
+
+    def _turn_pose(
+        self, robot: RobotController, feats: ObjectFeatures, point: np.ndarray, rotation: np.ndarray
+    ) -> tuple[np.ndarray, float]:
+        """Where a fallen object (``feats``) grasped at ``point`` (tool ``rotation``) is turned upright:
+        the tool's position, lifted clear of the table and away from the arm's base, and the swing
+        (rad, about the vertical) that points the object's top away from the robot."""
         half_length = 0.5 * float(np.linalg.norm(feats.top - feats.bottom))
         lifted = point + np.array([0.0, 0.0, half_length + 0.06])
-        base = robot.world.arm_base(arm)
+        base = robot.world.arm_base(self.arm)
         out = lifted[:2] - base[:2]
         if 1e-6 < float(np.linalg.norm(out)) < self.TURN_FROM_BASE:
             lifted[:2] = base[:2] + self.TURN_FROM_BASE * out / np.linalg.norm(out)
-        yield from move_to(robot, arm, pose_from_matrix(lifted, rotation), speed=0.15)
-        # Swing the object's top to point away from the robot and pitch it up, both at once: the
-        # swing about the vertical, the pitch about the fingers' axis, so the top only rises. The
-        # tool ends in the usual side-grasp frame with the object upright between the fingers.
-        outward = grasp_frame(lifted - robot.world.arm_base(arm))[:, 0]
-        yaw = np.arctan2(np.cross(top_dir, outward)[2], float(np.dot(top_dir, outward)))
-        pitch = -0.5 * np.pi
-        ticks = max(int(np.ceil(1.875 * max(abs(yaw), abs(pitch)) / ANGULAR_SPEED * 50)), 5)
-        for k in range(1, ticks + 1):
-            s = min_jerk(k / ticks)
-            turned = Rotation.from_euler("z", s * yaw).as_matrix() @ rotation @ Rotation.from_euler("y", s * pitch).as_matrix()
-            robot.set_pose(arm, pose_from_matrix(lifted, turned))
-            yield
-        yield from settle(robot, arm)
+        outward = grasp_frame(lifted - base)[:, 0]
+        top_dir = rotation[:, 2]
+        return lifted, float(np.arctan2(np.cross(top_dir, outward)[2], float(np.dot(top_dir, outward))))
+
+
+def _turned(rotation: np.ndarray, yaw: float, share: float) -> np.ndarray:
+    """A fallen grasp's tool ``rotation`` turned ``share`` of the way upright: the swing ``yaw`` about the
+    vertical and the pitch about the fingers' axis at once, so the object's top only rises. All the
+    way, the tool is in the usual side-grasp frame with the object upright between the fingers."""
+    return Rotation.from_euler("z", share * yaw).as_matrix() @ rotation @ Rotation.from_euler("y", share * (-0.5 * np.pi)).as_matrix()

@@ -28,6 +28,8 @@ from agentchord.solvers.poses import (  # noqa: F401  (grasp_frame, pose_from_ma
 #: Cartesian speed limits of the tool (m/s, rad/s).
 LINEAR_SPEED = 0.30
 ANGULAR_SPEED = 1.6
+#: Joint speed (rad/s, largest joint) of joint-space moves with an empty hand: twice the usual.
+EMPTY_HAND_JOINT_SPEED = 2.0
 #: Workspace every pose target is clipped to (m): above the table, within reach.
 WORKSPACE_LOW = np.array([-TABLE_HALF[0] + 0.05, 0.22, 0.015])
 WORKSPACE_HIGH = np.array([TABLE_HALF[0] - 0.05, 0.95, 0.55])
@@ -94,9 +96,9 @@ def approach(
     q_goal = solve_from_scratch(ik, q, arm, [goal], from_current=False)
     if q_goal is None:
         return
-    # The hand is empty (it is on its way to grasp): twice the usual joint speed.
-    yield from move_joints(robot, arm, HOME_Q, speed=2.0)
-    yield from move_joints(robot, arm, q_goal, speed=2.0)
+    # The hand is empty (it is on its way to grasp).
+    yield from move_joints(robot, arm, HOME_Q, speed=EMPTY_HAND_JOINT_SPEED)
+    yield from move_joints(robot, arm, q_goal, speed=EMPTY_HAND_JOINT_SPEED)
     robot.set_pose(arm, goal)
     yield from settle(robot, arm, tolerance=APPROACH_TOLERANCE, max_ticks=settle_ticks)
 
