@@ -16,6 +16,7 @@ from agentchord.actions.finger_clearance import (
     horizontal_sizes,
     open_finger_points,
     side_approach_blocking,
+    swept_hits,
 )
 from scipy.spatial.transform import Rotation
 
@@ -194,3 +195,18 @@ def test_only_the_way_in_is_swept_not_what_lies_beyond_the_object():
     # The bottle lying past the cup, ahead of the fingers' tips at the grasp: not in the way.
     frame = _frame(cup=CUP, bottle=_lying_bottle(at=(0.02, 0.405), yaw=np.pi / 2))
     assert side_approach_blocking(frame, "cup", *_side_way_in(0.0535)) == {}
+
+
+def test_a_swept_path_reports_what_the_fingers_and_a_held_object_pass_through():
+    # A tool pointing down with one open finger over the cup (the fingers lie 3.5-5.9 cm either side
+    # of the tool centre, their tips 3.9 cm below it): clear 9 cm over the cup's top, in it at 3 cm.
+    frame = _frame(cup=CUP, bottle=_lying_bottle())
+    down = np.column_stack([(0.0, 0.0, -1.0), (0.0, 1.0, 0.0), (1.0, 0.0, 0.0)])
+    finger_over_cup = np.array([CUP["pos"][0], CUP["pos"][1] - 0.045, 0.107])
+    assert swept_hits(frame, "bottle", [(finger_over_cup + (0.0, 0.0, 0.09), down)]) == {}
+    assert set(swept_hits(frame, "bottle", [(finger_over_cup + (0.0, 0.0, 0.03), down)])) == {"cup"}
+    # An object held 10 cm down the tool's approach, beside the finger, reaches into the cup from 9 cm.
+    held = np.array([[0.0, 0.045, 0.0], [0.1, 0.045, 0.0]])
+    assert set(swept_hits(frame, "bottle", [(finger_over_cup + (0.0, 0.0, 0.09), down)], held, 0.02)) == {"cup"}
+    # The object being grasped is never in its own way.
+    assert "bottle" not in swept_hits(frame, "bottle", [(np.array([-0.118, 0.478, 0.06]), down)])

@@ -130,6 +130,24 @@ def side_approach_blocking(
     return _neighbours_hit(frame, obj, points, 0.0)
 
 
+def swept_hits(
+    frame: FeatureFrame, obj: str, tool_poses: list[tuple[np.ndarray, np.ndarray]],
+    held: np.ndarray | None = None, held_radius: float = 0.0,
+) -> dict[str, int]:
+    """The neighbours of ``obj`` that the open fingers pass through along sampled tool poses
+    (position, rotation), and with ``held`` (points along a held object's axis, tool frame) what
+    the held object passes through (within ``held_radius`` of those points)."""
+    hits: dict[str, int] = {}
+    for point, rotation in tool_poses:
+        found = [_neighbours_hit(frame, obj, open_finger_points(point, rotation), 0.0)]
+        if held is not None and len(held):
+            found.append(_neighbours_hit(frame, obj, point + held @ rotation.T, held_radius))
+        for part in found:
+            for name, count in part.items():
+                hits[name] = hits.get(name, 0) + count
+    return hits
+
+
 def _neighbours_hit(frame: FeatureFrame, obj: str, points: np.ndarray, clearance: float) -> dict[str, int]:
     """How many of ``points`` lie within ``clearance`` of each neighbour of ``obj``.
 

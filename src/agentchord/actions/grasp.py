@@ -449,7 +449,7 @@ class Grasp(ArmAction):
         # passes the wrist's singularity without whipping the object round in the hand.
         lifted, yaw = self._turn_pose(robot, feats, point, rotation)
         plan = plan_unflipped_fallen_grasp(
-            robot, arm, pre, pose_from_matrix(point, rotation), self.ABOVE_PRE_GRASP, pose_from_matrix(lifted, rotation),
+            robot, arm, self.args.obj, pre, pose_from_matrix(point, rotation), self.ABOVE_PRE_GRASP, pose_from_matrix(lifted, rotation),
             _turned(rotation, yaw, 1.0),
             held=(np.array([feats.bottom, feats.top]) - point) @ rotation, radius=0.5 * float(feats.extent[0]),
         )

@@ -22,6 +22,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
 from agentchord.actions.controller import RobotController
+from agentchord.actions.finger_clearance import swept_hits
 from agentchord.actions.motion import ANGULAR_SPEED, EMPTY_HAND_JOINT_SPEED, move_joints, pose_from_matrix
 from agentchord.robot.aloha import ARM_JOINTS, ARM_PREFIX
 from agentchord.solvers.ik import ARM_CLEARANCE, BimanualIK, PoseTarget, solve_from_scratch
@@ -31,8 +32,8 @@ from agentchord.solvers.poses import quat_to_rotation
 FLIPPED_ROLL = 0.5 * np.pi
 #: Wrist rotate beyond this (rad) from 0: wound (a pour's roll would run it past its limit).
 WOUND_ROTATE = 0.5 * np.pi
-#: Joint-path samples checked (tool height, the held object, the other arm).
-PATH_SAMPLES = 12
+#: Joint-path samples checked (tool height, the fingers' and the held object's sweep, the other arm).
+PATH_SAMPLES = 24
 #: A joint-space move keeps the arms' collision proxies (which wrap the links) this far apart (m):
 #: half the live IK's margin, which a straight line's solver needs to steer by.
 PATH_CLEARANCE = 0.5 * ARM_CLEARANCE
@@ -139,11 +140,13 @@ class JointPath:
         lowest_tool: The tool centre's lowest height (m) along the move.
         lowest_held: The lowest height (m) of the held points along the move (inf: none given).
         clearance: The smallest distance (m) between the two arms' collision proxies.
+        tool_poses: The sampled tool poses (position, rotation matrix).
     """
 
     lowest_tool: float
     lowest_held: float
     clearance: float
+    tool_poses: tuple[tuple[np.ndarray, np.ndarray], ...] = ()
 
 
 def joint_path(
@@ -164,15 +167,17 @@ def joint_path(
     ik.reset(robot.ik.configuration.q.copy())
     q0 = robot.ik.arm_q(arm) if q_start is None else np.asarray(q_start, dtype=float)
     lowest_tool, lowest_held, clearance = np.inf, np.inf, np.inf
+    poses = []
     for s in np.linspace(0.0, 1.0, PATH_SAMPLES + 1):
         ik.set_arm_q(arm, q0 + s * (np.asarray(q_goal) - q0))
         pose = ik.tcp_pose(arm)
+        rotation = quat_to_rotation(pose.quat).as_matrix()
+        poses.append((pose.pos.copy(), rotation))
         lowest_tool = min(lowest_tool, float(pose.pos[2]))
         if held is not None and len(held):
-            rotation = quat_to_rotation(pose.quat).as_matrix()
             lowest_held = min(lowest_held, float(np.min((pose.pos + held @ rotation.T)[:, 2])))
         clearance = min(clearance, ik.arm_clearance())
-    return JointPath(lowest_tool=lowest_tool, lowest_held=lowest_held, clearance=clearance)
+    return JointPath(lowest_tool=lowest_tool, lowest_held=lowest_held, clearance=clearance, tool_poses=tuple(poses))
 
 
 @dataclass(frozen=True)
@@ -190,8 +195,8 @@ class UnflippedFallenGrasp:
 
 
 def plan_unflipped_fallen_grasp(
-    robot: RobotController, arm: str, pre: PoseTarget, grasp: PoseTarget, above_rise: float, lifted: PoseTarget,
-    upright: np.ndarray, held: np.ndarray, radius: float,
+    robot: RobotController, arm: str, obj: str, pre: PoseTarget, grasp: PoseTarget, above_rise: float,
+    lifted: PoseTarget, upright: np.ndarray, held: np.ndarray, radius: float,
 ) -> UnflippedFallenGrasp | None:
     """Plan the fallen grasp on the unflipped branch, or None where some move of it is not clear.
 
@@ -200,12 +205,13 @@ def plan_unflipped_fallen_grasp(
     sweep into what stands beside the object), comes down to ``grasp`` on the same branch (near
     the arm's own base that branch may not reach down), is lifted to ``lifted`` (raised further
     by the plan's ``rise``) and turned there to ``upright`` in joint space (the object kept
-    :data:`TURN_TABLE_CLEARANCE` clear of the table). No move may pass the other arm where it
-    stands now.
+    :data:`TURN_TABLE_CLEARANCE` clear of the table). No joint-space move may pass the other arm
+    where it stands now, nor sweep the open fingers (or, turning, the object) into a neighbour.
 
     Args:
         robot: The robot (read only).
         arm: The grasping arm.
+        obj: The fallen object.
         pre: The pre-grasp pose over the object.
         grasp: The grasp pose.
         above_rise: How far (m) over ``pre`` the joint-space move ends.
@@ -221,6 +227,8 @@ def plan_unflipped_fallen_grasp(
     approach = joint_path(robot, arm, q_above)
     if approach.clearance < PATH_CLEARANCE or approach.lowest_tool < float(pre.pos[2]):
         return None
+    if swept_hits(robot.frame, obj, list(approach.tool_poses)):
+        return None
     q_grasp = solve_from_scratch(robot.scratch_ik(), _with_arm(robot, arm, q_above), arm, [pre, grasp], from_home=False)
     if q_grasp is None or is_flipped(q_grasp):
         return None
@@ -235,13 +243,18 @@ def plan_unflipped_fallen_grasp(
         if q_turned is None:
             return None
         turn = joint_path(robot, arm, q_turned, held=held, q_start=q_lift)
-        if turn.clearance < PATH_CLEARANCE:
+        if turn.clearance < PATH_CLEARANCE or swept_hits(robot.frame, obj, list(turn.tool_poses), _along(held), radius):
             return None
         deficit = radius + TURN_TABLE_CLEARANCE - turn.lowest_held
         if deficit <= 0.0:
             return UnflippedFallenGrasp(above=q_above, rise=rise)
         rise += deficit + 0.005
     return None
+
+
+def _along(ends: np.ndarray, count: int = 5) -> np.ndarray:
+    """``count`` points from one end of a held object's axis to the other (tool frame)."""
+    return ends[0] + np.linspace(0.0, 1.0, count)[:, None] * (ends[1] - ends[0])
 
 
 def move_above(robot: RobotController, arm: str, plan: UnflippedFallenGrasp) -> Iterator[None]:
@@ -271,7 +284,10 @@ def turn_unflipped(robot: RobotController, arm: str, obj: str, upright: np.ndarr
     if q_goal is None:
         return False
     path = joint_path(robot, arm, q_goal, held=held)
-    if path.clearance < PATH_CLEARANCE or path.lowest_held < 0.5 * float(feats.extent[0]) + TURN_TABLE_CLEARANCE:
+    radius = 0.5 * float(feats.extent[0])
+    if path.clearance < PATH_CLEARANCE or path.lowest_held < radius + TURN_TABLE_CLEARANCE:
+        return False
+    if swept_hits(frame, obj, list(path.tool_poses), _along(held), radius):
         return False
     change = np.abs(q_goal - robot.ik.arm_q(arm))
     largest = float(np.max(change))
