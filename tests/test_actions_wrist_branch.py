@@ -3,11 +3,9 @@ the fallen grasp's turn upright on the unflipped branch (real physics)."""
 
 import numpy as np
 import pytest
-from scipy.spatial.transform import Rotation
 
 import agentchord.actions.grasp as grasp_module
 from agentchord.actions.base import Status
-from agentchord.actions.controller import RobotController
 from agentchord.actions.library import make_action
 from agentchord.actions.motion import pose_from_matrix
 from agentchord.actions.wrist_branch import (
@@ -18,23 +16,14 @@ from agentchord.actions.wrist_branch import (
     unflipped_solution,
 )
 from agentchord.features.frame import tilt_deg
-from agentchord.features.oracle import OracleExtractor
 from agentchord.solvers.poses import quat_to_rotation
-from agentchord.worlds.sim.world import SimWorld
+from test_actions_library import _lay_bottle_down, _setup
 
 #: A tool pointing down over a lying bottle, as the live IK leaves it (measured: Table II,
 #: single-arm pour, seed 8): forearm roll pi, the flipped branch.
 FLIPPED_DOWN = np.array([0.13, 0.22, 0.41, 3.14, -0.94, -2.95])
 #: The tool pointing down, fingers across a bottle lying along x (approach down, z along the bottle).
 DOWN = np.column_stack([[0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]])
-
-
-def _robot(scene):
-    world = SimWorld(scene)
-    robot = RobotController(world)
-    extractor = OracleExtractor(world, grasp_signal=lambda arm: robot.targets[arm].grip_closed_settled)
-    robot.frame = extractor.frame
-    return world, robot, extractor
 
 
 def _angle(quat_a, quat_b) -> float:
@@ -51,7 +40,7 @@ def test_flipped_and_wound_read_the_wrist_joints():
 
 
 def test_the_other_branch_holds_the_tool_the_same_way_within_millimetres(pour_scene):
-    _, robot, _ = _robot(pour_scene)
+    _, robot, _ = _setup(pour_scene)
     ik = robot.scratch_ik()
     ik.set_arm_q("right", FLIPPED_DOWN)
     flipped = ik.tcp_pose("right")
@@ -64,7 +53,7 @@ def test_the_other_branch_holds_the_tool_the_same_way_within_millimetres(pour_sc
 
 
 def test_an_unflipped_solution_reaches_the_pose_the_live_ik_reaches_flipped(pour_scene):
-    _, robot, _ = _robot(pour_scene)
+    _, robot, _ = _setup(pour_scene)
     pose = pose_from_matrix(np.array([0.106, 0.451, 0.185]), DOWN)
     q = unflipped_solution(robot, "right", pose)
     assert q is not None and not is_flipped(q)
@@ -76,7 +65,7 @@ def test_an_unflipped_solution_reaches_the_pose_the_live_ik_reaches_flipped(pour
 
 
 def test_a_joint_path_reports_the_lowest_tool_the_held_points_and_the_arms_clearance(pour_scene):
-    _, robot, _ = _robot(pour_scene)
+    _, robot, _ = _setup(pour_scene)
     q = robot.ik.arm_q("right")
     tool = robot.ik.tcp_pose("right")
     point = np.array([[0.0, 0.0, -0.1]])  # 10 cm down the tool's up axis
@@ -91,16 +80,6 @@ def test_a_joint_path_reports_the_lowest_tool_the_held_points_and_the_arms_clear
     assert joint_path(robot, "right", lower).lowest_tool < tool.pos[2]
 
 
-def _lay_bottle_down(world, scene, extractor, at, yaw) -> None:
-    adr = world.model.joint("bottle_free").qposadr[0]
-    radius = scene.objects[0].size[0]
-    x, y, z, w = (Rotation.from_euler("z", yaw) * Rotation.from_euler("y", 90, degrees=True)).as_quat()
-    world.data.qpos[adr : adr + 7] = [*at, radius + 0.001, w, x, y, z]
-    for _ in range(40):
-        world.step()
-    extractor.update()
-
-
 @pytest.mark.parametrize(("at", "yaw"), [((0.2, 0.45), 3.0), ((0.08, 0.5), 2.0), ((0.0, 0.45), -1.5)])
 def test_a_fallen_bottle_turned_upright_on_the_unflipped_branch_is_held_straight(pour_scene, at, yaw, monkeypatch):
     # Taken flipped and turned by the straight tool turn, the live IK swings the wrist through its
@@ -111,8 +90,8 @@ def test_a_fallen_bottle_turned_upright_on_the_unflipped_branch_is_held_straight
     for unflipped in (True, False):
         if not unflipped:
             monkeypatch.setattr(grasp_module, "plan_unflipped_fallen_grasp", lambda *args, **kwargs: None)
-        world, robot, extractor = _robot(pour_scene)
-        _lay_bottle_down(world, pour_scene, extractor, at, yaw)
+        world, robot, extractor = _setup(pour_scene)
+        _lay_bottle_down(world, pour_scene, extractor, at=at, yaw=yaw)
         grasp = make_action("grasp", "right", {"obj": "bottle"})
         grasp.initialise(robot)
         for _ in range(2500):
