@@ -8,7 +8,7 @@ side posture to a tool pointing down ends with the roll near pi, and the turn of
 upright in hand crosses back, the solver swinging roll and rotate through pi in ~0.2 s with the
 measured joints up to 0.7 rad behind. Measured on the real-world protocol's pours (seeds 0-19):
 every fallen grasp was taken flipped, and the whip at the crossing pivoted the object between the
-finger pads, leaving it 8-13 degrees askew in 7 of 16 (a pour from such a hold misses the cup).
+finger pads, leaving it 8-20 degrees askew in 8 of 16 (a pour from such a hold misses the cup).
 A straight joint-space move on the unflipped branch passes wrist angle 0 smoothly: over the
 object with the empty hand, then, holding it, to upright.
 """
