@@ -19,11 +19,10 @@ from collections.abc import Generator, Iterator
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial.transform import Rotation, Slerp
 
 from agentchord.actions.controller import RobotController
 from agentchord.actions.finger_clearance import swept_hits
-from agentchord.actions.motion import ANGULAR_SPEED, EMPTY_HAND_JOINT_SPEED, move_joints, pose_from_matrix
+from agentchord.actions.motion import ANGULAR_SPEED, EMPTY_HAND_JOINT_SPEED, line_poses, move_joints, pose_from_matrix
 from agentchord.robot.aloha import ARM_JOINTS, ARM_PREFIX
 from agentchord.solvers.ik import ARM_CLEARANCE, BimanualIK, PoseTarget, solve_from_scratch
 from agentchord.solvers.poses import quat_to_rotation
@@ -76,17 +75,6 @@ def other_branch(q6: np.ndarray) -> np.ndarray:
     return q
 
 
-def _line(start: PoseTarget, goal: PoseTarget, count: int) -> list[PoseTarget]:
-    """``count`` poses along the straight line from ``start`` to ``goal`` (the last is ``goal``)."""
-    turn = Slerp([0.0, 1.0], Rotation.concatenate([quat_to_rotation(start.quat), quat_to_rotation(goal.quat)]))
-    phases = np.arange(1, count + 1) / count
-    quats = turn(phases).as_quat()
-    return [
-        PoseTarget(pos=start.pos + s * (goal.pos - start.pos), quat=np.array([w, x, y, z]))
-        for s, (x, y, z, w) in zip(phases, quats)
-    ]
-
-
 def unflipped_solution(robot: RobotController, arm: str, pose: PoseTarget, start: np.ndarray | None = None) -> np.ndarray | None:
     """Joints that put ``arm``'s tool at ``pose`` on the unflipped branch, or None.
 
@@ -105,7 +93,7 @@ def unflipped_solution(robot: RobotController, arm: str, pose: PoseTarget, start
     q6 = solve_from_scratch(ik, q_full, arm, [pose])
     if q6 is None:
         ik.reset(q_full)
-        q6 = solve_from_scratch(ik, q_full, arm, _line(ik.tcp_pose(arm), pose, LINE_WAYPOINTS), from_home=False)
+        q6 = solve_from_scratch(ik, q_full, arm, line_poses(ik.tcp_pose(arm), pose, np.arange(1, LINE_WAYPOINTS + 1) / LINE_WAYPOINTS), from_home=False)
     if q6 is None or not is_flipped(q6):
         return q6
     mirrored = other_branch(q6)
