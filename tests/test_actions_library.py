@@ -6,10 +6,15 @@ from scipy.spatial.transform import Rotation
 
 from agentchord.actions.base import Status
 from agentchord.actions.controller import RobotController
+from agentchord.actions.finger_clearance import swept_hits
 from agentchord.actions.grasp import GraspMissed
+from agentchord.actions.joint_path import joint_path
 from agentchord.actions.library import make_action
+from agentchord.actions.motion import EMPTY_HAND_JOINT_SPEED
+from agentchord.actions.move import BACK_OPEN_WIDTH
 from agentchord.features.frame import tilt_deg
 from agentchord.features.oracle import OracleExtractor
+from agentchord.robot.aloha import HOME_Q
 from agentchord.worlds.sim.world import SimWorld
 
 
@@ -234,17 +239,52 @@ def test_back_opens_a_hand_closed_on_nothing_and_keeps_a_held_object(pour_scene,
     back = make_action("back", "right", {})
     back.initialise(robot)
     start = robot.commanded_pose("right").pos.copy()
-    grip_when_moving = None
+    span = float(np.max(np.abs(HOME_Q - robot.ik.arm_q("right"))))
+    grip_when_moving = width_when_moving = None
+    moving_ticks = 0
     while back.update(robot) == Status.RUNNING:
-        if grip_when_moving is None and np.linalg.norm(robot.commanded_pose("right").pos - start) > 0.005:
-            grip_when_moving = robot.targets["right"].grip
+        if grip_when_moving is None and np.linalg.norm(robot.commanded_pose("right").pos - start) > 0.001:
+            grip_when_moving, width_when_moving = robot.targets["right"].grip, world.gripper_width("right")
+        moving_ticks += grip_when_moving is not None
         robot.step()
         extractor.update()
     assert back.status == Status.SUCCESS
+    # An empty hand goes home twice as fast as one that holds something (the min-jerk move's
+    # first ticks, before the tool has gone 1 mm, are not counted).
+    expected = int(np.ceil(1.875 * span / (1.0 if holding else EMPTY_HAND_JOINT_SPEED) * 50))
+    assert expected - 8 <= moving_ticks <= expected + 1
     if holding:
         assert grip_when_moving == 1.0 and world.holding("right", "bottle")
     else:
-        assert grip_when_moving == 0.0
+        # The fingers opened before the arm set off.
+        assert grip_when_moving == 0.0 and width_when_moving >= BACK_OPEN_WIDTH
+
+
+@pytest.mark.parametrize("rising", [True, False])
+def test_an_empty_hand_rises_before_going_home_where_the_way_home_passes_its_fingers_through_an_object(
+    pour_scene, rising, monkeypatch
+):
+    # A side place's retreat leaves the fingers 8 cm back from the bottle's side; the joint-space
+    # move home from there can swing them through its top (stress protocol: the handover's block,
+    # seeds 30 and 32, knocked off its spot). The hand goes straight up first; without that, this
+    # bottle is knocked over.
+    if not rising:
+        monkeypatch.setattr("agentchord.actions.move.BACK_RISES", ())
+    world, robot, extractor = _setup(pour_scene)
+    assert _run(robot, extractor, make_action("grasp", "right", {"obj": "bottle"}))[0] == Status.SUCCESS
+    place = make_action("place", "right", {"obj": "bottle", "target": [0.2, 0.4]})
+    assert _run(robot, extractor, place)[0] == Status.SUCCESS
+    assert swept_hits(robot.frame, None, list(joint_path(robot, "right", HOME_Q).tool_poses))
+    at = world.object_pose("bottle")[0].copy()
+    assert _run(robot, extractor, make_action("back", "right", {}))[0] == Status.SUCCESS
+    for _ in range(50):
+        robot.step()
+    extractor.update()
+    moved = float(np.linalg.norm(world.object_pose("bottle")[0] - at))
+    if rising:
+        assert moved < 0.005 and tilt_deg(robot.frame.objects["bottle"].axis) < 2.0
+    else:
+        assert moved > 0.05
 
 
 def _place_cup(world, at) -> None:

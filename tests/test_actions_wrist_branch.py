@@ -1,5 +1,5 @@
-"""The wrist's two branches: the mirrored joints, the unflipped solution, the joint-path check, and
-the fallen grasp's turn upright on the unflipped branch (real physics)."""
+"""The wrist's two branches: the mirrored joints, the unflipped solution, and the fallen grasp's
+turn upright on the unflipped branch (real physics)."""
 
 import numpy as np
 import pytest
@@ -11,7 +11,6 @@ from agentchord.actions.motion import pose_from_matrix
 from agentchord.actions.wrist_branch import (
     is_flipped,
     is_wound,
-    joint_path,
     other_branch,
     unflipped_solution,
 )
@@ -62,22 +61,6 @@ def test_an_unflipped_solution_reaches_the_pose_the_live_ik_reaches_flipped(pour
     ik.set_arm_q("right", q)
     reached = ik.tcp_pose("right")
     assert np.linalg.norm(reached.pos - pose.pos) < 0.01 and _angle(reached.quat, pose.quat) < 0.05
-
-
-def test_a_joint_path_reports_the_lowest_tool_the_held_points_and_the_arms_clearance(pour_scene):
-    _, robot, _ = _setup(pour_scene)
-    q = robot.ik.arm_q("right")
-    tool = robot.ik.tcp_pose("right")
-    point = np.array([[0.0, 0.0, -0.1]])  # 10 cm down the tool's up axis
-    still = joint_path(robot, "right", q, held=point)
-    assert still.lowest_tool == pytest.approx(tool.pos[2], abs=1e-9)
-    expected = tool.pos[2] + (quat_to_rotation(tool.quat).as_matrix() @ point[0])[2]
-    assert still.lowest_held == pytest.approx(expected, abs=1e-9)
-    assert still.clearance == pytest.approx(robot.ik.arm_clearance(), abs=1e-9) and still.clearance > 0.0
-    # A move toward a lower posture passes lower than where it starts.
-    lower = q.copy()
-    lower[1] += 0.4
-    assert joint_path(robot, "right", lower).lowest_tool < tool.pos[2]
 
 
 @pytest.mark.parametrize(("at", "yaw"), [((0.2, 0.45), 3.0), ((0.08, 0.5), 2.0), ((0.0, 0.45), -1.5)])

@@ -79,3 +79,22 @@ def test_binding_is_at_rest_once_the_objects_stay_still_and_low():
     binding.still = 0
     lifted = _frame(pos=(0.0, 0.3, 0.2), held=False)  # still, but in mid-air: not a resting place
     assert not any(binding.at_rest(lifted, 50.0) for _ in range(20))
+
+
+@pytest.mark.parametrize("wait_ticks", [None, 100])
+def test_a_recovery_waits_for_a_person_to_set_a_pulled_object_down(wait_ticks):
+    # Real-world protocol, single-arm pour, seed 48: the second pull's person held the bottle clear of
+    # the hand and carried it for 2.8 s. With a 2 s wait the recovery was bound to it in mid-air, over
+    # the cup, where no arm's IK finds a grasp: "unrecoverable". The wait now outlasts the person's
+    # longest pull (3.3 s); the bottle is on the table and the left arm fetches it.
+    from agentchord.execution.episode import EpisodeSpec, run_episode
+    from agentchord.execution.executor import ExecutorConfig
+    from agentchord.worlds.sim.disturbances import PRESETS
+
+    config = None if wait_ticks is None else ExecutorConfig(bind_wait_ticks=wait_ticks)
+    result = run_episode(EpisodeSpec("single_arm_pour_water", seed=48, protocol=True, disturb=PRESETS["real"], config=config))
+    if wait_ticks is None:
+        assert result.success, result.reason
+        assert max(b["waited_ticks"] for b in result.trace.of("recovery_bound")) > 100
+    else:
+        assert not result.success and result.reason.startswith("unrecoverable")

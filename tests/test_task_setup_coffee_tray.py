@@ -1,6 +1,7 @@
 """Setup coffee tray: the compound tray, the success check both ways, the library graph, a recovered drop."""
 
 import numpy as np
+import pytest
 
 from agentchord.execution.episode import EpisodeSpec, run_episode
 from agentchord.expr import Vocabulary, compile_expr
@@ -8,7 +9,7 @@ from agentchord.features.oracle import OracleExtractor
 from agentchord.graph.progress import forward_filter, nominal_path
 from agentchord.graph.validation import check_graph
 from agentchord.tasks import load_task_graph
-from agentchord.worlds.sim.disturbances import ScriptedDrop
+from agentchord.worlds.sim.disturbances import ScriptedDisturbance, ScriptedDrop
 from agentchord.worlds.sim.tasks import SIM_TASKS
 from agentchord.worlds.sim.tasks.setup_coffee_tray import TRAY_TARGET, CoffeeTrayTracker, capsule_in_tray
 from agentchord.worlds.sim.world import SimWorld
@@ -145,3 +146,23 @@ def test_a_tray_dropped_during_the_carry_is_recovered_forward():
     # Forward-moving: from the recovery straight to the carry's target, no earlier node revisited.
     after = result.path[result.path.index("e4_r_tray_dropped"):]
     assert after[:2] == ["e4_r_tray_dropped", "v4"] and not {"v0", "v1", "v2", "v3"} & set(after)
+
+
+@pytest.mark.parametrize("watched", [True, False])
+def test_a_capsule_taken_out_of_the_tray_as_the_hand_opens_is_put_back_before_the_tray_is_grasped(watched):
+    # Taken out just as the fingers opened on it (stress protocol, seed 22): the drop monitor is
+    # gated by the closed hand and did not see it; the capsule was missed until the tray was
+    # carried, where only the left arm (holding the tray) is asked to put it back.
+    graph = load_task_graph("setup_coffee_tray")
+    if not watched:
+        for edge in graph.edges:
+            edge.failures = [f for f in edge.failures if f.name != "capsule_taken_out"]
+    pull = ScriptedDisturbance("place", "pull", after=145, seed=0, spot=(-0.2, 0.5))
+    result = run_episode(EpisodeSpec("setup_coffee_tray", seed=0, graph=graph, disturbance=pull))
+    assert result.success, result.reason
+    first = result.trace.of("failure_detected")[0]
+    if watched:
+        assert (first["edge"], first["failure"]) == ("e2", "capsule_taken_out")
+        assert result.trace.of("recovery_switch")[0]["to"] == "e2_r_capsule_dropped"
+    else:
+        assert (first["edge"], first["failure"]) == ("e4", "capsule_out")

@@ -63,10 +63,11 @@ def test_a_bottle_knocked_over_as_it_is_taken_again_is_taken_as_a_fallen_one():
 
 
 def test_a_fork_pushed_against_the_plate_is_taken_farther_along_its_length():
-    # Stress protocol, seed 2: the fork is pushed against the plate's rim during the recovery's
-    # grasp. Taken at its centre, the left finger came down on the rim and the tool stopped 1.8 cm
-    # above the grasp, for both arms ("stopped short"); the grasp now slides along the fork.
-    result = run_episode(EpisodeSpec("rearrange_table", seed=2, protocol=True, disturb=KINDS))
+    # Stress protocol, seed 86 (seed 2 until the empty hand went home faster and the moments
+    # moved): the fork, placed, is pushed against the plate's rim. Taken at its centre, a finger
+    # comes down on the rim and the tool stops 1.5 cm above the grasp ("stopped short"); the grasp
+    # slides along the fork.
+    result = run_episode(EpisodeSpec("rearrange_table", seed=86, protocol=True, disturb=KINDS))
     assert result.success, result.reason
     assert _recoveries(result) == ["e4_r_fork_moved"]
 
@@ -117,11 +118,11 @@ def _top_grasps_at_the_centre(monkeypatch, report_blocked: bool) -> None:
 
 
 def test_an_arm_that_falls_short_of_a_pushed_object_is_not_blamed_on_the_other_arm(monkeypatch):
-    # Seed 2 again with the fork taken at its centre and nothing known of what the fingers land on:
-    # the right arm stops short with both tools near each other but its links 12 cm clear of the
-    # left arm's; the reason used to say "the other arm was in the way".
+    # Seed 86 again with the fork taken at its centre and nothing known of what the fingers land on:
+    # the arm stops short with its links 5 cm clear of the other arm's; the reason used to say "the
+    # other arm was in the way".
     _top_grasps_at_the_centre(monkeypatch, report_blocked=False)
-    result = run_episode(EpisodeSpec("rearrange_table", seed=2, protocol=True, disturb=KINDS))
+    result = run_episode(EpisodeSpec("rearrange_table", seed=86, protocol=True, disturb=KINDS))
     assert not result.success
     assert "stopped short of the grasp of fork" in result.reason
     assert "in the way" not in result.reason
@@ -131,7 +132,7 @@ def test_fingers_that_come_down_on_a_neighbour_are_named_in_the_reason(monkeypat
     # The same grasp, its fingers known to overlap the plate and no clear one chosen: the reason
     # says what they came down on.
     _top_grasps_at_the_centre(monkeypatch, report_blocked=True)
-    result = run_episode(EpisodeSpec("rearrange_table", seed=2, protocol=True, disturb=KINDS))
+    result = run_episode(EpisodeSpec("rearrange_table", seed=86, protocol=True, disturb=KINDS))
     assert not result.success
     assert "the open fingers came down on plate beside fork" in result.reason
 

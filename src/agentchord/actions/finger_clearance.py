@@ -131,12 +131,13 @@ def side_approach_blocking(
 
 
 def swept_hits(
-    frame: FeatureFrame, obj: str, tool_poses: list[tuple[np.ndarray, np.ndarray]],
+    frame: FeatureFrame, obj: str | None, tool_poses: list[tuple[np.ndarray, np.ndarray]],
     held: np.ndarray | None = None, held_radius: float = 0.0,
 ) -> dict[str, int]:
-    """The neighbours of ``obj`` that the open fingers pass through along sampled tool poses
-    (position, rotation), and with ``held`` (points along a held object's axis, tool frame) what
-    the held object passes through (within ``held_radius`` of those points)."""
+    """The neighbours of ``obj`` (every object where None: an empty hand going away) that the open
+    fingers pass through along sampled tool poses (position, rotation), and with ``held`` (points
+    along a held object's axis, tool frame) what the held object passes through (within
+    ``held_radius`` of those points)."""
     hits: dict[str, int] = {}
     for point, rotation in tool_poses:
         found = [_neighbours_hit(frame, obj, open_finger_points(point, rotation), 0.0)]
@@ -148,17 +149,18 @@ def swept_hits(
     return hits
 
 
-def _neighbours_hit(frame: FeatureFrame, obj: str, points: np.ndarray, clearance: float) -> dict[str, int]:
-    """How many of ``points`` lie within ``clearance`` of each neighbour of ``obj``.
+def _neighbours_hit(frame: FeatureFrame, obj: str | None, points: np.ndarray, clearance: float) -> dict[str, int]:
+    """How many of ``points`` lie within ``clearance`` of each neighbour of ``obj`` (of every object
+    where None).
 
     A neighbour under the object's centre is one it rests on or in: the fingers reach in there.
     """
-    centre = frame.objects[obj].pos
+    centre = None if obj is None else frame.objects[obj].pos
     hits = {}
     for name, feats in frame.objects.items():
         if name == obj or float(np.max(feats.extent)) < POINT_EXTENT:
             continue  # a point feature (a cloth's corner) lies flat in the cloth: nothing to land on
-        if _inside(feats, np.array([[centre[0], centre[1], feats.pos[2]]]))[0]:
+        if centre is not None and _inside(feats, np.array([[centre[0], centre[1], feats.pos[2]]]))[0]:
             continue  # the object rests on or in it (a fork on the plate, a capsule in the tray): reach in
         count = int(np.count_nonzero(_inside(feats, points, clearance)))
         if count:

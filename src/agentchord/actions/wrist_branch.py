@@ -22,6 +22,7 @@ import numpy as np
 
 from agentchord.actions.controller import RobotController
 from agentchord.actions.finger_clearance import swept_hits
+from agentchord.actions.joint_path import joint_path
 from agentchord.actions.motion import ANGULAR_SPEED, EMPTY_HAND_JOINT_SPEED, line_poses, move_joints, pose_from_matrix
 from agentchord.robot.aloha import ARM_JOINTS, ARM_PREFIX
 from agentchord.solvers.ik import ARM_CLEARANCE, BimanualIK, PoseTarget, solve_from_scratch
@@ -31,8 +32,6 @@ from agentchord.solvers.poses import quat_to_rotation
 FLIPPED_ROLL = 0.5 * np.pi
 #: Wrist rotate beyond this (rad) from 0: wound (a pour's roll would run it past its limit).
 WOUND_ROTATE = 0.5 * np.pi
-#: Joint-path samples checked (tool height, the fingers' and the held object's sweep, the other arm).
-PATH_SAMPLES = 24
 #: A joint-space move keeps the arms' collision proxies (which wrap the links) this far apart (m):
 #: half the live IK's margin, which a straight line's solver needs to steer by.
 PATH_CLEARANCE = 0.5 * ARM_CLEARANCE
@@ -118,54 +117,6 @@ def _with_arm(robot: RobotController, arm: str, q6: np.ndarray) -> np.ndarray:
     ik.reset(robot.ik.configuration.q.copy())
     ik.set_arm_q(arm, q6)
     return ik.configuration.q.copy()
-
-
-@dataclass(frozen=True)
-class JointPath:
-    """What a straight joint-space move would do, from samples of its forward kinematics.
-
-    Attributes:
-        lowest_tool: The tool centre's lowest height (m) along the move.
-        lowest_held: The lowest height (m) of the held points along the move (inf: none given).
-        clearance: The smallest distance (m) between the two arms' collision proxies.
-        tool_poses: The sampled tool poses (position, rotation matrix).
-    """
-
-    lowest_tool: float
-    lowest_held: float
-    clearance: float
-    tool_poses: tuple[tuple[np.ndarray, np.ndarray], ...] = ()
-
-
-def joint_path(
-    robot: RobotController, arm: str, q_goal: np.ndarray, held: np.ndarray | None = None, q_start: np.ndarray | None = None
-) -> JointPath:
-    """Check the straight joint-space move of ``arm`` from ``q_start`` (its current joints) to ``q_goal``.
-
-    Args:
-        robot: The robot (read only: the check runs on a scratch solver; the other arm stays
-            where the live solution has it).
-        arm: The moving arm.
-        q_goal: Its six goal joints.
-        held: Points (n x 3, m) rigidly held by the tool, in the tool frame: the lowest of them
-            along the move is reported.
-        q_start: Its six start joints.
-    """
-    ik = robot.scratch_ik()
-    ik.reset(robot.ik.configuration.q.copy())
-    q0 = robot.ik.arm_q(arm) if q_start is None else np.asarray(q_start, dtype=float)
-    lowest_tool, lowest_held, clearance = np.inf, np.inf, np.inf
-    poses = []
-    for s in np.linspace(0.0, 1.0, PATH_SAMPLES + 1):
-        ik.set_arm_q(arm, q0 + s * (np.asarray(q_goal) - q0))
-        pose = ik.tcp_pose(arm)
-        rotation = quat_to_rotation(pose.quat).as_matrix()
-        poses.append((pose.pos.copy(), rotation))
-        lowest_tool = min(lowest_tool, float(pose.pos[2]))
-        if held is not None and len(held):
-            lowest_held = min(lowest_held, float(np.min((pose.pos + held @ rotation.T)[:, 2])))
-        clearance = min(clearance, ik.arm_clearance())
-    return JointPath(lowest_tool=lowest_tool, lowest_held=lowest_held, clearance=clearance, tool_poses=tuple(poses))
 
 
 @dataclass(frozen=True)
