@@ -155,10 +155,18 @@ class Binding:
                   for o in self.objects if o in self.previous]
         self.previous = {o: frame.objects[o].pos.copy() for o in self.objects}
         # At rest on the table: still, and low (a hand pausing mid-air is not a resting place).
-        low = all(min(frame.objects[o].bottom[2], frame.objects[o].top[2]) < RESTING_HEIGHT for o in self.objects)
-        still = len(speeds) == len(self.objects) and max(speeds) < REST_SPEED and low
+        still = len(speeds) == len(self.objects) and max(speeds) < REST_SPEED and not self.aloft(frame)
         self.still = self.still + 1 if still else 0
         return self.still >= REST_TICKS
+
+    def aloft(self, frame: FeatureFrame, rigid_only: bool = False) -> bool:
+        """Whether some object's lower end is above the table (in a person's hand, on another object;
+        a cloth's corner hanging from a hand that holds another), with ``rigid_only`` not counting
+        a cloth's corners."""
+        return any(
+            min(frame.objects[o].bottom[2], frame.objects[o].top[2]) >= RESTING_HEIGHT
+            for o in self.objects if not (rigid_only and float(np.max(frame.objects[o].extent)) < POINT_EXTENT)
+        )
 
     def holds_back(self, frame: FeatureFrame) -> bool:
         """Count this tick toward a cleared failure; whether every lost hold has been back long enough."""

@@ -94,7 +94,10 @@ class RecoverySwitching:
         if binding.holds_back(frame):
             self._resume(binding)
             return None
-        if not binding.at_rest(frame, CONTROL_HZ) and waited < self.config.bind_wait_ticks:
+        # Longer while a rigid object is held up (a person still carrying it); a cloth's corner
+        # hanging from the other hand, or jittering on the table, is not waited for longer.
+        limit = self.config.bind_aloft_wait_ticks if binding.aloft(frame, rigid_only=True) else self.config.bind_wait_ticks
+        if not binding.at_rest(frame, CONTROL_HZ) and waited < limit:
             return None
         self.binding = None
         if binding.suspended is not None:
