@@ -159,14 +159,14 @@ class Binding:
         self.still = self.still + 1 if still else 0
         return self.still >= REST_TICKS
 
-    def aloft(self, frame: FeatureFrame, rigid_only: bool = False) -> bool:
-        """Whether some object's lower end is above the table (in a person's hand, on another object;
-        a cloth's corner hanging from a hand that holds another), with ``rigid_only`` not counting
-        a cloth's corners."""
-        return any(
-            min(frame.objects[o].bottom[2], frame.objects[o].top[2]) >= RESTING_HEIGHT
-            for o in self.objects if not (rigid_only and float(np.max(frame.objects[o].extent)) < POINT_EXTENT)
-        )
+    def aloft(self, frame: FeatureFrame) -> bool:
+        """Whether some object's lower end is above the table (in a person's hand, on another object,
+        a cloth's corner hanging from a hand that holds another)."""
+        return any(min(frame.objects[o].bottom[2], frame.objects[o].top[2]) >= RESTING_HEIGHT for o in self.objects)
+
+    def rigid(self, frame: FeatureFrame) -> bool:
+        """Whether some object is a rigid body, not a cloth's corner (a point feature)."""
+        return any(float(np.max(frame.objects[o].extent)) >= POINT_EXTENT for o in self.objects)
 
     def holds_back(self, frame: FeatureFrame) -> bool:
         """Count this tick toward a cleared failure; whether every lost hold has been back long enough."""

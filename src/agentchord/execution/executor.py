@@ -61,12 +61,13 @@ class ExecutorConfig:
     max_repairs: int = 2
     #: Ticks an object must stay off the table before the episode ends as unrecoverable.
     off_table_ticks: int = 5
-    #: Ticks a recovery waits for the objects it grasps to come to rest before binding its arm ...
+    #: Ticks a recovery waits for the objects it grasps to come to rest before binding its arm: a
+    #: cloth's corners (they jitter on the table, or hang from the other hand) ...
     bind_wait_ticks: int = 100
-    #: ... and while one is still held up off the table: a person's pull takes up to 3.3 s to set
-    #: the object down (out of the fingers, held clear of a moving gripper for up to 1.5 s,
-    #: carried, lowered, held still: ``worlds/sim/hand.py``).
-    bind_aloft_wait_ticks: int = 200
+    #: ... and a rigid object: a person's pull takes up to 3.3 s to set it down (out of the
+    #: fingers, held clear of a moving gripper for up to 1.5 s, carried, lowered, held still:
+    #: ``worlds/sim/hand.py``).
+    bind_rigid_wait_ticks: int = 200
     #: Ticks a failing goal verdict waits, arms still, for a scene that still moves (a cloth's vertices
     #: jittering in contact, a tray rocking after release, a bottle knocked over as the arm got home)
     #: to come to rest; the last edge's monitors keep watching meanwhile.

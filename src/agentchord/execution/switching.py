@@ -94,9 +94,9 @@ class RecoverySwitching:
         if binding.holds_back(frame):
             self._resume(binding)
             return None
-        # Longer while a rigid object is held up (a person still carrying it); a cloth's corner
-        # hanging from the other hand, or jittering on the table, is not waited for longer.
-        limit = self.config.bind_aloft_wait_ticks if binding.aloft(frame, rigid_only=True) else self.config.bind_wait_ticks
+        # Longer for a rigid object (a person may still be carrying it, low over the table or held
+        # up) than for a cloth's corners, which jitter on the table or hang from the other hand.
+        limit = self.config.bind_rigid_wait_ticks if binding.rigid(frame) else self.config.bind_wait_ticks
         if not binding.at_rest(frame, CONTROL_HZ) and waited < limit:
             return None
         self.binding = None
