@@ -176,8 +176,8 @@ class Back(ArmAction):
         an object; None where the way home from here is clear, or no rise makes it so.
 
         Measured before this check (stress protocol, seeds 0-7, 30, 32): the way home from a side
-        place's retreat passed the fingers through the bottle or block just set down in 9 of 60
-        episodes of the pours and the handover; at the empty-hand speed that knocked the block
+        place's retreat passed the fingers through the bottle or block just set down in 9 of the 30
+        episodes of the pours and the handover (none of the other three tasks' 30); at the empty-hand speed that knocked the block
         off its spot and left it rocking (handover seeds 30, 32).
         """
         frame = robot.frame
