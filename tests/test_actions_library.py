@@ -372,3 +372,33 @@ def test_a_bottle_held_off_centre_by_a_fallen_grasp_is_carried_to_where_a_centre
         assert miss < 0.01
     else:
         assert miss > 0.015
+
+
+@pytest.mark.parametrize("confirmed", [True, False])
+def test_a_hand_off_spot_is_one_the_taker_reaches_with_the_top_down_grasp_it_will_make(confirmed, monkeypatch):
+    """Coffee tray stress seed 22: the capsule, dropped 0.60 m from the left shoulder, is inside the
+    side-grasp reach shell, so the right arm set it down where it lay, where the left arm's top-down
+    grasp ends 2 cm short. The IK-confirmed spot is 2 cm nearer the left arm, and the left arm takes it."""
+    from agentchord.actions import place
+    from agentchord.worlds.sim.tasks import SIM_TASKS
+
+    if not confirmed:
+        monkeypatch.setattr(place, "_top_grasp_reaches", lambda *args: True)
+    world, robot, extractor = _setup(SIM_TASKS["setup_coffee_tray"].sample_scene(np.random.default_rng([0, 0x5CE7E])))
+    adr = world.model.joint("capsule_free").qposadr[0]
+    world.data.qpos[adr : adr + 2] = (0.10, 0.32)
+    for _ in range(60):
+        world.step()
+    extractor.update()
+    assert _run(robot, extractor, make_action("grasp", "right", {"obj": "capsule", "mode": "top"}))[0] == Status.SUCCESS
+    hand_off = make_action("place", "right", {"obj": "capsule", "within_reach": "left"})
+    assert _run(robot, extractor, hand_off)[0] == Status.SUCCESS
+    assert _run(robot, extractor, make_action("back", "right", {}))[0] == Status.SUCCESS
+    set_down = world.object_pose("capsule")[0]
+    status, _ = _run(robot, extractor, make_action("grasp", "left", {"obj": "capsule", "mode": "top"}))
+    if confirmed:
+        assert set_down[0] < 0.09  # moved towards the left arm
+        assert status == Status.SUCCESS and robot.frame.is_holding("left", "capsule")
+    else:
+        assert abs(set_down[0] - 0.10) < 0.01  # where it lay
+        assert status == Status.FAILURE

@@ -71,3 +71,18 @@ def test_a_busy_hand_cannot_take_another_object():
     robot.frame.holding = {("left", "cup")}
     check = FeasibilityChecker(robot).check_grasp(Grasp("left", GraspArgs(obj="bottle")))
     assert not check.feasible and "holds cup" in check.reason
+
+
+def test_a_hand_pinching_one_corner_of_the_cloth_is_free_for_another_and_a_rigid_object_keeps_it_busy():
+    # Fold towel, real protocol seed 47: a bottom corner that slipped onto its top corner is re-pinched
+    # with it; the grasp of the bottom corner opens the hand first, so the pinched top corner does not
+    # make the arm busy (the episode ended "no feasible recovery: the left arm holds towel_tl").
+    world = SimWorld(SIM_TASKS["fold_towel"].sample_scene(np.random.default_rng([0, 0x5CE7E])))
+    robot = RobotController(world)
+    robot.frame = make_extractor("oracle", world, lambda arm: False).update()
+    robot.frame.holding = {("left", "towel_tl")}
+    assert FeasibilityChecker(robot).check_grasp(Grasp("left", GraspArgs(obj="towel_bl", mode="top"))).feasible
+    robot = _robot()
+    robot.frame.holding = {("left", "cup")}
+    assert not FeasibilityChecker(robot).check_grasp(Grasp("left", GraspArgs(obj="cup"))).reason  # its own object: free
+    assert "holds cup" in FeasibilityChecker(robot).check_grasp(Grasp("left", GraspArgs(obj="bottle"))).reason

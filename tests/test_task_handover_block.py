@@ -169,3 +169,22 @@ def test_a_receiving_grip_lost_as_the_left_lets_go_is_caught_before_the_block_fa
     assert result.success, result.reason
     assert [(e["edge"], e["failure"]) for e in result.trace.of("failure_detected")] == [("e3", "transfer_failed")]
     assert result.path[result.path.index("e3"):][:3] == ["e3", "e3_r_transfer_failed", "v3"]
+
+
+@pytest.mark.parametrize("max_tilt", [None, 25.0])
+def test_a_block_taken_askew_at_the_hand_over_is_set_upright_in_hand_before_it_is_placed(max_tilt, monkeypatch):
+    # Real-world protocol, seed 43: the block was pushed as the right hand closed on it at the hand-over
+    # and was held 39 deg askew. Turned upright over its spot, it is placed standing; with the old
+    # bound (the 25 deg upright tolerance) it was set down askew, leant on the opening fingers, and
+    # was dragged by the retreat to where neither arm's IK finds a grasp: "unrecoverable".
+    from agentchord.actions import place
+    from agentchord.worlds.sim.disturbances import PRESETS
+
+    if max_tilt is not None:
+        monkeypatch.setattr(place, "UPRIGHT_IN_HAND_MAX_DEG", max_tilt)
+    result = run_episode(EpisodeSpec(TASK, seed=43, protocol=True, disturb=PRESETS["real"]))
+    if max_tilt is None:
+        assert result.success, result.reason
+        assert not [d for d in result.trace.of("failure_detected") if d["edge"] == "e5"]  # placed standing
+    else:
+        assert not result.success and result.reason.startswith("unrecoverable")

@@ -64,6 +64,31 @@ class GraspMissed(ActionFailed):
     """The fingers closed but the object is not between them."""
 
 
+def plain_top_grasp(feats: ObjectFeatures) -> tuple[np.ndarray, np.ndarray]:
+    """The top-down grasp of an object where it lies, before any clearance or offset is applied.
+
+    Returns:
+        ``(long_dir, point)``: the object's long horizontal direction (unit; the fingers close
+        across it) and the tool centre, whose finger tips go 70 % down the object (at most 3 cm)
+        and never closer than 4 mm to the table.
+    """
+    rot = _matrix(feats.quat)
+    lying = tilt_deg(feats.axis) >= Grasp.FALLEN_DEG
+    # The object's horizontal principal direction: its axis if lying, else its longer side.
+    if lying:
+        long_dir = feats.axis
+    else:
+        long_dir = rot[:, 0] if feats.extent[0] >= feats.extent[1] else rot[:, 1]
+    long_dir = np.array([long_dir[0], long_dir[1], 0.0])
+    if np.linalg.norm(long_dir) < 1e-6:
+        long_dir = np.array([1.0, 0.0, 0.0])
+    long_dir /= np.linalg.norm(long_dir)
+    top_z = feats.pos[2] + 0.5 * feats.extent[0] if lying else max(feats.top[2], feats.bottom[2])
+    height = top_z - min(feats.bottom[2], feats.top[2]) if not lying else float(feats.extent[0])
+    tips_z = max(top_z - min(0.7 * height, 0.03), 0.004)
+    return long_dir, np.r_[feats.pos[:2], tips_z + Grasp.FINGERTIP_REACH]
+
+
 class Grasp(ArmAction):
     """Grasp an object wherever it is, then lift it; a fallen object is set upright in hand.
 
@@ -364,22 +389,7 @@ class Grasp(ArmAction):
         attempt's first look is kept, so re-observing the object does not move the grasp around.
         """
         feats = robot.frame.objects[self.args.obj]
-        rot = _matrix(feats.quat)
-        # The object's horizontal principal direction: its axis if lying, else its longer side.
-        if tilt_deg(feats.axis) >= self.FALLEN_DEG:
-            long_dir = feats.axis
-        else:
-            long_dir = rot[:, 0] if feats.extent[0] >= feats.extent[1] else rot[:, 1]
-        long_dir = np.array([long_dir[0], long_dir[1], 0.0])
-        if np.linalg.norm(long_dir) < 1e-6:
-            long_dir = np.array([1.0, 0.0, 0.0])
-        long_dir /= np.linalg.norm(long_dir)
-        lying = tilt_deg(feats.axis) >= self.FALLEN_DEG
-        top_z = feats.pos[2] + 0.5 * feats.extent[0] if lying else max(feats.top[2], feats.bottom[2])
-        height = top_z - min(feats.bottom[2], feats.top[2]) if not lying else float(feats.extent[0])
-        # Finger tips go 70% down the object (at most 3 cm), never closer than 4 mm to the table.
-        tips_z = max(top_z - min(0.7 * height, 0.03), 0.004)
-        point = np.r_[feats.pos[:2], tips_z + self.FINGERTIP_REACH]
+        long_dir, point = plain_top_grasp(feats)
         if np.any(np.asarray(self.args.offset) != 0.0):
             choice = TopGraspChoice()  # a grasp point the graph asked for (a tray's handle) stays put
         elif keep_choice and self._top_choice is not None:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
+from dataclasses import replace
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -11,18 +12,27 @@ from agentchord.actions import catalog
 from agentchord.actions.base import ActionFailed, ArmAction, ObjectGone
 from agentchord.actions.controller import RobotController
 from agentchord.actions.geometry import _level, _matrix, _yaw_turn
-from agentchord.actions.grasp import UPRIGHT_TOLERANCE_DEG, Grasp
+from agentchord.actions.grasp import UPRIGHT_TOLERANCE_DEG, Grasp, plain_top_grasp
 from agentchord.actions.motion import grip, move_to, pose_from_matrix, settle, wait_for_rest
-from agentchord.features.frame import FeatureFrame, tilt_deg
+from agentchord.features.frame import FeatureFrame, ObjectFeatures, tilt_deg
 from agentchord.solvers.exceptions import NoHandoffSpotError
-from agentchord.solvers.handoff import handoff_spot
+from agentchord.solvers.handoff import TAKER_MARGIN, handoff_spot
+from agentchord.solvers.ik import solve_from_scratch
 from agentchord.robot.aloha import FINGER_GAP_OFFSET, FINGER_RANGE
 
+#: Extra reach slack (m) tried in turn for a hand-off spot until the IK confirms the taker's top-down grasp there.
+HANDOFF_EXTRA_MARGINS = (0.0, 0.02, 0.04, 0.06, 0.08)
+#: Position residual (m) under which the IK counts a hand-off grasp pose as reached (as the feasibility check).
+HANDOFF_IK_TOLERANCE = 0.01
 #: Largest extent (m) of a point feature (a cloth corner) rather than a body.
 POINT_EXTENT = 0.01
 #: A tall object tilted more than this in the hand (deg) is turned upright before it is put down,
 #: with its bottom at least this high (m) while it turns.
 LEVEL_IN_HAND_DEG = 4.0
+#: ... and at most this tilted (deg): more is a hold across the object (a fork, a bottle lying), not askew.
+#: A hand-over grasp pushed as it closed held the block at 39 deg (handover, real protocol seed 43);
+#: the bound was the upright tolerance (25 deg) and the block, set down askew, leant on the fingers.
+UPRIGHT_IN_HAND_MAX_DEG = 50.0
 LEVEL_CLEARANCE = 0.02
 #: Finger gap beyond the object's width (m) when releasing it inside a rim.
 RELEASE_MARGIN = 0.02
@@ -42,6 +52,21 @@ def _long_axis(feats) -> np.ndarray:
         return feats.axis
     rot = _matrix(feats.quat)
     return rot[:, 0] if feats.extent[0] >= feats.extent[1] else rot[:, 1]
+
+
+def _top_grasp_reaches(robot: RobotController, arm: str, feats: ObjectFeatures, spot: np.ndarray) -> bool:
+    """Whether the IK puts ``arm``'s tool above and at a top-down grasp of the object set down at ``spot``."""
+    shift = np.r_[spot - feats.pos[:2], -min(feats.bottom[2], feats.top[2])]
+    there = replace(feats, pos=feats.pos + shift, top=feats.top + shift, bottom=feats.bottom + shift)
+    long_dir, point = plain_top_grasp(there)
+    if np.dot(long_dir[:2], there.pos[:2] - robot.world.arm_base(arm)[:2]) < 0:
+        long_dir = -long_dir  # the finger orientation facing away from the arm's base, as the grasp takes
+    down = np.array([0.0, 0.0, -1.0])
+    rotation = np.column_stack([down, np.cross(long_dir, down), long_dir])
+    above = point + np.array([0.0, 0.0, catalog.GraspArgs.model_fields["pre_grasp_dis"].default])
+    poses = [pose_from_matrix(above, rotation), pose_from_matrix(point, rotation)]
+    ik = robot.scratch_ik(avoid_other_arm=False)
+    return solve_from_scratch(ik, robot.ik.configuration.q.copy(), arm, poses, HANDOFF_IK_TOLERANCE) is not None
 
 
 class Place(ArmAction):
@@ -86,10 +111,7 @@ class Place(ArmAction):
         if target is not None and self.args.relative_to is not None:
             target = target + robot.frame.objects[self.args.relative_to].pos[:2]
         if self.args.within_reach is not None:
-            try:
-                target = handoff_spot(robot.frame, self.args.obj, arm, self.args.within_reach)
-            except NoHandoffSpotError as error:
-                raise ActionFailed(str(error)) from None
+            target = self._handoff_target(robot)
         if self.args.yaw is not None:
             # Turn the tool about the vertical so the object's long axis ends at the asked yaw
             # (either direction), keeping the object's centre where it goes.
@@ -120,6 +142,30 @@ class Place(ArmAction):
         if robot.targets[arm].grip > 0.0:
             yield from grip(robot, arm, 0.0, ticks=6)  # clear of the rim: open fully for the next grasp
 
+    def _handoff_target(self, robot: RobotController) -> np.ndarray:
+        """Where to set the object down for the other arm: the nearest spot both arms reach.
+
+        The reach shell was measured for side grasps; a top-down tool reaches less far (the coffee
+        tray's capsule, stress seed 22: set down 0.60 m from the taker's shoulder, its grasp 2 cm
+        short). An object the taker will take from above gets a spot the IK confirms, moved towards
+        the middle of the taker's shell until one is; none confirmed, the nearest spot it is.
+        """
+        frame, taker = robot.frame, self.args.within_reach
+        feats = frame.objects[self.args.obj]
+        from_above = float(np.linalg.norm(feats.top - feats.bottom)) < Grasp.SIDE_MIN_HEIGHT
+        nearest = None
+        for extra in HANDOFF_EXTRA_MARGINS:
+            try:
+                spot = handoff_spot(frame, self.args.obj, self.arm, taker, taker_margin=TAKER_MARGIN + extra)
+            except NoHandoffSpotError as error:
+                if nearest is None:
+                    raise ActionFailed(str(error)) from None
+                break
+            nearest = spot if nearest is None else nearest
+            if not from_above or _top_grasp_reaches(robot, taker, feats, spot):
+                return spot
+        return nearest
+
     def _upright_in_hand(self, robot: RobotController, rotation: np.ndarray) -> Iterator[None]:
         """Over the spot, turn a tall object held askew (an off-centre regrasp) upright before lowering it.
 
@@ -132,7 +178,7 @@ class Place(ArmAction):
         if obj.extent[2] <= 1.5 * max(obj.extent[0], obj.extent[1]):
             return rotation
         angle = tilt_deg(obj.axis)
-        if angle < LEVEL_IN_HAND_DEG or angle > UPRIGHT_TOLERANCE_DEG:
+        if angle < LEVEL_IN_HAND_DEG or angle > UPRIGHT_IN_HAND_MAX_DEG:
             return rotation
         tool = robot.commanded_pose(self.arm).pos
         lift = max(0.0, LEVEL_CLEARANCE - float(min(obj.bottom[2], obj.top[2])))

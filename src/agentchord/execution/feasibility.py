@@ -59,6 +59,16 @@ def off_table(frame: FeatureFrame, objects: list[str]) -> list[str]:
     return lost
 
 
+def _both_corners(frame: FeatureFrame, held: str, wanted: str) -> bool:
+    """Whether ``held`` and ``wanted`` are both a cloth's corners (point features).
+
+    A hand pinching one corner is not busy for another: the grasp opens it first. A corner that
+    slipped onto its neighbour is re-pinched with it (fold towel, real protocol seed 47: the left hand
+    "held" the top-left corner the bottom-left one had been laid on).
+    """
+    return all(float(np.max(frame.objects[name].extent)) < POINT_EXTENT for name in (held, wanted))
+
+
 def others_move_first(program: EdgeProgram, grasp: Grasp) -> bool:
     """Whether another arm acts before or with ``grasp`` (it may be moving out of the way)."""
     for step in program.steps:
@@ -139,7 +149,7 @@ class FeasibilityChecker:
         frame = self.robot.frame
         if off_table(frame, [obj]):
             return GraspCheck(arm, obj, f"{obj} has left the table (z = {frame.objects[obj].pos[2]:.2f} m)")
-        busy = sorted(o for a, o in frame.holding if a == arm and o != obj)
+        busy = sorted(o for a, o in frame.holding if a == arm and o != obj and not _both_corners(frame, o, obj))
         if hand_free and busy:
             return GraspCheck(arm, obj, f"the {arm} arm holds {', '.join(busy)}")
         if (arm, obj) in frame.holding:

@@ -34,7 +34,7 @@ def _footprint(frame: FeatureFrame, name: str) -> float:
         else 0.5 * float(max(feats.extent[0], feats.extent[1]))
 
 
-def handoff_spot(frame: FeatureFrame, obj: str, placer: str, taker: str) -> np.ndarray:
+def handoff_spot(frame: FeatureFrame, obj: str, placer: str, taker: str, taker_margin: float = TAKER_MARGIN) -> np.ndarray:
     """The table spot (x, y) where ``placer`` sets ``obj`` down for ``taker``.
 
     Args:
@@ -42,6 +42,8 @@ def handoff_spot(frame: FeatureFrame, obj: str, placer: str, taker: str) -> np.n
         obj: The object being handed over (held upright by ``placer``).
         placer: The arm that sets it down.
         taker: The arm that will grasp it there.
+        taker_margin: Reach slack (m) the spot needs for ``taker`` (more keeps it nearer the middle
+            of the shell, where a top-down tool, which the shell was not measured for, reaches too).
 
     Raises:
         NoHandoffSpotError: No grid spot is reachable by both arms and clear of everything.
@@ -53,7 +55,7 @@ def handoff_spot(frame: FeatureFrame, obj: str, placer: str, taker: str) -> np.n
     xs, ys = np.meshgrid(np.arange(x_lo, x_hi + 1e-9, step), np.arange(y_lo, y_hi + 1e-9, step))
     spots = np.column_stack([xs.ravel(), ys.ravel()])
     points = np.column_stack([spots, np.full(len(spots), grasp_z)])
-    ok = (REACH[taker].slack(points) >= TAKER_MARGIN) & (REACH[placer].slack(points) >= PLACER_MARGIN)
+    ok = (REACH[taker].slack(points) >= taker_margin) & (REACH[placer].slack(points) >= PLACER_MARGIN)
     radius = 0.5 * float(min(feats.extent[0], feats.extent[1])) if height == feats.extent[2] else 0.5 * height
     for name in frame.objects:
         other = frame.objects[name]
