@@ -43,8 +43,6 @@ TURN_STEP_DEG = 15.0
 SLIDE_STEP = 0.005
 #: A slide keeps the fingers' centre this far (m) inside the object's end.
 END_MARGIN = 0.02
-#: Largest extent (m) of a point feature (a cloth corner) rather than a body.
-POINT_EXTENT = 0.01
 #: A side grasp's sweep from the pre-grasp is sampled at most this far apart (m).
 SWEEP_STEP = 0.01
 #: Neighbours read as round (cylinders) when their horizontal sides differ by less than this share.
@@ -158,7 +156,7 @@ def _neighbours_hit(frame: FeatureFrame, obj: str | None, points: np.ndarray, cl
     centre = None if obj is None else frame.objects[obj].pos
     hits = {}
     for name, feats in frame.objects.items():
-        if name == obj or float(np.max(feats.extent)) < POINT_EXTENT:
+        if name == obj or feats.is_point:
             continue  # a point feature (a cloth's corner) lies flat in the cloth: nothing to land on
         if centre is not None and _inside(feats, np.array([[centre[0], centre[1], feats.pos[2]]]))[0]:
             continue  # the object rests on or in it (a fork on the plate, a capsule in the tray): reach in

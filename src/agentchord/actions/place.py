@@ -24,8 +24,6 @@ from agentchord.robot.aloha import FINGER_GAP_OFFSET, FINGER_RANGE
 HANDOFF_EXTRA_MARGINS = (0.0, 0.02, 0.04, 0.06, 0.08)
 #: Position residual (m) under which the IK counts a hand-off grasp pose as reached (as the feasibility check).
 HANDOFF_IK_TOLERANCE = 0.01
-#: Largest extent (m) of a point feature (a cloth corner) rather than a body.
-POINT_EXTENT = 0.01
 #: A tall object tilted more than this in the hand (deg) is turned upright before it is put down,
 #: with its bottom at least this high (m) while it turns.
 LEVEL_IN_HAND_DEG = 4.0
@@ -206,7 +204,7 @@ class Place(ArmAction):
     def _standing(self, robot: RobotController) -> bool:
         """Whether the object already stands upright on the table (an earlier place released it)."""
         feats = robot.frame.objects[self.args.obj]
-        if float(np.max(feats.extent)) < POINT_EXTENT:
+        if feats.is_point:
             return True  # a point feature (a cloth's corner) released is placed wherever it lies
         return tilt_deg(feats.axis) <= UPRIGHT_TOLERANCE_DEG and min(feats.bottom[2], feats.top[2]) < 0.01
 

@@ -22,7 +22,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from agentchord.actions.library import POINT_EXTENT
 from agentchord.execution.edge_program import EdgeProgram
 from agentchord.features.frame import FeatureFrame
 from agentchord.solvers.poses import quat_to_rotation
@@ -97,7 +96,7 @@ class HoldMemory:
         """Record the holds of this tick's frame (rigid objects only)."""
         for arm, obj in frame.holding:
             feats = frame.objects.get(obj)
-            if feats is not None and float(np.max(feats.extent)) >= POINT_EXTENT:
+            if feats is not None and not feats.is_point:
                 tool = frame.arms[arm]
                 self.last[(arm, obj)] = (frame.tick, tool.ee.copy(), tool.ee_quat.copy(), feats.pos.copy(), feats.axis.copy())
 
@@ -166,7 +165,7 @@ class Binding:
 
     def rigid(self, frame: FeatureFrame) -> bool:
         """Whether some object is a rigid body, not a cloth's corner (a point feature)."""
-        return any(float(np.max(frame.objects[o].extent)) >= POINT_EXTENT for o in self.objects)
+        return any(not frame.objects[o].is_point for o in self.objects)
 
     def holds_back(self, frame: FeatureFrame) -> bool:
         """Count this tick toward a cleared failure; whether every lost hold has been back long enough."""

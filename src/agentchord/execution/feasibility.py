@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from agentchord.actions.controller import RobotController
-from agentchord.actions.library import POINT_EXTENT, Grasp
+from agentchord.actions.library import Grasp
 from agentchord.actions.catalog import GraspArgs
 from agentchord.execution.edge_program import EdgeProgram
 from agentchord.features.frame import ARMS, FeatureFrame
@@ -54,7 +54,7 @@ def off_table(frame: FeatureFrame, objects: list[str]) -> list[str]:
     lost = []
     for name in objects:
         feats = frame.objects.get(name)
-        if feats is not None and float(np.max(feats.extent)) >= POINT_EXTENT and feats.pos[2] < OFF_TABLE_Z:
+        if feats is not None and not feats.is_point and feats.pos[2] < OFF_TABLE_Z:
             lost.append(name)
     return lost
 
@@ -66,7 +66,7 @@ def _both_corners(frame: FeatureFrame, held: str, wanted: str) -> bool:
     slipped onto its neighbour is re-pinched with it (fold towel, real protocol seed 47: the left hand
     "held" the top-left corner the bottom-left one had been laid on).
     """
-    return all(float(np.max(frame.objects[name].extent)) < POINT_EXTENT for name in (held, wanted))
+    return frame.objects[held].is_point and frame.objects[wanted].is_point
 
 
 def others_move_first(program: EdgeProgram, grasp: Grasp) -> bool:

@@ -29,6 +29,10 @@ def tilt_deg(axis) -> float:
     return float(np.degrees(np.arccos(np.clip(axis[2], -1.0, 1.0))))
 
 
+#: Largest extent (m) of a point feature (a cloth's corner) rather than a body.
+POINT_EXTENT = 0.01
+
+
 @dataclass
 class ObjectFeatures:
     """Geometric features of one object.
@@ -50,6 +54,11 @@ class ObjectFeatures:
     top: np.ndarray
     bottom: np.ndarray
     points: float = 1000.0
+
+    @property
+    def is_point(self) -> bool:
+        """Whether this is a point feature (a cloth's corner, lying flat in the cloth) rather than a body."""
+        return float(np.max(self.extent)) < POINT_EXTENT
 
     def at(self, fraction: float) -> np.ndarray:
         """Fractional point along the principal axis: 0 = bottom, 1 = top."""

@@ -59,7 +59,7 @@ def handoff_spot(frame: FeatureFrame, obj: str, placer: str, taker: str, taker_m
     radius = 0.5 * float(min(feats.extent[0], feats.extent[1])) if height == feats.extent[2] else 0.5 * height
     for name in frame.objects:
         other = frame.objects[name]
-        if name == obj or float(np.max(other.extent)) < 0.01:  # itself, or a point feature (a cloth corner)
+        if name == obj or other.is_point:  # itself, or a point feature (a cloth corner)
             continue
         gap = np.linalg.norm(spots - other.pos[:2], axis=1)
         ok &= gap >= radius + _footprint(frame, name) + OBJECT_CLEARANCE
