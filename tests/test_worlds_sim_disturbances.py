@@ -151,3 +151,30 @@ def test_a_person_takes_the_object_out_of_a_gripper_that_keeps_moving(spot_seed)
     pulled = result.trace.of("disturbance")[0]["tick"]
     assert not held[pulled + 75] and not held[pulled + 150]
     assert result.trace.of("replan")  # its sub-goal check saw the bottle gone
+
+
+def test_a_perturb_pushes_an_object_at_rest_or_in_the_other_hand_never_one_in_the_air(pour_scene):
+    # Real protocol, single-arm pour, seed 32: a pull set the bottle down across the closed fingers,
+    # and the push of a later grasp, with no table friction to hold it, flung it off the table.
+    import numpy as np
+
+    from agentchord.features.oracle import OracleExtractor
+    from agentchord.worlds.sim.disturbances import inject
+    from agentchord.worlds.sim.world import SimWorld
+
+    world = SimWorld(pour_scene)
+    extractor = OracleExtractor(world, grasp_signal=lambda arm: False)
+    for _ in range(30):
+        world.step()
+    grasp = make_action("grasp", "right", {"obj": "bottle"})
+    rng = np.random.default_rng(0)
+    assert inject("perturb", world, extractor.update(), rng, "right", grasp) is not None  # at rest: pushed
+    for _ in range(200):
+        world.step()
+    joint = world.model.body("bottle").jntadr[0]
+    world.data.qpos[world.model.jnt_qposadr[joint] + 2] += 0.2  # in the air
+    world.step()
+    assert inject("perturb", world, extractor.update(), rng, "right", grasp) is None
+    frame = extractor.update()
+    frame.holding = {("left", "bottle")}  # ... unless the other hand holds it (a hand-over)
+    assert inject("perturb", world, frame, rng, "right", grasp) is not None

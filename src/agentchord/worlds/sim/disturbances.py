@@ -111,13 +111,13 @@ def _free_objects(frame: FeatureFrame, world: SimWorld) -> list[str]:
     """
     # Rigid bodies only: a frame may also carry feature points (a cloth's corners).
     held = {obj for _, obj in frame.holding}
-    names = world.object_names
+    return sorted(name for name in world.object_names if name not in held and _resting(world, name))
 
-    def resting(name: str) -> bool:
-        supported = world.on_table(name) or any(world.touching(name, other) for other in names if other != name)
-        return supported and world.object_velocity(name) < RESTING_SPEED
 
-    return sorted(name for name in names if name not in held and resting(name))
+def _resting(world: SimWorld, name: str) -> bool:
+    """Whether an object is at rest on the table or on another object (not on the robot alone, not moving)."""
+    supported = world.on_table(name) or any(world.touching(name, other) for other in world.object_names if other != name)
+    return supported and world.object_velocity(name) < RESTING_SPEED
 
 
 def _slide(world: SimWorld, obj: str, direction: np.ndarray, distance: float) -> None:
@@ -263,6 +263,11 @@ def inject(kind: str, world: SimWorld, frame: FeatureFrame, rng: np.random.Gener
         return DisturbanceEvent(world.tick, kind, obj, arm, name)
     if kind == "perturb":
         if name != "grasp" or target not in world.object_names or frame.is_holding(arm, target):
+            return None
+        if not _resting(world, target) and not any(obj == target for _, obj in frame.holding):
+            # Not one lying on nothing but the robot's fingers (a pull set it down there) or falling
+            # off them: pushed so, no table friction held it and the bottle went off the table (real
+            # protocol, single-arm pour, seed 32). One the other hand holds (a hand-over) is pushed in that hand.
             return None
         _slide(world, target, push_dir, float(rng.uniform(*PERTURB_DISTANCE)))
         return DisturbanceEvent(world.tick, kind, target, arm, name)
