@@ -64,6 +64,12 @@ class GraspMissed(ActionFailed):
     """The fingers closed but the object is not between them."""
 
 
+def top_down_rotation(long_dir: np.ndarray) -> np.ndarray:
+    """The tool frame of a top grasp: approach straight down, fingers closing across ``long_dir``."""
+    down = np.array([0.0, 0.0, -1.0])
+    return np.column_stack([down, np.cross(long_dir, down), long_dir])
+
+
 def plain_top_grasp(feats: ObjectFeatures) -> tuple[np.ndarray, np.ndarray]:
     """The top-down grasp of an object where it lies, before any clearance or offset is applied.
 
@@ -413,8 +419,7 @@ class Grasp(ArmAction):
             near, far = sorted((long_dir, -long_dir), key=lambda d: abs(turn(d)))
             keep = _wrist_margin(robot, self.arm, turn(near), feats.pos)
             long_dir = far if keep < 0.0 and _wrist_margin(robot, self.arm, turn(far), feats.pos) > keep else near
-        down = np.array([0.0, 0.0, -1.0])
-        rotation = np.column_stack([down, np.cross(long_dir, down), long_dir])
+        rotation = top_down_rotation(long_dir)
         return rotation, point + self._offset(feats)
 
     def _offset(self, feats) -> np.ndarray:

@@ -12,7 +12,7 @@ from agentchord.actions import catalog
 from agentchord.actions.base import ActionFailed, ArmAction, ObjectGone
 from agentchord.actions.controller import RobotController
 from agentchord.actions.geometry import _level, _matrix, _yaw_turn
-from agentchord.actions.grasp import UPRIGHT_TOLERANCE_DEG, Grasp, plain_top_grasp
+from agentchord.actions.grasp import UPRIGHT_TOLERANCE_DEG, Grasp, plain_top_grasp, top_down_rotation
 from agentchord.actions.motion import grip, move_to, pose_from_matrix, settle, wait_for_rest
 from agentchord.features.frame import FeatureFrame, ObjectFeatures, tilt_deg
 from agentchord.solvers.exceptions import NoHandoffSpotError
@@ -59,8 +59,7 @@ def _top_grasp_reaches(robot: RobotController, arm: str, feats: ObjectFeatures, 
     long_dir, point = plain_top_grasp(there)
     if np.dot(long_dir[:2], there.pos[:2] - robot.world.arm_base(arm)[:2]) < 0:
         long_dir = -long_dir  # the finger orientation facing away from the arm's base, as the grasp takes
-    down = np.array([0.0, 0.0, -1.0])
-    rotation = np.column_stack([down, np.cross(long_dir, down), long_dir])
+    rotation = top_down_rotation(long_dir)
     above = point + np.array([0.0, 0.0, catalog.GraspArgs.model_fields["pre_grasp_dis"].default])
     poses = [pose_from_matrix(above, rotation), pose_from_matrix(point, rotation)]
     ik = robot.scratch_ik(avoid_other_arm=False)
