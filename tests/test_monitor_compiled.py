@@ -70,3 +70,11 @@ def test_violated_now_scene_only_skips_monitors_that_read_an_arm():
     closed_on_nothing = _frame(False)  # the gripper closed, the bottle not held; the cup upright
     assert monitors.violated_now(closed_on_nothing).failure.name == "bottle_dropped"
     assert monitors.violated_now(closed_on_nothing, scene_only=True) is None
+
+
+def test_watching_names_the_monitors_of_one_arms_hold_of_one_object():
+    graph = load_task_graph("dual_arm_pour_water")
+    monitors = EdgeMonitors.compile(graph.edge("e1"), Vocabulary(frozenset(graph.objects)))
+    assert [m.failure.name for m in monitors.watching("right", "bottle")] == ["bottle_dropped"]
+    assert [m.failure.name for m in monitors.watching("left", "cup")] == ["cup_dropped"]
+    assert monitors.watching("left", "bottle") == []

@@ -188,3 +188,25 @@ def test_a_block_taken_askew_at_the_hand_over_is_set_upright_in_hand_before_it_i
         assert not [d for d in result.trace.of("failure_detected") if d["edge"] == "e5"]  # placed standing
     else:
         assert not result.success and result.reason.startswith("unrecoverable")
+
+
+@pytest.mark.parametrize("taken_as_anticipated", [True, False])
+def test_a_block_pushed_out_of_the_left_arms_reach_during_its_first_grasp_is_taken_by_the_right(
+        taken_as_anticipated, monkeypatch):
+    # Real-world protocol, seed 52: the block, pulled out of the closing hand and then pushed, ends
+    # out of the left arm's reach; its grasp fails before the drop monitor (which reads a closed hand)
+    # could fire. Taken as that monitor's failure, the pre-compiled recovery's right-arm alternative
+    # takes it; without that rule the episode ended with the skill's failure.
+    from agentchord.execution.strategies import RecoveryStrategy
+    from agentchord.worlds.sim.disturbances import PRESETS
+
+    if not taken_as_anticipated:
+        monkeypatch.setattr(RecoveryStrategy, "on_program_failure", lambda self, executor, program: None)
+    result = run_episode(EpisodeSpec(TASK, seed=52, protocol=True, disturb=PRESETS["real"]))
+    if taken_as_anticipated:
+        assert result.success, result.reason
+        assert result.trace.of("action_failed")[0]["edge"] == "e1"
+        assert result.trace.of("failure_detected")[0]["failure"] == "block_dropped"
+        assert result.trace.of("recovery_bound")[0]["edge"] == "e1_r_block_dropped_via_right"
+    else:
+        assert not result.success and "out of reach" in result.reason

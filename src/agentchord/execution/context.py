@@ -15,7 +15,7 @@ if TYPE_CHECKING:
     from agentchord.execution.trace import Trace
     from agentchord.features.frame import FeatureFrame
     from agentchord.graph.models import TaskGraph
-    from agentchord.monitor import RecoveryMap
+    from agentchord.monitor import EdgeMonitors, RecoveryMap
 
 
 class ExecutionContext(Protocol):
@@ -29,6 +29,7 @@ class ExecutionContext(Protocol):
         program: The edge program running now (None between edges).
         nominal_next: Nominal node -> the nominal edge out of it.
         recovery_map: (edge, failure mode) -> recovery entry edges (Eq. 13).
+        monitors: Edge id -> its compiled monitors.
         visited_nominal: Nominal nodes reached so far, in order.
         keyframes: Nominal node -> per arm (joint targets, grip) when it was reached.
     """
@@ -40,6 +41,7 @@ class ExecutionContext(Protocol):
     program: EdgeProgram | None
     nominal_next: dict[str, str]
     recovery_map: RecoveryMap
+    monitors: dict[str, EdgeMonitors]
     visited_nominal: list[str]
     keyframes: dict[str, dict[str, tuple[np.ndarray, float]]]
 

@@ -40,6 +40,8 @@ class EdgeProgram:
         self.kind = kind
         self.step_index = 0
         self.failure_reason: str | None = None
+        #: The action whose failure ended the program (None while it has not failed).
+        self.failed_action: ArmAction | None = None
         #: 1 for a program's first run; a recovery bound again after the scene changed under it is its 2nd.
         self.attempt = 1
         #: Whether it failed because an object was not where an earlier step left it (:class:`ObjectGone`).
@@ -82,6 +84,7 @@ class EdgeProgram:
             if Status.FAILURE in statuses:
                 failed = next(a for a in self.running if a.status == Status.FAILURE)
                 self.failure_reason = f"{failed.describe()}: {failed.failure_reason}"
+                self.failed_action = failed
                 self.scene_changed = failed.object_gone
                 self.terminate(Status.INVALID)
                 return Status.FAILURE

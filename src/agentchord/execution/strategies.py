@@ -11,12 +11,13 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from agentchord.execution.edge_program import EdgeProgram, ReturnToKeyframe
+from agentchord.execution.feasibility import first_grasps
+from agentchord.monitor import Detection
 from agentchord.execution.reasoning import ReasoningConfig, charge_calls
 
 if TYPE_CHECKING:
     from agentchord.execution.context import ExecutionContext as Executor  # the executor as a strategy sees it
     from agentchord.features.frame import FeatureFrame
-    from agentchord.monitor import Detection
 
 
 class RecoveryStrategy:
@@ -60,7 +61,30 @@ class RecoveryStrategy:
         return None
 
     def on_program_failure(self, executor: Executor, program: EdgeProgram) -> Detection | None:
-        """A skill reported failure: a detection to recover from, or None to end the episode."""
+        """A skill reported failure: a detection to recover from, or None to end the episode.
+
+        With compiled monitors, a nominal edge's grasp that failed (its object pushed or pulled away
+        during the approach, now out of that arm's reach) is the failure the edge's monitor of that
+        arm's hold anticipates: the object is not in the hand. That mode's detection switches to its
+        pre-compiled recovery, whose alternatives include the other arm's; the monitor itself could
+        not fire, since it reads the hold only once the hand has closed. A recovery's own failure is
+        not taken so: it was bound where its arms could make it, and the same recovery would only
+        run again.
+        """
+        action = program.failed_action
+        monitors = executor.monitors.get(program.edge_id)
+        if not self.uses_monitors or program.kind != "nominal" or monitors is None:
+            return None
+        if action is None or action.name != "grasp":
+            return None
+        obj = action.args.obj
+        if executor.frame.is_holding(action.arm, obj):
+            return None
+        for monitor in monitors.watching(action.arm, obj):
+            candidates = executor.recovery_map.candidates(program.edge_id, monitor.failure.name)
+            if any(g.args.obj == obj for c in candidates for g in first_grasps(EdgeProgram.from_edge(c))):
+                tick = executor.world.tick
+                return Detection(program.edge_id, monitor.failure, tick, tick, monitor.expr.scalar(executor.frame))
         return None
 
     def next_edge(self, executor: Executor, node_id: str) -> str | None:

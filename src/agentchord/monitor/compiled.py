@@ -67,6 +67,10 @@ class EdgeMonitors:
                 fired = Detection(monitor.edge_id, monitor.failure, frame.tick, monitor.trigger.first_violation_tick, value)
         return fired
 
+    def watching(self, arm: str, obj: str) -> list[CompiledMonitor]:
+        """The monitors that read both ``arm`` and ``obj`` (what watches that arm's hold of it)."""
+        return [m for m in self.monitors if arm in m.expr.arms and obj in m.expr.objects]
+
     def violated_now(self, frame: FeatureFrame, scene_only: bool = False) -> Detection | None:
         """The first monitor violated on this frame alone, persistence aside (a state to explain, not a transient).
 
