@@ -58,3 +58,21 @@ def test_a_scratch_solve_from_home_reaches_what_a_stalled_start_does_not():
     far = PoseTarget(np.array([0.0, 2.0, 0.1]), grasp.quat)
     assert solve_from_scratch(ik, home, "left", [far]) is None
     assert solve_from_scratch(ik, home, "left", [grasp], from_current=False, from_home=False) is None
+
+
+def test_a_scratch_solve_returns_the_joints_at_the_pose_asked_for():
+    from agentchord.actions.motion import grasp_frame, pose_from_matrix
+    from agentchord.solvers.ik import solve_from_scratch
+    from agentchord.solvers.reach import REACH
+
+    ik = BimanualIK(iterations=150, avoid_arm_collisions=False)
+    home = ik.configuration.q.copy()
+    point = np.array([-0.1, 0.57, 0.044])
+    rotation = grasp_frame(point - np.r_[REACH["left"].shoulder[:2], 0.0])
+    pre = point - 0.04 * rotation[:, 0]
+    poses = [pose_from_matrix(pre, rotation), pose_from_matrix(point, rotation)]
+    for index, where in ((0, pre), (-1, point)):
+        q = solve_from_scratch(ik, home, "left", poses, joints_at=index)
+        ik.reset(home)
+        ik.set_arm_q("left", q)
+        assert np.linalg.norm(ik.tcp_pose("left").pos - where) < 0.01

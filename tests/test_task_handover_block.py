@@ -210,3 +210,24 @@ def test_a_block_pushed_out_of_the_left_arms_reach_during_its_first_grasp_is_tak
         assert result.trace.of("recovery_bound")[0]["edge"] == "e1_r_block_dropped_via_right"
     else:
         assert not result.success and "out of reach" in result.reason
+
+
+@pytest.mark.parametrize("checks_the_line_ahead", [True, False])
+def test_a_block_set_down_near_the_right_shoulder_is_approached_on_a_branch_that_reaches_it(
+        checks_the_line_ahead, monkeypatch):
+    # Pulled out of the left hand and set down at (0.30, 0.70), 26 cm from the right shoulder: the
+    # right arm reaches the side pre-grasp with its wrist wound, a branch from which the straight line
+    # to the grasp point stalls at once (7.5 cm short). Checked at the pre-grasp, the arm goes round
+    # through home onto the branch that reaches the grasp point.
+    from agentchord.actions import grasp, motion
+    from agentchord.worlds.sim.disturbances import ScriptedDisturbance
+
+    if not checks_the_line_ahead:
+        monkeypatch.setattr(grasp, "approach", lambda robot, arm, goal, then=None: motion.approach(robot, arm, goal))
+    pull = ScriptedDisturbance("grasp", "pull", after=180, seed=0, spot=(0.3, 0.7), lying=False)
+    result = run_episode(EpisodeSpec(TASK, seed=0, disturbance=pull))
+    assert result.trace.of("recovery_bound")[0]["edge"] == "e1_r_block_dropped_via_right"
+    if checks_the_line_ahead:
+        assert result.success, result.reason
+    else:
+        assert not result.success and "is out of reach" in result.reason

@@ -345,7 +345,7 @@ class Grasp(ArmAction):
         if np.linalg.norm(robot.commanded_pose(arm).pos[:2] - pre[:2]) > 0.05:
             yield from self._clear_from_below(robot, pre[2] + 0.08)
         yield from self._pass_over(robot, pre, rotation)
-        yield from approach(robot, arm, pose_from_matrix(pre, rotation))
+        yield from approach(robot, arm, pose_from_matrix(pre, rotation), then=pose_from_matrix(point, rotation))
         self._still_standing(robot, "during the approach")
         # Re-observe: the object may have moved while the arm approached.
         point = self._side_point(robot, self._height_fraction)
@@ -432,7 +432,7 @@ class Grasp(ArmAction):
         rotation, point = self._top_frame(robot)
         above = point + np.array([0.0, 0.0, self.args.pre_grasp_dis])
         yield from self._clear_from_below(robot, above[2])
-        yield from approach(robot, arm, pose_from_matrix(above, rotation))
+        yield from approach(robot, arm, pose_from_matrix(above, rotation), then=pose_from_matrix(point, rotation))
         # A top-down tool often flips the forearm roll: let the IK converge before descending.
         yield from settle(robot, arm, tolerance=0.003, max_ticks=60, required=0.015)
         rotation, point = self._top_frame(robot, keep_choice=True)
@@ -470,7 +470,7 @@ class Grasp(ArmAction):
         )
         if plan is not None:
             yield from move_above(robot, arm, plan)
-        yield from approach(robot, arm, pre)
+        yield from approach(robot, arm, pre, then=pose_from_matrix(point, rotation))
         # A top-down tool often flips the forearm roll: let the IK converge before descending.
         yield from settle(robot, arm, tolerance=0.003, max_ticks=60, required=0.015)
         feats = robot.frame.objects[self.args.obj]

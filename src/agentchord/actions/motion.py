@@ -74,7 +74,8 @@ APPROACH_TOLERANCE = 0.015
 
 
 def approach(
-    robot: RobotController, arm: str, goal: PoseTarget, speed: float = LINEAR_SPEED, settle_ticks: int = 60
+    robot: RobotController, arm: str, goal: PoseTarget, speed: float = LINEAR_SPEED, settle_ticks: int = 60,
+    then: PoseTarget | None = None,
 ) -> Iterator[None]:
     """Move the tool to ``goal`` in a straight line; where it stalls, go round through home.
 
@@ -85,6 +86,11 @@ def approach(
     so the detour starts from a posture clear of the table. Otherwise nothing more happens
     here: the action's own checks judge the pose as they always did.
 
+    The same detour is taken where ``goal`` is reached on a wrist branch from which ``then``
+    (the grasp point the tool moves to next, in a straight line) is not, but from home's branch
+    it is: a block set down 26 cm from the right shoulder was approached with the wrist wound,
+    and the line to the grasp point stalled at the pre-grasp, 7.5 cm short.
+
     Args:
         robot: The robot.
         arm: The arm.
@@ -92,15 +98,19 @@ def approach(
         speed: Straight-line speed (m/s).
         settle_ticks: Ticks the IK gets to converge at the end of the line (a tool turning
             its forearm roll needs many) before it counts as stalled.
+        then: The pose the next straight move goes to from ``goal`` (None: no check).
     """
     yield from move_to(robot, arm, goal, speed=speed)
     yield from settle(robot, arm, tolerance=APPROACH_TOLERANCE, max_ticks=settle_ticks)
-    if float(np.linalg.norm(robot.frame.arms[arm].ee - goal.pos)) < APPROACH_TOLERANCE:
-        return
     ik, q = robot.scratch_ik(), robot.ik.configuration.q.copy()
-    if solve_from_scratch(ik, q, arm, [goal], from_home=False) is not None:
-        return  # slow, not stalled
-    q_goal = solve_from_scratch(ik, q, arm, [goal], from_current=False)
+    if float(np.linalg.norm(robot.frame.arms[arm].ee - goal.pos)) < APPROACH_TOLERANCE:
+        if then is None or solve_from_scratch(ik, q, arm, [then], from_home=False) is not None:
+            return
+        q_goal = solve_from_scratch(ik, q, arm, [goal, then], from_current=False, joints_at=0)
+    else:
+        if solve_from_scratch(ik, q, arm, [goal], from_home=False) is not None:
+            return  # slow, not stalled
+        q_goal = solve_from_scratch(ik, q, arm, [goal], from_current=False)
     if q_goal is None:
         return
     # The hand is empty (it is on its way to grasp).

@@ -150,7 +150,7 @@ class BimanualIK:
 
 def solve_from_scratch(
     ik: BimanualIK, q: np.ndarray, arm: str, poses: list[PoseTarget], tolerance: float = 0.01,
-    from_current: bool = True, from_home: bool = True,
+    from_current: bool = True, from_home: bool = True, joints_at: int = -1,
 ) -> np.ndarray | None:
     """Joints that put ``arm`` at the last of ``poses``, reached through the others in order.
 
@@ -166,21 +166,23 @@ def solve_from_scratch(
         tolerance: Position residual (m) under which a pose counts as reached.
         from_current: Try the start ``q``.
         from_home: Try ``q`` with the arm at home.
+        joints_at: Index of the pose whose joints are returned (the last by default).
 
     Returns:
-        The arm's six joints at the last pose, or None where no start reaches every pose.
+        The arm's six joints at ``poses[joints_at]``, or None where no start reaches every pose.
     """
     starts = [start for start, wanted in ((False, from_current), (True, from_home)) if wanted]
     for at_home in starts:
         ik.reset(q)
         if at_home:
             ik.set_arm_q(arm, HOME_Q)
-        reached = True
+        reached, joints = True, []
         for pose in poses:
             ik.solve({arm: pose})
             if ik.residual(arm, pose) >= tolerance:
                 reached = False
                 break
+            joints.append(ik.arm_q(arm))
         if reached:
-            return ik.arm_q(arm)
+            return joints[joints_at]
     return None
