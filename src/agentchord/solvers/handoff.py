@@ -4,7 +4,8 @@ A recovery that the busy arm cannot reach is one the other arm can: it picks the
 object up and sets it down where both arms reach, then the busy arm takes it. The
 spot is chosen when the recovery runs, from the latest feature frame: inside both
 arms' reach shells with a margin, clear of the other objects and of the receiving
-arm's tool, and as near to where the object is as possible (a short carry).
+arm's tool, out of the way either arm's hand comes to grasp another object where such
+a spot exists, and as near to where the object is as possible (a short carry).
 """
 
 from __future__ import annotations
@@ -25,6 +26,11 @@ OBJECT_CLEARANCE = 0.04
 TOOL_CLEARANCE = 0.12
 #: Lowest tool height (m) a side grasp is checked at.
 MIN_GRASP_HEIGHT = 0.06
+#: An arm's side grasp of an object comes from its shoulder's side (``actions.motion.grasp_frame``): the
+#: corridor it sweeps reaches this far (m) beyond the object's footprint (the 8 cm pre-grasp and the hand
+#: behind the tool), and this far (m) either side of the line to the shoulder (the open hand with a margin).
+APPROACH_CORRIDOR_LENGTH = 0.20
+APPROACH_CORRIDOR_HALF_WIDTH = 0.08
 
 
 def _footprint(frame: FeatureFrame, name: str) -> float:
@@ -57,14 +63,36 @@ def handoff_spot(frame: FeatureFrame, obj: str, placer: str, taker: str, taker_m
     points = np.column_stack([spots, np.full(len(spots), grasp_z)])
     ok = (REACH[taker].slack(points) >= taker_margin) & (REACH[placer].slack(points) >= PLACER_MARGIN)
     radius = 0.5 * float(min(feats.extent[0], feats.extent[1])) if height == feats.extent[2] else 0.5 * height
+    in_the_way = np.zeros(len(spots), dtype=bool)
     for name in frame.objects:
         other = frame.objects[name]
         if name == obj or other.is_point:  # itself, or a point feature (a cloth corner)
             continue
         gap = np.linalg.norm(spots - other.pos[:2], axis=1)
         ok &= gap >= radius + _footprint(frame, name) + OBJECT_CLEARANCE
+        in_the_way |= _in_approach_corridor(spots, other.pos[:2], _footprint(frame, name), radius)
     ok &= np.linalg.norm(spots - frame.arms[taker].ee[:2], axis=1) >= TOOL_CLEARANCE
     if not ok.any():
         raise NoHandoffSpotError(obj, placer, taker)
+    # Set down in the way an arm's hand comes to another object, it is knocked over when that object
+    # is taken next (dual-arm pour, stress seed 38: the bottle set down 8 cm from the cup, on the left
+    # shoulder's side, was struck by the left hand going to take the cup). Such spots only where no other is.
+    if (ok & ~in_the_way).any():
+        ok &= ~in_the_way
     candidates = spots[ok]
     return candidates[int(np.argmin(np.linalg.norm(candidates - feats.pos[:2], axis=1)))]
+
+
+def _in_approach_corridor(spots: np.ndarray, centre: np.ndarray, footprint: float, radius: float) -> np.ndarray:
+    """Which ``spots`` put an object of ``radius`` in the way of either arm's side grasp of the object
+    whose footprint (radius ``footprint``) is centred at ``centre``."""
+    inside = np.zeros(len(spots), dtype=bool)
+    for reach in REACH.values():
+        towards = reach.shoulder[:2] - centre
+        towards /= max(float(np.linalg.norm(towards)), 1e-9)
+        offset = spots - centre
+        along = offset @ towards
+        across = np.abs(offset[:, 0] * towards[1] - offset[:, 1] * towards[0])
+        inside |= (along > 0.0) & (along < footprint + APPROACH_CORRIDOR_LENGTH + radius) \
+            & (across < APPROACH_CORRIDOR_HALF_WIDTH + radius)
+    return inside
