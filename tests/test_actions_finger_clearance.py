@@ -12,6 +12,7 @@ from agentchord.actions.finger_clearance import (
     TopGraspChoice,
     blocking,
     clear_top_grasp,
+    crossing_over,
     finger_points,
     horizontal_sizes,
     open_finger_points,
@@ -210,3 +211,49 @@ def test_a_swept_path_reports_what_the_fingers_and_a_held_object_pass_through():
     assert set(swept_hits(frame, "bottle", [(finger_over_cup + (0.0, 0.0, 0.09), down)], held, 0.02)) == {"cup"}
     # The object being grasped is never in its own way.
     assert "bottle" not in swept_hits(frame, "bottle", [(np.array([-0.118, 0.478, 0.06]), down)])
+
+
+def _top_down(long_dir=(-0.4, 0.92, 0.0)):
+    from agentchord.actions.grasp import top_down_rotation
+
+    long_dir = np.asarray(long_dir, dtype=float)
+    return top_down_rotation(long_dir / np.linalg.norm(long_dir))
+
+
+def _leg_hits(frame, obj, start, end):
+    from agentchord.actions.finger_clearance import _leg
+
+    return swept_hits(frame, obj, _leg(start, end))
+
+
+# Single-arm pour, stress seed 38: the hand let the bottle go at (0.03, 0.50, 0.21); the bottle lies
+# beyond the cup, whose rim the straight line to the fallen grasp's pre-grasp crossed.
+POUR_CUP = {"pos": (-0.091, 0.594, 0.047), "extent": (0.053, 0.053, 0.094)}
+FALLEN_BOTTLE = {"pos": (-0.169, 0.629, 0.027), "extent": (0.055, 0.055, 0.192), "axis": (-0.4, 0.92, 0.0)}
+
+
+def test_a_move_whose_straight_line_crosses_a_neighbour_goes_over_it():
+    frame = make_static_frame({"cup": POUR_CUP, "bottle": FALLEN_BOTTLE})
+    start, goal = (np.array([0.03, 0.503, 0.14]), _top_down()), (np.array([-0.169, 0.629, 0.125]), _top_down())
+    assert set(_leg_hits(frame, "bottle", start, goal)) == {"cup"}
+    waypoints = crossing_over(frame, "bottle", start, goal)
+    assert waypoints is not None and len(waypoints) == 2
+    up, over = waypoints
+    np.testing.assert_allclose(up[0][:2], start[0][:2])
+    np.testing.assert_allclose(over[0][:2], goal[0][:2])
+    assert up[0][2] == over[0][2] >= goal[0][2]
+    legs = [(start, up), (up, over), (over, goal)]
+    assert not any(_leg_hits(frame, "bottle", a, b) for a, b in legs)
+
+
+def test_a_clear_straight_move_or_one_no_crossing_clears_is_left_as_it_is():
+    frame = make_static_frame({"cup": POUR_CUP, "bottle": FALLEN_BOTTLE})
+    start = (np.array([-0.3, 0.45, 0.2]), _top_down())
+    goal = (np.array([-0.169, 0.629, 0.125]), _top_down())
+    assert not _leg_hits(frame, "bottle", start, goal)
+    assert crossing_over(frame, "bottle", start, goal) is None
+    # A finger of the pre-grasp itself in the cup: no height helps.
+    rotation = _top_down()
+    inside = (np.array([-0.091, 0.594, 0.1]) - 0.047 * rotation[:, 1], rotation)
+    assert set(swept_hits(frame, "bottle", [inside])) == {"cup"}
+    assert crossing_over(frame, "bottle", start, inside) is None

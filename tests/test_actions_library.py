@@ -128,6 +128,24 @@ def test_a_fallen_bottle_beside_the_arms_own_base_is_turned_upright_clear_of_the
     assert not struck
 
 
+@pytest.mark.parametrize("crosses_over", [True, False])
+def test_a_fallen_grasp_goes_over_a_neighbour_its_straight_approach_would_strike(crosses_over, monkeypatch):
+    # Stress protocol, single-arm pour, seed 38: the bottle pulled out of the hand lies beyond the cup
+    # from where the hand let it go. The straight move to the fallen grasp's pre-grasp crossed the cup's
+    # rim; the fingers struck it and the cup went off the table. The hand now goes over it.
+    from agentchord.actions import grasp as grasp_module
+    from agentchord.execution.episode import EpisodeSpec, run_episode
+    from agentchord.worlds.sim.disturbances import PRESETS
+
+    if not crosses_over:
+        monkeypatch.setattr(grasp_module, "crossing_over", lambda *args: None)
+    result = run_episode(EpisodeSpec("single_arm_pour_water", seed=38, protocol=True, disturb=PRESETS["stress"]))
+    if crosses_over:
+        assert result.success, result.reason
+    else:
+        assert not result.success and "cup fell off the table" in result.reason
+
+
 def test_a_side_grasp_refuses_an_object_knocked_over_meanwhile(pour_scene):
     # A side grasp closing on a bottle that now lies would carry it lying across the fingers; the
     # grasp's retry takes it the way a fallen one is taken instead.

@@ -13,6 +13,9 @@ A side grasp's fingers are followed from the pre-grasp to the grasp point
 (:func:`side_approach_blocking`): a bottle lying beside a cup is swept into and pushed, and the cup
 caught off centre (stress protocol, dual-arm pour seed 8); the grasp action picks a clear one.
 
+An empty hand's straight move to a pre-grasp that would sweep the open fingers into a neighbour
+goes over it instead (:func:`crossing_over`).
+
 Only the feature frame is read (objects as oriented boxes, round ones as cylinders), so the
 check works on any world's perception, not on simulator geometry.
 """
@@ -22,7 +25,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial.transform import Rotation
+from scipy.spatial.transform import Rotation, Slerp
 
 from agentchord.actions.geometry import _matrix
 from agentchord.features.frame import UP, FeatureFrame, ObjectFeatures
@@ -47,6 +50,10 @@ END_MARGIN = 0.02
 SWEEP_STEP = 0.01
 #: Neighbours read as round (cylinders) when their horizontal sides differ by less than this share.
 ROUND_SHARE = 0.1
+#: Heights (m) over the higher of a move's ends tried for a crossing above the neighbours, lowest first.
+CROSSING_RISES = (0.0, 0.04, 0.08, 0.12, 0.16)
+#: Tool poses sampled along each leg of a move whose sweep is checked.
+LEG_SAMPLES = 21
 
 
 @dataclass(frozen=True)
@@ -145,6 +152,48 @@ def swept_hits(
             for name, count in part.items():
                 hits[name] = hits.get(name, 0) + count
     return hits
+
+
+def _leg(start: tuple[np.ndarray, np.ndarray], end: tuple[np.ndarray, np.ndarray]) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Tool poses (position, rotation matrix) along a straight move, the rotation turned in step."""
+    turn = Slerp([0.0, 1.0], Rotation.from_matrix(np.stack([start[1], end[1]])))
+    phases = np.linspace(0.0, 1.0, LEG_SAMPLES)
+    rotations = turn(phases).as_matrix()
+    return [(start[0] + s * (end[0] - start[0]), rotations[k]) for k, s in enumerate(phases)]
+
+
+def crossing_over(
+    frame: FeatureFrame, obj: str, start: tuple[np.ndarray, np.ndarray], goal: tuple[np.ndarray, np.ndarray],
+) -> list[tuple[np.ndarray, np.ndarray]] | None:
+    """Waypoints over the neighbours of ``obj`` for an empty hand going from ``start`` to ``goal``.
+
+    Where the straight move (the tool turning in step) sweeps the open fingers into a neighbour: up
+    from ``start`` in its rotation, then level to over ``goal`` turning to its rotation, from where
+    a straight move down ends at ``goal``. The lowest such crossing whose every leg is clear.
+
+    Single-arm pour, stress seed 38: the straight line from where the hand let a bottle go to the
+    fallen bottle's pre-grasp passed over the cup standing beside it; the fingers struck its rim
+    and the cup went off the table.
+
+    Args:
+        frame: The current features.
+        obj: The object the hand is going to (its own fingers may reach it).
+        start: Tool position and rotation matrix now.
+        goal: Tool position and rotation matrix at the end of the move.
+
+    Returns:
+        The waypoints (position, rotation matrix) before the last move down to ``goal``; None where
+        the straight move is clear, or no crossing is.
+    """
+    if not swept_hits(frame, obj, _leg(start, goal)):
+        return None
+    for rise in CROSSING_RISES:
+        height = max(start[0][2], goal[0][2]) + rise
+        up = (np.r_[start[0][:2], height], start[1])
+        over = (np.r_[goal[0][:2], height], goal[1])
+        if not swept_hits(frame, obj, _leg(start, up) + _leg(up, over) + _leg(over, goal)):
+            return [up, over]
+    return None
 
 
 def _neighbours_hit(frame: FeatureFrame, obj: str | None, points: np.ndarray, clearance: float) -> dict[str, int]:

@@ -15,7 +15,7 @@ from scipy.spatial.transform import Rotation
 from agentchord.actions import catalog
 from agentchord.actions.base import ActionFailed, ArmAction
 from agentchord.actions.controller import RobotController
-from agentchord.actions.finger_clearance import TopGraspChoice, clear_top_grasp
+from agentchord.actions.finger_clearance import TopGraspChoice, clear_top_grasp, crossing_over
 from agentchord.actions.geometry import _matrix, _wrist_margin
 from agentchord.actions.in_hand import grasp_height_share
 from agentchord.actions.motion import (
@@ -35,6 +35,7 @@ from agentchord.actions.side_plan import SidePlanner, side_point
 from agentchord.actions.wrist_branch import is_wound, move_above, plan_unflipped_fallen_grasp, turn_unflipped
 from agentchord.features.frame import ObjectFeatures, tilt_deg
 from agentchord.solvers.ik import ARM_CLEARANCE, PoseTarget
+from agentchord.solvers.poses import quat_to_rotation
 from agentchord.robot.aloha import HOME_Q
 
 #: Tilt (deg) beyond which an object counts as fallen for a side grasp.
@@ -470,6 +471,8 @@ class Grasp(ArmAction):
         )
         if plan is not None:
             yield from move_above(robot, arm, plan)
+        else:
+            yield from self._cross_over(robot, pre)
         yield from approach(robot, arm, pre, then=pose_from_matrix(point, rotation))
         # A top-down tool often flips the forearm roll: let the IK converge before descending.
         yield from settle(robot, arm, tolerance=0.003, max_ticks=60, required=0.015)
@@ -490,6 +493,14 @@ class Grasp(ArmAction):
             robot.set_pose(arm, pose_from_matrix(lifted, _turned(rotation, yaw, min_jerk(k / ticks))))
             yield
         yield from settle(robot, arm)
+
+    def _cross_over(self, robot: RobotController, goal: PoseTarget) -> Iterator[None]:
+        """Go over the neighbours first where the straight move to ``goal`` sweeps the fingers into one."""
+        start = robot.commanded_pose(self.arm)
+        matrices = (quat_to_rotation(start.quat).as_matrix(), quat_to_rotation(goal.quat).as_matrix())
+        waypoints = crossing_over(robot.frame, self.args.obj, (start.pos, matrices[0]), (goal.pos, matrices[1]))
+        for pos, rotation in waypoints or []:
+            yield from move_to(robot, self.arm, pose_from_matrix(pos, rotation))
 
     def _turn_pose(
         self, robot: RobotController, feats: ObjectFeatures, point: np.ndarray, rotation: np.ndarray
