@@ -12,8 +12,8 @@ from typing import TYPE_CHECKING
 
 from agentchord.execution.edge_program import EdgeProgram, ReturnToKeyframe
 from agentchord.execution.feasibility import first_grasps
-from agentchord.monitor import Detection
 from agentchord.execution.reasoning import ReasoningConfig, charge_calls
+from agentchord.monitor import Detection
 
 if TYPE_CHECKING:
     from agentchord.execution.context import ExecutionContext as Executor  # the executor as a strategy sees it
