@@ -213,17 +213,19 @@ def test_a_swept_path_reports_what_the_fingers_and_a_held_object_pass_through():
     assert "bottle" not in swept_hits(frame, "bottle", [(np.array([-0.118, 0.478, 0.06]), down)])
 
 
-def _top_down(long_dir=(-0.4, 0.92, 0.0)):
+def _top_down(at, long_dir=(-0.4, 0.92, 0.0)):
+    """A top-down tool pose at ``at``, fingers closing across ``long_dir`` (the lying bottle's axis)."""
     from agentchord.actions.grasp import top_down_rotation
+    from agentchord.actions.motion import pose_from_matrix
 
     long_dir = np.asarray(long_dir, dtype=float)
-    return top_down_rotation(long_dir / np.linalg.norm(long_dir))
+    return pose_from_matrix(np.asarray(at, dtype=float), top_down_rotation(long_dir / np.linalg.norm(long_dir)))
 
 
 def _leg_hits(frame, obj, start, end):
-    from agentchord.actions.finger_clearance import _leg
+    from agentchord.actions.finger_clearance import _sweeps
 
-    return swept_hits(frame, obj, _leg(start, end))
+    return _sweeps(frame, obj, start, end)
 
 
 # Single-arm pour, stress seed 38: the hand let the bottle go at (0.03, 0.50, 0.21); the bottle lies
@@ -234,26 +236,27 @@ FALLEN_BOTTLE = {"pos": (-0.169, 0.629, 0.027), "extent": (0.055, 0.055, 0.192),
 
 def test_a_move_whose_straight_line_crosses_a_neighbour_goes_over_it():
     frame = make_static_frame({"cup": POUR_CUP, "bottle": FALLEN_BOTTLE})
-    start, goal = (np.array([0.03, 0.503, 0.14]), _top_down()), (np.array([-0.169, 0.629, 0.125]), _top_down())
+    start, goal = _top_down((0.03, 0.503, 0.14)), _top_down((-0.169, 0.629, 0.125))
     assert set(_leg_hits(frame, "bottle", start, goal)) == {"cup"}
     waypoints = crossing_over(frame, "bottle", start, goal)
     assert waypoints is not None and len(waypoints) == 2
     up, over = waypoints
-    np.testing.assert_allclose(up[0][:2], start[0][:2])
-    np.testing.assert_allclose(over[0][:2], goal[0][:2])
-    assert up[0][2] == over[0][2] >= goal[0][2]
+    np.testing.assert_allclose(up.pos[:2], start.pos[:2])
+    np.testing.assert_allclose(over.pos[:2], goal.pos[:2])
+    assert up.pos[2] == over.pos[2] >= goal.pos[2]
     legs = [(start, up), (up, over), (over, goal)]
     assert not any(_leg_hits(frame, "bottle", a, b) for a, b in legs)
 
 
 def test_a_clear_straight_move_or_one_no_crossing_clears_is_left_as_it_is():
     frame = make_static_frame({"cup": POUR_CUP, "bottle": FALLEN_BOTTLE})
-    start = (np.array([-0.3, 0.45, 0.2]), _top_down())
-    goal = (np.array([-0.169, 0.629, 0.125]), _top_down())
+    start, goal = _top_down((-0.3, 0.45, 0.2)), _top_down((-0.169, 0.629, 0.125))
     assert not _leg_hits(frame, "bottle", start, goal)
     assert crossing_over(frame, "bottle", start, goal) is None
     # A finger of the pre-grasp itself in the cup: no height helps.
-    rotation = _top_down()
-    inside = (np.array([-0.091, 0.594, 0.1]) - 0.047 * rotation[:, 1], rotation)
-    assert set(swept_hits(frame, "bottle", [inside])) == {"cup"}
+    from agentchord.solvers.poses import quat_to_rotation
+
+    across = quat_to_rotation(_top_down((0.0, 0.0, 0.0)).quat).as_matrix()[:, 1]
+    inside = _top_down(np.array([-0.091, 0.594, 0.1]) - 0.047 * across)
+    assert set(_leg_hits(frame, "bottle", inside, inside)) == {"cup"}
     assert crossing_over(frame, "bottle", start, inside) is None

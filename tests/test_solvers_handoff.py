@@ -45,9 +45,12 @@ def test_a_spot_is_out_of_the_way_an_arm_comes_to_grasp_another_object(corridors
 
 
 def test_a_spot_in_the_way_is_taken_where_no_other_is_clear(monkeypatch):
+    frame = _frame((-0.167, 0.61, 0.196), (-0.109, 0.727, 0.048))
+    monkeypatch.setattr(handoff, "APPROACH_CORRIDOR_LENGTH", -1.0)  # no corridors: the nearest clear spot
+    nearest = handoff_spot(frame, "bottle", placer="left", taker="right")
+    monkeypatch.setattr(handoff, "APPROACH_CORRIDOR_LENGTH", 10.0)
     monkeypatch.setattr(handoff, "APPROACH_CORRIDOR_HALF_WIDTH", 10.0)  # every spot in some arm's way
-    spot = handoff_spot(_frame((-0.167, 0.61, 0.196), (-0.109, 0.727, 0.048)), "bottle", placer="left", taker="right")
-    assert spot is not None
+    np.testing.assert_allclose(handoff_spot(frame, "bottle", placer="left", taker="right"), nearest)
 
 
 def test_no_spot_both_arms_reach_is_an_error_naming_the_object():

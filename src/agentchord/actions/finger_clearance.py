@@ -25,10 +25,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial.transform import Rotation, Slerp
+from scipy.spatial.transform import Rotation
 
 from agentchord.actions.geometry import _matrix
+from agentchord.actions.motion import line_poses
 from agentchord.features.frame import UP, FeatureFrame, ObjectFeatures
+from agentchord.solvers.ik import PoseTarget
+from agentchord.solvers.poses import quat_to_rotation
 
 #: The open fingers in the tool frame of a top grasp (m; measured on the ViperX gripper's meshes):
 #: along the approach (down), from the palm side to the tips, the tips being at the tool's reach;
@@ -154,22 +157,18 @@ def swept_hits(
     return hits
 
 
-def _leg(start: tuple[np.ndarray, np.ndarray], end: tuple[np.ndarray, np.ndarray]) -> list[tuple[np.ndarray, np.ndarray]]:
-    """Tool poses (position, rotation matrix) along a straight move, the rotation turned in step."""
-    turn = Slerp([0.0, 1.0], Rotation.from_matrix(np.stack([start[1], end[1]])))
-    phases = np.linspace(0.0, 1.0, LEG_SAMPLES)
-    rotations = turn(phases).as_matrix()
-    return [(start[0] + s * (end[0] - start[0]), rotations[k]) for k, s in enumerate(phases)]
+def _sweeps(frame: FeatureFrame, obj: str, start: PoseTarget, end: PoseTarget) -> dict[str, int]:
+    """What the open fingers pass through on the straight move from ``start`` to ``end``."""
+    poses = line_poses(start, end, np.linspace(0.0, 1.0, LEG_SAMPLES))
+    return swept_hits(frame, obj, [(p.pos, quat_to_rotation(p.quat).as_matrix()) for p in poses])
 
 
-def crossing_over(
-    frame: FeatureFrame, obj: str, start: tuple[np.ndarray, np.ndarray], goal: tuple[np.ndarray, np.ndarray],
-) -> list[tuple[np.ndarray, np.ndarray]] | None:
+def crossing_over(frame: FeatureFrame, obj: str, start: PoseTarget, goal: PoseTarget) -> list[PoseTarget] | None:
     """Waypoints over the neighbours of ``obj`` for an empty hand going from ``start`` to ``goal``.
 
     Where the straight move (the tool turning in step) sweeps the open fingers into a neighbour: up
-    from ``start`` in its rotation, then level to over ``goal`` turning to its rotation, from where
-    a straight move down ends at ``goal``. The lowest such crossing whose every leg is clear.
+    from ``start`` in its orientation, then level to over ``goal`` turning to its orientation, from
+    where a straight move down ends at ``goal``. The lowest such crossing whose every leg is clear.
 
     Single-arm pour, stress seed 38: the straight line from where the hand let a bottle go to the
     fallen bottle's pre-grasp passed over the cup standing beside it; the fingers struck its rim
@@ -178,20 +177,20 @@ def crossing_over(
     Args:
         frame: The current features.
         obj: The object the hand is going to (its own fingers may reach it).
-        start: Tool position and rotation matrix now.
-        goal: Tool position and rotation matrix at the end of the move.
+        start: The tool pose now.
+        goal: The tool pose at the end of the move.
 
     Returns:
-        The waypoints (position, rotation matrix) before the last move down to ``goal``; None where
-        the straight move is clear, or no crossing is.
+        The waypoints before the last move down to ``goal``; None where the straight move is clear,
+        or no crossing is.
     """
-    if not swept_hits(frame, obj, _leg(start, goal)):
+    if not _sweeps(frame, obj, start, goal):
         return None
     for rise in CROSSING_RISES:
-        height = max(start[0][2], goal[0][2]) + rise
-        up = (np.r_[start[0][:2], height], start[1])
-        over = (np.r_[goal[0][:2], height], goal[1])
-        if not swept_hits(frame, obj, _leg(start, up) + _leg(up, over) + _leg(over, goal)):
+        height = max(start.pos[2], goal.pos[2]) + rise
+        up = PoseTarget(pos=np.r_[start.pos[:2], height], quat=start.quat)
+        over = PoseTarget(pos=np.r_[goal.pos[:2], height], quat=goal.quat)
+        if not any(_sweeps(frame, obj, a, b) for a, b in ((start, up), (up, over), (over, goal))):
             return [up, over]
     return None
 

@@ -35,7 +35,6 @@ from agentchord.actions.side_plan import SidePlanner, side_point
 from agentchord.actions.wrist_branch import is_wound, move_above, plan_unflipped_fallen_grasp, turn_unflipped
 from agentchord.features.frame import ObjectFeatures, tilt_deg
 from agentchord.solvers.ik import ARM_CLEARANCE, PoseTarget
-from agentchord.solvers.poses import quat_to_rotation
 from agentchord.robot.aloha import HOME_Q
 
 #: Tilt (deg) beyond which an object counts as fallen for a side grasp.
@@ -496,11 +495,8 @@ class Grasp(ArmAction):
 
     def _cross_over(self, robot: RobotController, goal: PoseTarget) -> Iterator[None]:
         """Go over the neighbours first where the straight move to ``goal`` sweeps the fingers into one."""
-        start = robot.commanded_pose(self.arm)
-        matrices = (quat_to_rotation(start.quat).as_matrix(), quat_to_rotation(goal.quat).as_matrix())
-        waypoints = crossing_over(robot.frame, self.args.obj, (start.pos, matrices[0]), (goal.pos, matrices[1]))
-        for pos, rotation in waypoints or []:
-            yield from move_to(robot, self.arm, pose_from_matrix(pos, rotation))
+        for waypoint in crossing_over(robot.frame, self.args.obj, robot.commanded_pose(self.arm), goal) or []:
+            yield from move_to(robot, self.arm, waypoint)
 
     def _turn_pose(
         self, robot: RobotController, feats: ObjectFeatures, point: np.ndarray, rotation: np.ndarray
