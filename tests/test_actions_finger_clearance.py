@@ -215,7 +215,7 @@ def test_a_swept_path_reports_what_the_fingers_and_a_held_object_pass_through():
 
 def _top_down(at, long_dir=(-0.4, 0.92, 0.0)):
     """A top-down tool pose at ``at``, fingers closing across ``long_dir`` (the lying bottle's axis)."""
-    from agentchord.actions.grasp import top_down_rotation
+    from agentchord.solvers.poses import top_down_rotation
     from agentchord.actions.motion import pose_from_matrix
 
     long_dir = np.asarray(long_dir, dtype=float)

@@ -31,7 +31,7 @@ from agentchord.actions.geometry import _matrix
 from agentchord.actions.motion import line_poses
 from agentchord.features.frame import UP, FeatureFrame, ObjectFeatures
 from agentchord.solvers.ik import PoseTarget
-from agentchord.solvers.poses import quat_to_rotation
+from agentchord.solvers.poses import quat_to_rotation, top_down_rotation
 
 #: The open fingers in the tool frame of a top grasp (m; measured on the ViperX gripper's meshes):
 #: along the approach (down), from the palm side to the tips, the tips being at the tool's reach;
@@ -102,8 +102,7 @@ def open_finger_points(point: np.ndarray, rotation: np.ndarray) -> np.ndarray:
 def finger_points(point: np.ndarray, long_dir: np.ndarray) -> np.ndarray:
     """Sample points (n x 3) inside both open fingers of a top grasp at ``point`` (the tool centre),
     fingers closing across ``long_dir`` (horizontal, unit)."""
-    down = np.array([0.0, 0.0, -1.0])
-    return open_finger_points(point, np.column_stack([down, np.cross(long_dir, down), long_dir]))
+    return open_finger_points(point, top_down_rotation(long_dir))
 
 
 def _inside(feats: ObjectFeatures, points: np.ndarray, clearance: float = CLEARANCE) -> np.ndarray:

@@ -35,6 +35,7 @@ from agentchord.actions.side_plan import SidePlanner, side_point
 from agentchord.actions.wrist_branch import is_wound, move_above, plan_unflipped_fallen_grasp, turn_unflipped
 from agentchord.features.frame import ObjectFeatures, tilt_deg
 from agentchord.solvers.ik import ARM_CLEARANCE, PoseTarget
+from agentchord.solvers.poses import top_down_rotation
 from agentchord.robot.aloha import HOME_Q
 
 #: Tilt (deg) beyond which an object counts as fallen for a side grasp.
@@ -62,12 +63,6 @@ class PlacedCheck(Protocol):
 
 class GraspMissed(ActionFailed):
     """The fingers closed but the object is not between them."""
-
-
-def top_down_rotation(long_dir: np.ndarray) -> np.ndarray:
-    """The tool frame of a top grasp: approach straight down, fingers closing across ``long_dir``."""
-    down = np.array([0.0, 0.0, -1.0])
-    return np.column_stack([down, np.cross(long_dir, down), long_dir])
 
 
 def plain_top_grasp(feats: ObjectFeatures) -> tuple[np.ndarray, np.ndarray]:
@@ -448,8 +443,7 @@ class Grasp(ArmAction):
         feats = robot.frame.objects[self.args.obj]
         top_dir = np.array([feats.axis[0], feats.axis[1], 0.0])
         top_dir /= max(np.linalg.norm(top_dir), 1e-9)
-        down = np.array([0.0, 0.0, -1.0])
-        rotation = np.column_stack([down, np.cross(top_dir, down), top_dir])
+        rotation = top_down_rotation(top_dir)
         radius = 0.5 * float(feats.extent[0])
         # The finger tips reach ~4 cm past the tool centre: stay high enough to miss the table.
         return rotation, np.r_[feats.pos[:2], max(feats.pos[2] + 0.35 * radius, self.FINGERTIP_REACH + 0.006)]

@@ -12,12 +12,13 @@ from agentchord.actions import catalog
 from agentchord.actions.base import ActionFailed, ArmAction, ObjectGone
 from agentchord.actions.controller import RobotController
 from agentchord.actions.geometry import _level, _matrix, _yaw_turn
-from agentchord.actions.grasp import UPRIGHT_TOLERANCE_DEG, Grasp, plain_top_grasp, top_down_rotation
+from agentchord.actions.grasp import UPRIGHT_TOLERANCE_DEG, Grasp, plain_top_grasp
 from agentchord.actions.motion import grip, move_to, pose_from_matrix, settle, wait_for_rest
 from agentchord.features.frame import FeatureFrame, ObjectFeatures, tilt_deg
 from agentchord.solvers.exceptions import NoHandoffSpotError
 from agentchord.solvers.handoff import TAKER_MARGIN, handoff_spot
 from agentchord.solvers.ik import solve_from_scratch
+from agentchord.solvers.poses import top_down_rotation
 from agentchord.robot.aloha import FINGER_GAP_OFFSET, FINGER_RANGE
 
 #: Extra reach slack (m) tried in turn for a hand-off spot until the IK confirms the taker's top-down grasp there.

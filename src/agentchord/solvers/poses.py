@@ -40,3 +40,10 @@ def grasp_frame(approach: np.ndarray) -> np.ndarray:
     x /= norm
     y = np.cross(UP, x)
     return np.column_stack([x, y, UP])
+
+
+def top_down_rotation(long_dir: np.ndarray) -> np.ndarray:
+    """Tool rotation for a top grasp: approach straight down, fingers closing across ``long_dir``
+    (horizontal, unit)."""
+    down = np.array([0.0, 0.0, -1.0])
+    return np.column_stack([down, np.cross(long_dir, down), long_dir])
