@@ -59,3 +59,11 @@ def test_no_spot_both_arms_reach_is_an_error_naming_the_object():
         patch.setattr(handoff, "SPOT_GRID", ((1.5, 1.6), (1.5, 1.6), 0.02))  # far beyond both shells
         with pytest.raises(NoHandoffSpotError, match="bottle"):
             handoff_spot(frame, "bottle", placer="left", taker="right")
+
+
+def test_a_spot_keeps_clear_of_where_the_program_carries_a_held_object_next():
+    frame = _frame((-0.167, 0.61, 0.196), (0.0, 0.62, 0.052))
+    free = handoff_spot(frame, "bottle", placer="left", taker="right")
+    held_cup_at = free.copy()  # the other arm brings the cup right there next
+    spot = handoff_spot(frame, "bottle", placer="left", taker="right", carried_to=[held_cup_at])
+    assert np.linalg.norm(spot - held_cup_at) >= 0.0255 + handoff.CARRIED_CLEARANCE

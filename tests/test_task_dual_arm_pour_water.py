@@ -225,3 +225,18 @@ def test_reseat_turns_a_fallen_bottle_left_askew_into_a_nominal_side_grasp(x, y,
     offset = feats.pos - tool
     off_axis = np.linalg.norm(offset - np.dot(offset, feats.axis) * feats.axis)
     assert bool(off_axis < 0.01) is reseated
+
+
+@pytest.mark.parametrize("kept_clear", [True, False])
+def test_a_hand_off_is_not_set_down_where_the_cup_is_held_next(kept_clear, monkeypatch):
+    # Real-world protocol, seed 54: the bottle pulled out of the right hand after the pour was handed
+    # over by the left arm at (-0.10, 0.72); the left arm then took the cup and held it at (-0.12, 0.72),
+    # knocking the bottle over, out of the right arm's reach.
+    from agentchord.execution import edge_program
+    from agentchord.worlds.sim.disturbances import PRESETS
+
+    if not kept_clear:
+        monkeypatch.setattr(edge_program, "_link_handoffs_to_later_moves", lambda steps: None)
+    result = run_episode(EpisodeSpec("dual_arm_pour_water", seed=54, protocol=True, disturb=PRESETS["real"]))
+    assert result.trace.of("recovery_bound")[0]["edge"] == "e5_r_bottle_dropped_via_left"
+    assert result.success == kept_clear, result.reason

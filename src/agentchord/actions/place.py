@@ -81,6 +81,9 @@ class Place(ArmAction):
     #: the recovery's merge sub-goal asks of it. A towel corner is released 4 cm short of where it
     #: settles, so "at the place's target" is the wrong test for a corner that fell and settled.
     meets_subgoal: Callable[[FeatureFrame], bool] | None = None
+    #: Set by the edge program on a hand-off place: the table points its later steps move a tool to
+    #: (``move_to_target``), where a held object is carried (kept clear of the spot).
+    carried_to: tuple[np.ndarray, ...] = ()
 
     def script(self, robot: RobotController) -> Iterator[None]:
         arm = self.arm
@@ -154,7 +157,8 @@ class Place(ArmAction):
         nearest = None
         for extra in HANDOFF_EXTRA_MARGINS:
             try:
-                spot = handoff_spot(frame, self.args.obj, self.arm, taker, taker_margin=TAKER_MARGIN + extra)
+                spot = handoff_spot(frame, self.args.obj, self.arm, taker, taker_margin=TAKER_MARGIN + extra,
+                                    carried_to=self.carried_to)
             except NoHandoffSpotError as error:
                 if nearest is None:
                     raise ActionFailed(str(error)) from None

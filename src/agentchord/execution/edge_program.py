@@ -54,6 +54,7 @@ class EdgeProgram:
         """Compile a graph edge's steps into arm actions."""
         steps = [[make_action(call.fn, arm, call.args) for arm, call in step.items() if call is not None] for step in edge.steps]
         _link_grasps_to_places(steps)
+        _link_handoffs_to_later_moves(steps)
         return cls(edge.id, edge.target, steps, edge.kind, edge=edge)
 
     @property
@@ -113,6 +114,16 @@ def _link_grasps_to_places(steps: list[list[ArmAction]]) -> None:
             later = (a for s in steps[i + 1:] for a in s
                      if a.name == "place" and a.arm == action.arm and a.args.obj == action.args.obj)
             action.placed_by = next(later, None)
+
+
+def _link_handoffs_to_later_moves(steps: list[list[ArmAction]]) -> None:
+    """Give each hand-off place (``within_reach``) the points later steps move a tool to."""
+    for i, step in enumerate(steps):
+        for action in step:
+            if action.name != "place" or getattr(action.args, "within_reach", None) is None:
+                continue
+            action.carried_to = tuple(np.asarray(a.args.pos, dtype=float)[:2] for s in steps[i + 1:] for a in s
+                                      if a.name == "move_to_target")
 
 
 class ReturnToKeyframe(ArmAction):

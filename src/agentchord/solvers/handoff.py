@@ -10,6 +10,8 @@ a spot exists, and as near to where the object is as possible (a short carry).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 from agentchord.features.frame import FeatureFrame
@@ -31,6 +33,9 @@ MIN_GRASP_HEIGHT = 0.06
 #: behind the tool), and this far (m) either side of the line to the shoulder (the open hand with a margin).
 APPROACH_CORRIDOR_LENGTH = 0.20
 APPROACH_CORRIDOR_HALF_WIDTH = 0.08
+#: Clearance (m) between a spot's object and a point the program carries a held object to later (a
+#: held cup's footprint with a margin).
+CARRIED_CLEARANCE = 0.10
 
 
 def _footprint(frame: FeatureFrame, name: str) -> float:
@@ -40,7 +45,10 @@ def _footprint(frame: FeatureFrame, name: str) -> float:
         else 0.5 * float(max(feats.extent[0], feats.extent[1]))
 
 
-def handoff_spot(frame: FeatureFrame, obj: str, placer: str, taker: str, taker_margin: float = TAKER_MARGIN) -> np.ndarray:
+def handoff_spot(
+    frame: FeatureFrame, obj: str, placer: str, taker: str, taker_margin: float = TAKER_MARGIN,
+    carried_to: Sequence[np.ndarray] = (),
+) -> np.ndarray:
     """The table spot (x, y) where ``placer`` sets ``obj`` down for ``taker``.
 
     Args:
@@ -50,6 +58,8 @@ def handoff_spot(frame: FeatureFrame, obj: str, placer: str, taker: str, taker_m
         taker: The arm that will grasp it there.
         taker_margin: Reach slack (m) the spot needs for ``taker`` (more keeps it nearer the middle
             of the shell, where a top-down tool, which the shell was not measured for, reaches too).
+        carried_to: Table points (x, y) the rest of the program carries a held object to (where the
+            other arm holds the cup for the pour): a spot keeps clear of them where one can.
 
     Raises:
         NoHandoffSpotError: No grid spot is reachable by both arms and clear of everything.
@@ -71,6 +81,10 @@ def handoff_spot(frame: FeatureFrame, obj: str, placer: str, taker: str, taker_m
         gap = np.linalg.norm(spots - other.pos[:2], axis=1)
         ok &= gap >= radius + _footprint(frame, name) + OBJECT_CLEARANCE
         in_the_way |= _in_approach_corridor(spots, other.pos[:2], _footprint(frame, name), radius)
+    for point in carried_to:
+        # Dual-arm pour, real seed 54: set down under where the left arm then held the cup, the bottle
+        # was knocked over by it, out of the right arm's reach.
+        in_the_way |= np.linalg.norm(spots - np.asarray(point, dtype=float)[:2], axis=1) < radius + CARRIED_CLEARANCE
     ok &= np.linalg.norm(spots - frame.arms[taker].ee[:2], axis=1) >= TOOL_CLEARANCE
     if not ok.any():
         raise NoHandoffSpotError(obj, placer, taker)
