@@ -152,3 +152,21 @@ def test_plate_shifted_during_the_place_is_followed():
     assert result.success, result.reason
     switch = result.trace.of("recovery_switch")[0]
     assert (switch["failure"], switch["edge"], switch["to"]) == ("plate_shifted", "e3", "e3_r_replace")
+
+
+@pytest.mark.parametrize("level", [True, False])
+def test_a_fork_that_flipped_over_is_grasped_lying_flat(level, monkeypatch):
+    # Stress protocol, seed 45: the fork, shifted against the plate's rim, is dropped by the right arm
+    # taking it for the left and lands upside down. Read as lying on its side (tilt 180 deg), its top
+    # grasp aimed 5 cm above it and the fingers closed on nothing three times.
+    from agentchord.actions import grasp as grasp_module
+    from agentchord.features.frame import tilt_deg
+    from agentchord.worlds.sim.disturbances import PRESETS
+
+    if not level:
+        monkeypatch.setattr(grasp_module, "level_tilt_deg", tilt_deg)
+    result = run_episode(EpisodeSpec(TASK, seed=45, protocol=True, disturb=PRESETS["stress"]))
+    if level:
+        assert result.success, result.reason
+    else:
+        assert not result.success and "fingers closed but fork is not held" in result.reason

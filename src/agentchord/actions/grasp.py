@@ -33,7 +33,7 @@ from agentchord.actions.motion import (
 )
 from agentchord.actions.side_plan import SidePlanner, side_point
 from agentchord.actions.wrist_branch import is_wound, move_above, plan_unflipped_fallen_grasp, turn_unflipped
-from agentchord.features.frame import ObjectFeatures, tilt_deg
+from agentchord.features.frame import ObjectFeatures, level_tilt_deg, tilt_deg
 from agentchord.solvers.ik import ARM_CLEARANCE, PoseTarget
 from agentchord.solvers.poses import top_down_rotation
 from agentchord.robot.aloha import HOME_Q
@@ -74,7 +74,9 @@ def plain_top_grasp(feats: ObjectFeatures) -> tuple[np.ndarray, np.ndarray]:
         and never closer than 4 mm to the table.
     """
     rot = _matrix(feats.quat)
-    lying = tilt_deg(feats.axis) >= Grasp.FALLEN_DEG
+    # On its side, not upside down: rearrange stress seed 45, a fork that flipped over when dropped
+    # was taken for a lying cylinder as tall as the fork is long, and the fingers closed 5 cm above it.
+    lying = level_tilt_deg(feats.axis) >= Grasp.FALLEN_DEG
     # The object's horizontal principal direction: its axis if lying, else its longer side.
     if lying:
         long_dir = feats.axis

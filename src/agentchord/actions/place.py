@@ -14,7 +14,7 @@ from agentchord.actions.controller import RobotController
 from agentchord.actions.geometry import _level, _matrix, _yaw_turn
 from agentchord.actions.grasp import UPRIGHT_TOLERANCE_DEG, Grasp, plain_top_grasp
 from agentchord.actions.motion import grip, move_to, pose_from_matrix, settle, wait_for_rest
-from agentchord.features.frame import FeatureFrame, ObjectFeatures, tilt_deg
+from agentchord.features.frame import FeatureFrame, ObjectFeatures, level_tilt_deg, tilt_deg
 from agentchord.solvers.exceptions import NoHandoffSpotError
 from agentchord.solvers.handoff import TAKER_MARGIN, handoff_spot
 from agentchord.solvers.ik import solve_from_scratch
@@ -47,7 +47,7 @@ PLACED_HEIGHT = 0.05
 
 def _long_axis(feats) -> np.ndarray:
     """An object's long horizontal direction: its axis if lying, else its longer horizontal side."""
-    if tilt_deg(feats.axis) >= Grasp.FALLEN_DEG:
+    if level_tilt_deg(feats.axis) >= Grasp.FALLEN_DEG:
         return feats.axis
     rot = _matrix(feats.quat)
     return rot[:, 0] if feats.extent[0] >= feats.extent[1] else rot[:, 1]

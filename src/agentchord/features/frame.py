@@ -29,6 +29,12 @@ def tilt_deg(axis) -> float:
     return float(np.degrees(np.arccos(np.clip(axis[2], -1.0, 1.0))))
 
 
+def level_tilt_deg(axis) -> float:
+    """Angle (deg, 0-90) between a principal axis's line and the vertical: an object upside down
+    (a flipped fork) lies as level as one the right way up, and is not lying on its side."""
+    return float(np.degrees(np.arccos(np.clip(abs(axis[2]), 0.0, 1.0))))
+
+
 #: Largest extent (m) of a point feature (a cloth's corner) rather than a body.
 POINT_EXTENT = 0.01
 

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from agentchord.features.frame import FeatureFrame
+from agentchord.features.frame import FeatureFrame, level_tilt_deg
 from agentchord.worlds.sim.scene import ObjectSpec, SceneSpec
 from agentchord.worlds.sim.tasks.base import Verdict, resting_on_table, uniform
 from agentchord.worlds.sim.world import SimWorld
@@ -71,7 +71,7 @@ class RearrangeTracker:
             yaw_err = yaw_error_deg(obj.quat, self.target_yaw_deg)
             if yaw_err > self.yaw_tol_deg:
                 return Verdict(False, f"the {name} is {yaw_err:.0f} deg off the y axis")
-            tilt = float(np.degrees(np.arccos(np.clip(abs(obj.axis[2]), 0.0, 1.0))))
+            tilt = level_tilt_deg(obj.axis)
             if tilt > self.flat_tol_deg:
                 return Verdict(False, f"the {name} is not lying flat (tilt {tilt:.0f} deg)")
             if not resting_on_table(world, name, frame):
