@@ -314,6 +314,15 @@ def test_move_then_open_while_holding_is_a_place_at_the_offset() -> None:
     assert _args(result, "e2", "left") == ("open_gripper", {})
 
 
+def test_an_open_after_a_move_whose_object_is_not_a_name_reports_the_move() -> None:
+    # Found by fuzzing: a list for the move's obj_name ended in a TypeError (exit 3), not exit 2.
+    bad = copy.deepcopy(SET_DOWN)
+    bad["edges"][2]["left_arm_action"]["kwargs"]["obj_name"] = []
+    problems = _problems(bad, graph_name="g.json")
+    assert any(p.startswith("g.json: edges[2].left_arm_action.kwargs.obj_name: ") and "needs obj_name" in p
+               for p in problems), problems
+
+
 def test_place_yaw_follows_the_release_x_and_only_an_unturned_down_tool() -> None:
     # The release's x in our frame: 90 deg with the aloha frame, 0 with identity, 30 for yaw=-60.
     assert _args(_import(SET_DOWN, frame="identity"), "e4", "left")[1]["yaw"] == 0.0

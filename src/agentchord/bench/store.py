@@ -15,6 +15,7 @@ import os
 from pathlib import Path
 
 from agentchord.bench.exceptions import SweepStoreError
+from agentchord.bench.record import check_record
 from agentchord.bench.sweep import RECORD_VERSION, SweepConfig, is_error
 from agentchord.guard.outputs import atomic_write_text, finite_json
 
@@ -87,10 +88,11 @@ class RecordStore:
                 record = json.loads(line)
             except ValueError as error:
                 raise SweepStoreError(f"{self.path}: line {number}: not a JSON record ({error})") from None
-            if not isinstance(record, dict) or not isinstance(record.get("id"), str):
-                raise SweepStoreError(f"{self.path}: line {number}: a record needs a string 'id'")
-            if record.get("version") != RECORD_VERSION:
+            if isinstance(record, dict) and record.get("version") != RECORD_VERSION:
                 raise SweepStoreError(f"{self.path}: line {number}: record version {record.get('version')!r}, expected {RECORD_VERSION}")
+            problems = check_record(record)
+            if problems:
+                raise SweepStoreError(f"{self.path}: line {number}: " + "; ".join(problems))
             if not (is_error(record) and record["id"] in self):  # a verdict is never replaced by an error
                 self.records[record["id"]] = record
 

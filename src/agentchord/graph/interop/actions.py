@@ -24,6 +24,7 @@ from agentchord.graph.interop.release import (
     _fmt,
     _fmt_vec,
     _fn_of,
+    _kwargs_of,
     _number,
     _Raw,
     _RawStep,
@@ -46,10 +47,11 @@ class ActionTranslator:
                     if raw is None or not isinstance(raw.call, dict):
                         continue
                     prev = last.get(arm)
-                    kwargs = raw.call.get("kwargs") or {}
+                    kwargs = _kwargs_of(raw)
                     if raw.call.get("fn") == "orient_eef" and prev is not None and prev.call.get("fn") == "grasp":
-                        obj = (prev.call.get("kwargs") or {}).get("obj_name")
-                        mode = {"down": "top", "front": "side"}.get(kwargs.get("direction", "front"))
+                        obj = _kwargs_of(prev).get("obj_name")
+                        direction = kwargs.get("direction", "front")
+                        mode = {"down": "top", "front": "side"}.get(direction) if isinstance(direction, str) else None
                         if isinstance(obj, str) and mode is not None:
                             self.grasp_modes[(arm, self.renames.get(obj, obj))] = mode
                     last[arm] = raw
@@ -143,7 +145,7 @@ class ActionTranslator:
         ok = True
         for name in names:
             value = kwargs.pop(name, default)
-            if value is not None and not _number(value):
+            if (value is not None or default is not None) and not _number(value):  # null only where it may be
                 self.error(raw.file, f"{raw.path}.kwargs.{name}", f"expected a number, got {value!r}")
                 ok = False
             out[name] = None if value is None or not ok else float(value)
@@ -284,8 +286,9 @@ class ActionTranslator:
         if held is None or _fn_of(ctx.before) != "move_relative_to_object":
             return "open_gripper", {}
         # The move before it took what the arm holds to its release point: place it there.
-        move = ctx.before.call.get("kwargs") or {}
-        ref = self.renames.get(move.get("obj_name"), move.get("obj_name"))
+        move = _kwargs_of(ctx.before)
+        ref = move.get("obj_name")
+        ref = self.renames.get(ref, ref) if isinstance(ref, str) else None  # a list or dict is not a name
         d = {k: move.get(k, 0.0) for k in ("x_offset", "y_offset", "z_offset")}
         if not isinstance(ref, str) or not all(_number(v) for v in d.values()):
             return "open_gripper", {}  # the move itself reports what is wrong with it

@@ -165,7 +165,7 @@ class ReleaseReader:
             self._unknown_keys(f, path, b, ("edge_id", "failure_name", "monitors", "recovery", "merge",
                                             "repeat_until_success"))
             edge_id, name = b.get("edge_id"), b.get("failure_name")
-            if edge_id not in steps:
+            if not isinstance(edge_id, str) or edge_id not in steps:
                 self.error(f, f"{path}.edge_id", f"unknown edge {edge_id!r}; the task graph has {', '.join(steps)}")
                 continue
             if not isinstance(name, str) or not name:
@@ -288,7 +288,7 @@ class ReleaseReader:
             elif kind in ("retry_failed_edge", "replay_edge"):
                 self._unknown_keys(f, where, s, (*common, "edge_id") if kind == "replay_edge" else common)
                 edge_id = failed if kind == "retry_failed_edge" else s.get("edge_id")
-                if edge_id not in steps:
+                if not isinstance(edge_id, str) or edge_id not in steps:
                     known = ", ".join(steps)
                     self.error(f, f"{where}.edge_id", f"unknown edge {edge_id!r}; the task graph has {known}")
                     continue

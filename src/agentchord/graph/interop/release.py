@@ -110,11 +110,20 @@ def _fmt_vec(v: Sequence[float]) -> str:
     return "(" + ", ".join(_fmt(x) for x in v) + ")"
 
 
+def _kwargs_of(raw: _Raw | None) -> dict:
+    """A release call's kwargs; empty where the call or its kwargs is not an object (the call's own
+    translation reports that)."""
+    if raw is None or not isinstance(raw.call, dict):
+        return {}
+    kwargs = raw.call.get("kwargs")
+    return kwargs if isinstance(kwargs, dict) else {}
+
+
 def _roll_of(raw: _Raw | None) -> float:
     """The roll (deg) of a release ``rotate_eef`` call, 0 for anything else."""
     if raw is None or not isinstance(raw.call, dict) or raw.call.get("fn") != "rotate_eef":
         return 0.0
-    degree = (raw.call.get("kwargs") or {}).get("degree", 0)
+    degree = _kwargs_of(raw).get("degree", 0)
     return float(degree) if _number(degree) else 0.0
 
 
