@@ -280,6 +280,7 @@ HOSTILE = [
     ("1 +", ExprSyntaxError, ""),
     ("", ExprSyntaxError, ""),
     ("1; 2", ExprSyntaxError, ";"),
+    ("0.5and right.width", ExprSyntaxError, "5and"),  # Python only warns on stderr; an error here
     ("9**9**9**9", ExprForbiddenError, "9**9"),
     ("2 ** 11", ExprForbiddenError, "11"),
     ("2 ** right.width", ExprForbiddenError, "right.width"),

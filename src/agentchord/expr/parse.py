@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import ast
+import warnings
 
 from agentchord.expr.exceptions import ExprForbiddenError, ExprSyntaxError
 
@@ -44,7 +45,11 @@ def parse_bounded(source: str) -> tuple[ast.Expression, str, int]:
     prefix = source[: len(source) - len(text)]
     shift = len(prefix) - (prefix.rfind("\n") + 1)
     try:
-        tree = ast.parse(text, mode="eval")
+        with warnings.catch_warnings():
+            # "1if", "0.5and": Python only warns (on stderr) of a number run into a keyword; here it
+            # is an error like any other, reported with the expression.
+            warnings.simplefilter("error", SyntaxWarning)
+            tree = ast.parse(text, mode="eval")
     except SyntaxError as exc:
         col = None if exc.offset is None else max(exc.offset - 1, 0) + (shift if exc.lineno == 1 else 0)
         lines = text.splitlines() or [text]
