@@ -23,8 +23,6 @@ from agentchord.robot.aloha import FINGER_GAP_OFFSET, FINGER_RANGE
 
 #: Extra reach slack (m) tried in turn for a hand-off spot until the IK confirms the taker's top-down grasp there.
 HANDOFF_EXTRA_MARGINS = (0.0, 0.02, 0.04, 0.06, 0.08)
-#: Position residual (m) under which the IK counts a hand-off grasp pose as reached (as the feasibility check).
-HANDOFF_IK_TOLERANCE = 0.01
 #: A tall object tilted more than this in the hand (deg) is turned upright before it is put down,
 #: with its bottom at least this high (m) while it turns.
 LEVEL_IN_HAND_DEG = 4.0
@@ -64,7 +62,7 @@ def _top_grasp_reaches(robot: RobotController, arm: str, feats: ObjectFeatures, 
     above = point + np.array([0.0, 0.0, catalog.GraspArgs.model_fields["pre_grasp_dis"].default])
     poses = [pose_from_matrix(above, rotation), pose_from_matrix(point, rotation)]
     ik = robot.scratch_ik(avoid_other_arm=False)
-    return solve_from_scratch(ik, robot.ik.configuration.q.copy(), arm, poses, HANDOFF_IK_TOLERANCE) is not None
+    return solve_from_scratch(ik, robot.ik.configuration.q.copy(), arm, poses) is not None
 
 
 class Place(ArmAction):

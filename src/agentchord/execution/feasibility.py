@@ -25,8 +25,6 @@ from agentchord.solvers.reach import REACH
 OFF_TABLE_Z = -0.05
 #: How far (m) beyond the reach shell's outer radius a pose is ruled out by the model alone; nearer, the IK decides.
 REACH_BEYOND_LIMIT = 0.12
-#: Position residual (m) under which the IK counts a pose as reached.
-IK_TOLERANCE = 0.01
 
 
 @dataclass(frozen=True)
@@ -133,7 +131,7 @@ class FeasibilityChecker:
         """
         ik = self.robot.scratch_ik(avoid_other_arm)
         current = self.robot.ik.configuration.q.copy()
-        return solve_from_scratch(ik, current, arm, poses, IK_TOLERANCE) is not None
+        return solve_from_scratch(ik, current, arm, poses) is not None
 
     def check_grasp(self, grasp: Grasp, *, hand_free: bool = True, confirm_ik: bool = True,
                     avoid_other_arm: bool = True) -> GraspCheck:

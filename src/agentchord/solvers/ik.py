@@ -148,8 +148,13 @@ class BimanualIK:
         return float(np.linalg.norm(self.tcp_pose(arm).pos - target.pos))
 
 
+#: Position residual (m) under which a scratch solve counts a pose as reached: the feasibility check
+#: before a recovery binds and the hand-off's check of the taker's grasp use the same.
+REACHED_TOLERANCE = 0.01
+
+
 def solve_from_scratch(
-    ik: BimanualIK, q: np.ndarray, arm: str, poses: list[PoseTarget], tolerance: float = 0.01,
+    ik: BimanualIK, q: np.ndarray, arm: str, poses: list[PoseTarget], tolerance: float = REACHED_TOLERANCE,
     from_current: bool = True, from_home: bool = True, joints_at: int = -1,
 ) -> np.ndarray | None:
     """Joints that put ``arm`` at the last of ``poses``, reached through the others in order.
