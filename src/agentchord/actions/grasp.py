@@ -171,14 +171,18 @@ class Grasp(ArmAction):
         share = grasp_height_share(robot.frame, self.arm, self.args.obj)
         return abs(share - self.args.height) <= self.HELD_HEIGHT_TOLERANCE
 
+    @classmethod
+    def is_tall(cls, feats: ObjectFeatures) -> bool:
+        """Whether an object is tall enough to be taken from the side (``auto`` mode), not from above."""
+        return float(np.linalg.norm(feats.top - feats.bottom)) >= cls.SIDE_MIN_HEIGHT
+
     def _mode(self, robot: RobotController) -> str:
         """How the object is taken now: ``top``, ``side`` (upright or leaning a little) or ``fallen`` (lying)."""
         feats = robot.frame.objects[self.args.obj]
         tilt = tilt_deg(feats.axis)
-        height = float(np.linalg.norm(feats.top - feats.bottom))
         mode = self.args.mode
         if mode == "auto":
-            mode = "side" if height >= self.SIDE_MIN_HEIGHT else "top"
+            mode = "side" if self.is_tall(feats) else "top"
         if mode == "top":
             return "top"
         # Leaning on something (pushed into another object): a little, the closing fingers stand it

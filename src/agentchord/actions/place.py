@@ -151,7 +151,7 @@ class Place(ArmAction):
         """
         frame, taker = robot.frame, self.args.within_reach
         feats = frame.objects[self.args.obj]
-        from_above = float(np.linalg.norm(feats.top - feats.bottom)) < Grasp.SIDE_MIN_HEIGHT
+        from_above = not Grasp.is_tall(feats)
         nearest = None
         for extra in HANDOFF_EXTRA_MARGINS:
             try:
@@ -234,8 +234,7 @@ class Place(ArmAction):
             return False
         if min(feats.bottom[2], feats.top[2]) > PLACED_HEIGHT:
             return False
-        tall = float(np.linalg.norm(feats.top - feats.bottom)) >= Grasp.SIDE_MIN_HEIGHT
-        if tall and tilt_deg(feats.axis) > UPRIGHT_TOLERANCE_DEG:
+        if Grasp.is_tall(feats) and tilt_deg(feats.axis) > UPRIGHT_TOLERANCE_DEG:
             return False
         if args.yaw is not None:
             axis = _long_axis(feats)
