@@ -628,3 +628,55 @@ def test_rearrangement_imported_graph_succeeds_on_one_seed(tmp_path: Path) -> No
     run = CliRunner().invoke(main, ["run", "rearrange_table", "--graph", str(out), "--seed", "1"])
     assert run.exit_code == 0, run.output
     assert "SUCCESS" in run.output
+
+
+#: Values a mutated release file gets where it had something else (types an importer must not trip on).
+_WRONG = [None, "", "x", -1, 0, 1e308, float("nan"), float("inf"), [], {}, [1, 2], {"a": 1}, True, [None], "e1", "left_arm"]
+
+
+def _paths(value, at=()):
+    yield at
+    children = value.items() if isinstance(value, dict) else enumerate(value) if isinstance(value, list) else ()
+    for key, child in children:
+        yield from _paths(child, (*at, key))
+
+
+def _mutated(document, rng):
+    """``document`` with 1-3 values deleted, duplicated or replaced by one of :data:`_WRONG`."""
+    document = copy.deepcopy(document)
+    for _ in range(rng.randint(1, 3)):
+        paths = [p for p in _paths(document) if p]
+        if not paths:
+            break
+        *parent_path, key = rng.choice(paths)
+        parent = document
+        for step in parent_path:
+            parent = parent[step]
+        roll = rng.random()
+        if roll < 0.25:
+            del parent[key]
+        elif roll < 0.35 and isinstance(parent, list):
+            parent.append(copy.deepcopy(parent[key]))
+        else:
+            parent[key] = copy.deepcopy(rng.choice(_WRONG))
+    return document
+
+
+@needs_examples
+@pytest.mark.parametrize("name", PAIRS)
+def test_mutated_release_files_are_reported_never_crashed_on(name: str) -> None:
+    # Fuzzing found six places where a wrongly typed value (a list for an obj_name or an edge_id,
+    # a string for kwargs, a null offset) ended in a TypeError or AttributeError: exit 3, not 2.
+    import random
+
+    rng = random.Random(f"interop-{name}")
+    graph_path, spec_path = _pair(name)
+    graph, spec = json.loads(graph_path.read_text()), json.loads(spec_path.read_text())
+    for _ in range(400):
+        which = rng.random()
+        pair = (_mutated(graph, rng), spec) if which < 0.45 else (graph, _mutated(spec, rng)) if which < 0.9 \
+            else (_mutated(graph, rng), _mutated(spec, rng))
+        try:
+            import_release_data(*pair, folder=name)
+        except ReleaseImportError as error:
+            assert error.problems and all(isinstance(p, str) and p for p in error.problems)
