@@ -665,7 +665,7 @@ def _mutated(document, rng):
 @needs_examples
 @pytest.mark.parametrize("name", PAIRS)
 def test_mutated_release_files_are_reported_never_crashed_on(name: str) -> None:
-    # Fuzzing found six places where a wrongly typed value (a list for an obj_name or an edge_id,
+    # Fuzzing found eight places where a wrongly typed value (a list for an obj_name or an edge_id,
     # a string for kwargs, a null offset) ended in a TypeError or AttributeError: exit 3, not 2.
     import random
 

@@ -65,6 +65,23 @@ class GraspMissed(ActionFailed):
     """The fingers closed but the object is not between them."""
 
 
+def lies_on_side(feats: ObjectFeatures) -> bool:
+    """Whether an object lies on its side (its axis near horizontal), not upright or upside down.
+
+    Rearrange stress seed 45: a fork that flipped over when dropped (tilt 180 deg) was taken for a
+    lying cylinder as tall as the fork is long, and the fingers closed 5 cm above it.
+    """
+    return level_tilt_deg(feats.axis) >= Grasp.FALLEN_DEG
+
+
+def long_axis(feats: ObjectFeatures) -> np.ndarray:
+    """An object's long direction: its axis if it lies on its side, else its longer horizontal side."""
+    if lies_on_side(feats):
+        return feats.axis
+    rot = _matrix(feats.quat)
+    return rot[:, 0] if feats.extent[0] >= feats.extent[1] else rot[:, 1]
+
+
 def plain_top_grasp(feats: ObjectFeatures) -> tuple[np.ndarray, np.ndarray]:
     """The top-down grasp of an object where it lies, before any clearance or offset is applied.
 
@@ -73,15 +90,8 @@ def plain_top_grasp(feats: ObjectFeatures) -> tuple[np.ndarray, np.ndarray]:
         across it) and the tool centre, whose finger tips go 70 % down the object (at most 3 cm)
         and never closer than 4 mm to the table.
     """
-    rot = _matrix(feats.quat)
-    # On its side, not upside down: rearrange stress seed 45, a fork that flipped over when dropped
-    # was taken for a lying cylinder as tall as the fork is long, and the fingers closed 5 cm above it.
-    lying = level_tilt_deg(feats.axis) >= Grasp.FALLEN_DEG
-    # The object's horizontal principal direction: its axis if lying, else its longer side.
-    if lying:
-        long_dir = feats.axis
-    else:
-        long_dir = rot[:, 0] if feats.extent[0] >= feats.extent[1] else rot[:, 1]
+    lying = lies_on_side(feats)
+    long_dir = long_axis(feats)
     long_dir = np.array([long_dir[0], long_dir[1], 0.0])
     if np.linalg.norm(long_dir) < 1e-6:
         long_dir = np.array([1.0, 0.0, 0.0])

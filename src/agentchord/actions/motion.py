@@ -102,9 +102,12 @@ def approach(
     """
     yield from move_to(robot, arm, goal, speed=speed)
     yield from settle(robot, arm, tolerance=APPROACH_TOLERANCE, max_ticks=settle_ticks)
-    ik, q = robot.scratch_ik(), robot.ik.configuration.q.copy()
-    if float(np.linalg.norm(robot.frame.arms[arm].ee - goal.pos)) < APPROACH_TOLERANCE:
-        if then is None or solve_from_scratch(ik, q, arm, [then], from_home=False) is not None:
+    reached = float(np.linalg.norm(robot.frame.arms[arm].ee - goal.pos)) < APPROACH_TOLERANCE
+    if reached and then is None:
+        return
+    ik, q = robot.scratch_ik(), robot.ik.configuration.q.copy()  # only where a check is due
+    if reached:
+        if solve_from_scratch(ik, q, arm, [then], from_home=False) is not None:
             return
         q_goal = solve_from_scratch(ik, q, arm, [goal, then], from_current=False, joints_at=0)
     else:

@@ -11,10 +11,10 @@ from scipy.spatial.transform import Rotation
 from agentchord.actions import catalog
 from agentchord.actions.base import ActionFailed, ArmAction, ObjectGone
 from agentchord.actions.controller import RobotController
-from agentchord.actions.geometry import _level, _matrix, _yaw_turn
-from agentchord.actions.grasp import UPRIGHT_TOLERANCE_DEG, Grasp, plain_top_grasp
+from agentchord.actions.geometry import _level, _yaw_turn
+from agentchord.actions.grasp import UPRIGHT_TOLERANCE_DEG, Grasp, long_axis, plain_top_grasp
 from agentchord.actions.motion import grip, move_to, pose_from_matrix, settle, wait_for_rest
-from agentchord.features.frame import FeatureFrame, ObjectFeatures, level_tilt_deg, tilt_deg
+from agentchord.features.frame import FeatureFrame, ObjectFeatures, tilt_deg
 from agentchord.solvers.exceptions import NoHandoffSpotError
 from agentchord.solvers.handoff import TAKER_MARGIN, handoff_spot
 from agentchord.solvers.ik import solve_from_scratch
@@ -41,14 +41,6 @@ PLACED_TOLERANCE = 0.03
 PLACED_YAW_DEG = 20.0
 #: ... resting: its lower end below this height (m) (on the table, or on a tray or plate).
 PLACED_HEIGHT = 0.05
-
-
-def _long_axis(feats) -> np.ndarray:
-    """An object's long horizontal direction: its axis if lying, else its longer horizontal side."""
-    if level_tilt_deg(feats.axis) >= Grasp.FALLEN_DEG:
-        return feats.axis
-    rot = _matrix(feats.quat)
-    return rot[:, 0] if feats.extent[0] >= feats.extent[1] else rot[:, 1]
 
 
 def _top_grasp_reaches(robot: RobotController, arm: str, feats: ObjectFeatures, spot: np.ndarray) -> bool:
@@ -115,7 +107,7 @@ class Place(ArmAction):
             # Turn the tool about the vertical so the object's long axis ends at the asked yaw
             # (either direction), keeping the object's centre where it goes.
             goal = target if target is not None else obj.pos[:2]
-            turn = _yaw_turn(robot, arm, _long_axis(obj), self.args.yaw, goal)
+            turn = _yaw_turn(robot, arm, long_axis(obj), self.args.yaw, goal)
             held = obj.pos[:2] - tool.pos[:2]
             rotation = turn @ rotation
             above[:2] = goal - turn[:2, :2] @ held
@@ -237,7 +229,7 @@ class Place(ArmAction):
         if Grasp.is_tall(feats) and tilt_deg(feats.axis) > UPRIGHT_TOLERANCE_DEG:
             return False
         if args.yaw is not None:
-            axis = _long_axis(feats)
+            axis = long_axis(feats)
             off = (np.degrees(np.arctan2(axis[1], axis[0])) - args.yaw) % 180.0
             if min(off, 180.0 - off) > PLACED_YAW_DEG:
                 return False

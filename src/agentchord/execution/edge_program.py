@@ -120,10 +120,9 @@ def _link_handoffs_to_later_moves(steps: list[list[ArmAction]]) -> None:
     """Give each hand-off place (``within_reach``) the points later steps move a tool to."""
     for i, step in enumerate(steps):
         for action in step:
-            if action.name != "place" or getattr(action.args, "within_reach", None) is None:
-                continue
-            action.carried_to = tuple(np.asarray(a.args.pos, dtype=float)[:2] for s in steps[i + 1:] for a in s
-                                      if a.name == "move_to_target")
+            if action.name == "place" and action.args.within_reach is not None:
+                action.carried_to = tuple(np.asarray(a.args.pos[:2], dtype=float) for s in steps[i + 1:] for a in s
+                                          if a.name == "move_to_target")
 
 
 class ReturnToKeyframe(ArmAction):

@@ -84,7 +84,7 @@ def handoff_spot(
     for point in carried_to:
         # Dual-arm pour, real seed 54: set down under where the left arm then held the cup, the bottle
         # was knocked over by it, out of the right arm's reach.
-        in_the_way |= np.linalg.norm(spots - np.asarray(point, dtype=float)[:2], axis=1) < radius + CARRIED_CLEARANCE
+        in_the_way |= np.linalg.norm(spots - np.asarray(point[:2], dtype=float), axis=1) < radius + CARRIED_CLEARANCE
     ok &= np.linalg.norm(spots - frame.arms[taker].ee[:2], axis=1) >= TOOL_CLEARANCE
     if not ok.any():
         raise NoHandoffSpotError(obj, placer, taker)
