@@ -146,6 +146,26 @@ def test_a_fallen_grasp_goes_over_a_neighbour_its_straight_approach_would_strike
         assert not result.success and "cup fell off the table" in result.reason
 
 
+@pytest.mark.parametrize("slides", [True, False])
+def test_a_fallen_grasp_slides_along_the_object_where_a_finger_would_come_down_on_a_neighbour(slides, monkeypatch):
+    # Real-world protocol, single-arm pour, seed 58: the bottle pulled out of the hand lies against the
+    # cup. At its centre a finger came down on the cup's rim and the tool stopped 6 cm above the grasp,
+    # three times, for the right arm; the left arm's alternative could not reach past it. Slid 2.5 cm
+    # along the bottle, clear of the cup, the right arm takes it.
+    from agentchord.actions import grasp as grasp_module
+    from agentchord.actions.finger_clearance import TopGraspChoice
+    from agentchord.execution.episode import EpisodeSpec, run_episode
+    from agentchord.worlds.sim.disturbances import PRESETS
+
+    if not slides:
+        monkeypatch.setattr(grasp_module, "clear_top_grasp", lambda *args: TopGraspChoice())
+    result = run_episode(EpisodeSpec("single_arm_pour_water", seed=58, protocol=True, disturb=PRESETS["real"]))
+    if slides:
+        assert result.success, result.reason
+    else:
+        assert not result.success and "bottle_dropped_via_left" in result.reason
+
+
 def test_a_side_grasp_refuses_an_object_knocked_over_meanwhile(pour_scene):
     # A side grasp closing on a bottle that now lies would carry it lying across the fingers; the
     # grasp's retry takes it the way a fallen one is taken instead.

@@ -148,6 +148,8 @@ class Grasp(ArmAction):
     placed_by: PlacedCheck | None = None
     #: The top grasp's departure from the plain one, chosen at an attempt's first look.
     _top_choice: TopGraspChoice | None = None
+    #: The fallen grasp's slide along the lying object's axis (m), chosen at an attempt's first look.
+    _fallen_slide: float | None = None
 
     def script(self, robot: RobotController) -> Iterator[None]:
         held = robot.targets[self.arm].grip_closed_settled and robot.frame.is_holding(self.arm, self.args.obj)
@@ -454,15 +456,26 @@ class Grasp(ArmAction):
         lift = robot.commanded_pose(arm).pos + np.array([0.0, 0.0, lift_by])
         yield from move_to(robot, arm, pose_from_matrix(lift, rotation), speed=0.15)
 
-    def _fallen_frame(self, robot: RobotController) -> tuple[np.ndarray, np.ndarray]:
-        """Tool rotation (approach down, fingers across the lying object's axis) and grasp point."""
+    def _fallen_frame(self, robot: RobotController, keep_slide: bool = False) -> tuple[np.ndarray, np.ndarray]:
+        """Tool rotation (approach down, fingers across the lying object's axis) and grasp point.
+
+        Where the open fingers would come down on a neighbour, the grasp point slides along the
+        axis to the nearest one whose fingers clear it (:func:`clear_top_grasp`, as a top grasp):
+        single-arm pour, real seed 58, a bottle pulled out of the hand came to lie against the cup,
+        and a finger came down on the cup's rim three times, 6 cm above the grasp. With
+        ``keep_slide`` the slide chosen at the attempt's first look is kept.
+        """
         feats = robot.frame.objects[self.args.obj]
         top_dir = np.array([feats.axis[0], feats.axis[1], 0.0])
         top_dir /= max(np.linalg.norm(top_dir), 1e-9)
         rotation = top_down_rotation(top_dir)
         radius = 0.5 * float(feats.extent[0])
         # The finger tips reach ~4 cm past the tool centre: stay high enough to miss the table.
-        return rotation, np.r_[feats.pos[:2], max(feats.pos[2] + 0.35 * radius, self.FINGERTIP_REACH + 0.006)]
+        point = np.r_[feats.pos[:2], max(feats.pos[2] + 0.35 * radius, self.FINGERTIP_REACH + 0.006)]
+        if not keep_slide or self._fallen_slide is None:
+            # Only a slide: the fingers stay across the axis, which the turn upright needs.
+            self._fallen_slide = clear_top_grasp(robot.frame, self.args.obj, point, top_dir).slide
+        return rotation, point + self._fallen_slide * top_dir
 
     def _fallen_grasp(self, robot: RobotController) -> Iterator[None]:
         arm = self.arm
@@ -486,7 +499,7 @@ class Grasp(ArmAction):
         # A top-down tool often flips the forearm roll: let the IK converge before descending.
         yield from settle(robot, arm, tolerance=0.003, max_ticks=60, required=0.015)
         feats = robot.frame.objects[self.args.obj]
-        point[:2] = feats.pos[:2]
+        point[:2] = feats.pos[:2] + self._fallen_slide * rotation[:2, 2]  # the slide kept: the fingers' axis
         yield from move_to(robot, arm, pose_from_matrix(point, rotation), speed=0.08)
         yield from self._close_and_check(robot)
         lifted, yaw = self._turn_pose(robot, feats, point, rotation)
@@ -515,7 +528,8 @@ class Grasp(ArmAction):
         the tool's position, lifted clear of the table and away from the arm's base, and the swing
         (rad, about the vertical) that points the object's top away from the robot."""
         half_length = 0.5 * float(np.linalg.norm(feats.top - feats.bottom))
-        lifted = point + np.array([0.0, 0.0, half_length + 0.06])
+        # Grasped nearer the top (a slide clear of a neighbour), the bottom hangs that much lower.
+        lifted = point + np.array([0.0, 0.0, half_length + max(self._fallen_slide or 0.0, 0.0) + 0.06])
         base = robot.world.arm_base(self.arm)
         out = lifted[:2] - base[:2]
         if 1e-6 < float(np.linalg.norm(out)) < self.TURN_FROM_BASE:
