@@ -58,6 +58,10 @@ class RobotController:
         self.frame: FeatureFrame | None = None
         #: Wall seconds of every receding-horizon path solve (for the benchmarks).
         self.path_solves: list[float] = []
+        #: Arms no running action commands in the current step (set by the edge program while it
+        #: updates): an action held back by one of them may move it out of its way. Empty outside a
+        #: program, so an action run on its own never moves the other arm.
+        self.free_arms: frozenset[str] = frozenset()
         self._scratch_ik: dict[bool, BimanualIK] = {}
         self.sync_from_world()
 

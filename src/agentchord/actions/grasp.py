@@ -18,6 +18,7 @@ from agentchord.actions.controller import RobotController
 from agentchord.actions.finger_clearance import TopGraspChoice, clear_top_grasp, crossing_over
 from agentchord.actions.geometry import _matrix, _wrist_margin
 from agentchord.actions.in_hand import grasp_height_share
+from agentchord.actions.make_way import make_way
 from agentchord.actions.motion import (
     ANGULAR_SPEED,
     EMPTY_HAND_JOINT_SPEED,
@@ -63,6 +64,10 @@ class PlacedCheck(Protocol):
 
 class GraspMissed(ActionFailed):
     """The fingers closed but the object is not between them."""
+
+
+class HeldBackByOtherArm(GraspMissed):
+    """The arm-arm collision limit held the arm back from the grasp: the other arm was in the way."""
 
 
 def lies_on_side(feats: ObjectFeatures) -> bool:
@@ -160,12 +165,21 @@ class Grasp(ArmAction):
             if robot.targets[self.arm].grip > 0.0:
                 yield from grip(robot, self.arm, 0.0, ticks=8)
             return
+        made_way = False
         for attempt in range(self.ATTEMPTS):
             try:
                 yield from self._let_go(robot)
                 yield from wait_for_rest(robot, self.args.obj)
                 yield from self._attempt(robot)
                 return
+            except HeldBackByOtherArm:
+                if attempt == self.ATTEMPTS - 1:
+                    raise
+                # Once per grasp: the other arm, if its part of the step is done, steps back.
+                if not made_way:
+                    above = robot.commanded_pose(self.arm)
+                    above.pos[2] += self.args.pre_grasp_dis
+                    made_way = yield from make_way(robot, self.arm, back_off=above)
             except GraspMissed:
                 # The object moved as the fingers closed (a nudge, a roll): look again and retry.
                 if attempt == self.ATTEMPTS - 1:
@@ -310,7 +324,7 @@ class Grasp(ArmAction):
                 # the arm fell short on its own (a joint limit), and the message says so.
                 clearance = robot.ik.arm_clearance()
                 if clearance < BLOCKED_CLEARANCE:
-                    raise GraspMissed(f"the other arm was in the way of the grasp of {self.args.obj}") from None
+                    raise HeldBackByOtherArm(f"the other arm was in the way of the grasp of {self.args.obj}") from None
                 if not blocked:
                     raise GraspMissed(
                         f"the arm stopped short of the grasp of {self.args.obj}, "

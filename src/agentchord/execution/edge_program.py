@@ -74,10 +74,18 @@ class EdgeProgram:
 
     def update(self, robot: RobotController) -> Status:
         """Advance every running action one tick."""
+        try:
+            return self._update(robot)
+        finally:
+            robot.free_arms = frozenset()
+
+    def _update(self, robot: RobotController) -> Status:
         while self.step_index < len(self.steps):
             statuses = []
             for action in self.running:
                 if action.status == Status.RUNNING:
+                    # An arm whose part of the step is done may be moved aside by the other's action.
+                    robot.free_arms = frozenset(robot.targets) - {a.arm for a in self.running if a.status == Status.RUNNING}
                     status = action.update(robot)
                     if status != Status.RUNNING:
                         self.on_action_end(action.arm, action)
