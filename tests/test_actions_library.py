@@ -458,3 +458,17 @@ def test_a_flat_object_upside_down_is_grasped_as_if_the_right_way_up():
     np.testing.assert_allclose(down_point, up_point, atol=1e-9)
     assert abs(float(np.dot(down_dir, up_dir))) == pytest.approx(1.0)
     assert up_point[2] < 0.05  # the finger tips near the table, not a fork's length above it
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", [25, 33])
+def test_a_cloth_corner_pinched_off_its_point_is_held(seed):
+    # Real-world protocol, fold towel, seeds 25 and 33: a corner re-taken from the folded towel (it
+    # lies on the cloth) is pinched 2.6-2.8 cm from its point. The hold is a hold (the frame reports
+    # it: the fingers touch the cloth near the point); before, the off-centre check let go of it
+    # three times and the episode failed ("towel_bl is held 2.8 cm off the grasp point").
+    from agentchord.execution.episode import EpisodeSpec, run_episode
+    from agentchord.worlds.sim.disturbances import PRESETS
+
+    result = run_episode(EpisodeSpec("fold_towel", seed=seed, protocol=True, disturb=PRESETS["real"]))
+    assert result.success, result.reason

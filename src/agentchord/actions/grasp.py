@@ -348,10 +348,13 @@ class Grasp(ArmAction):
             self._still_standing(robot, "as the fingers closed")
         # Pushed while the fingers closed, it is held off-centre (a pour or a place would then miss):
         # where the grasp point is now, seen from where the tool aimed, says so.
-        # (Not for a fallen or leaning object: the closing fingers turn it, which is the point.)
-        upright = tilt_deg(robot.frame.objects[self.args.obj].axis) <= UPRIGHT_TOLERANCE_DEG
+        # (Not for a fallen or leaning object: the closing fingers turn it, which is the point. Nor for
+        # a cloth's point: the fingers pinch the cloth around it, the hold the frame reports is the
+        # check, and where the point is then laid the placed monitors judge.)
+        feats = robot.frame.objects[self.args.obj]
+        upright = tilt_deg(feats.axis) <= UPRIGHT_TOLERANCE_DEG
         off = 0.0
-        if self._taken_as == "top":
+        if self._taken_as == "top" and not feats.is_point:
             off = float(np.linalg.norm(self._top_frame(robot, keep_choice=True)[1] - aimed))
         elif self._taken_as == "side" and upright and self._upright_at_start:
             off = float(np.linalg.norm(self._side_point(robot, self._height_fraction) - aimed))
