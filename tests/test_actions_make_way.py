@@ -77,6 +77,17 @@ def test_an_arm_running_an_action_of_its_own_is_not_moved(robot):
     np.testing.assert_allclose(robot.commanded_pose("left").pos, before)
 
 
+def test_an_arm_the_collision_limit_holds_still_is_not_moved(robot, monkeypatch):
+    # Proxies already overlapping (a bottle caught on the right hand at home, reached for by the
+    # left arm): the collision limit holds both arms still, so a step back would only cost time.
+    _command(robot, "left", [-0.06, 0.55, 0.15])
+    before = robot.commanded_pose("left").pos.copy()
+    robot.free_arms = frozenset({"left"})
+    monkeypatch.setattr(robot.ik, "arm_clearance", lambda: -0.04)
+    assert _drive(robot, make_way(robot, "right", back_off=robot.commanded_pose("right"))) is False
+    np.testing.assert_allclose(robot.commanded_pose("left").pos, before)
+
+
 def test_a_free_arm_steps_back_after_the_blocked_arm_backs_off(robot):
     _command(robot, "left", [-0.06, 0.55, 0.15])
     for _ in range(150):

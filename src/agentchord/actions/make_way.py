@@ -56,10 +56,13 @@ def make_way(robot: RobotController, blocked: str, back_off: PoseTarget) -> Iter
     the other arm off its own target lets go of it there); then the other arm steps back.
 
     Returns (as the generator's value) whether it moved: an arm still running an action of its own,
-    or one already as near its shoulder as it may go, is left where it is.
+    one already as near its shoulder as it may go, or one the collision limit holds still, is left
+    where it is.
     """
     arm = other_arm(robot, blocked)
-    if arm not in robot.free_arms:
+    # Arms whose collision proxies already overlap (a bottle caught on the hand at home, reached
+    # for by the other arm) are both held still by the collision limit: no step back is followed.
+    if arm not in robot.free_arms or robot.ik.arm_clearance() < 0.0:
         return False
     goal = step_back_pose(robot, arm)
     if goal is None:
