@@ -82,6 +82,7 @@ LAID_HEIGHT = 0.015
 
 
 def _same_cloth(a: str, b: str) -> bool:
+    # A cloth's points are named ``{cloth}_{corner}`` (``towel_bl``; the world's cloth point names).
     return a.rsplit("_", 1)[0] == b.rsplit("_", 1)[0]
 
 
