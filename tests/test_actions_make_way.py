@@ -103,28 +103,32 @@ def test_a_free_arm_steps_back_after_the_blocked_arm_backs_off(robot):
     assert float(np.linalg.norm(robot.frame.arms["left"].ee - goal.pos)) < 0.01
 
 
+def _episode(task, seed, protocol, monkeypatch, switched_off=None):
+    """Run a protocol episode, with one of make_way's helpers (as the grasp calls it) switched off."""
+    from agentchord.actions import grasp as grasp_module
+    from agentchord.execution.episode import EpisodeSpec, run_episode
+    from agentchord.worlds.sim.disturbances import PRESETS
+
+    if switched_off is not None:
+        def never(*args, **kwargs):
+            return False
+            yield
+
+        monkeypatch.setattr(grasp_module, switched_off, never)
+    return run_episode(EpisodeSpec(task, seed=seed, protocol=True, disturb=PRESETS[protocol]))
+
+
 @pytest.mark.parametrize("makes_way", [True, False])
 def test_a_regrasp_held_back_by_the_idle_arm_has_it_step_back(makes_way, monkeypatch):
     # Stress protocol, dual-arm pour, seed 26: the bottle knocked over during the first grasp lies
     # beside the cup the left arm holds. The right arm's fallen grasp is held back by the left arm
     # (the collision limit), every attempt. With the left arm's part of the step done, it steps back
     # towards its shoulder, cup in hand, and the right arm takes the bottle.
-    from agentchord.actions import grasp as grasp_module
-    from agentchord.execution.episode import EpisodeSpec, run_episode
-    from agentchord.worlds.sim.disturbances import PRESETS
-
-    if not makes_way:
-        def stays(robot, blocked, back_off):
-            return False
-            yield
-
-        monkeypatch.setattr(grasp_module, "make_way", stays)
-    result = run_episode(EpisodeSpec("dual_arm_pour_water", seed=26, protocol=True, disturb=PRESETS["stress"]))
+    result = _episode("dual_arm_pour_water", 26, "stress", monkeypatch, None if makes_way else "make_way")
     if makes_way:
         assert result.success, result.reason
     else:
         assert not result.success and "the other arm was in the way of the grasp of bottle" in result.reason
-
 
 
 def test_no_cloth_is_laid_down_where_the_other_arm_holds_no_point_of_it(robot):
@@ -143,17 +147,7 @@ def test_a_corner_draped_from_the_held_one_is_taken_after_the_held_one_is_lowere
     # draped from it. Pinched in the air it slipped out again, then the fingers closed on nothing
     # three times (each pushed it 3.5 cm away). With the left corner lowered first, the cloth lies
     # down, the right corner is taken from the table and the towel folded.
-    from agentchord.actions import grasp as grasp_module
-    from agentchord.execution.episode import EpisodeSpec, run_episode
-    from agentchord.worlds.sim.disturbances import PRESETS
-
-    if not lays_down:
-        def stays(robot, grasping, point):
-            return False
-            yield
-
-        monkeypatch.setattr(grasp_module, "lay_cloth_down", stays)
-    result = run_episode(EpisodeSpec("fold_towel", seed=37, protocol=True, disturb=PRESETS["real"]))
+    result = _episode("fold_towel", 37, "real", monkeypatch, None if lays_down else "lay_cloth_down")
     if lays_down:
         assert result.success, result.reason
     else:
