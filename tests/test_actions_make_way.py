@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from agentchord.actions.controller import RobotController
-from agentchord.actions.make_way import NEAREST_TO_SHOULDER, STEP_BACK, lay_cloth_down, make_way, other_arm, step_back_pose
+from agentchord.actions.make_way import NEAREST_TO_SHOULDER, STEP_BACK, make_way, other_arm, step_back_pose
 from agentchord.features.oracle import OracleExtractor
 from agentchord.solvers.ik import PoseTarget
 from agentchord.worlds.sim.world import SimWorld
@@ -104,7 +104,7 @@ def test_a_free_arm_steps_back_after_the_blocked_arm_backs_off(robot):
 
 
 def _episode(task, seed, protocol, monkeypatch, switched_off=None):
-    """Run a protocol episode, with one of make_way's helpers (as the grasp calls it) switched off."""
+    """Run a protocol episode, with a make_way helper (as the grasp calls it) switched off."""
     from agentchord.actions import grasp as grasp_module
     from agentchord.execution.episode import EpisodeSpec, run_episode
     from agentchord.worlds.sim.disturbances import PRESETS
@@ -129,26 +129,3 @@ def test_a_regrasp_held_back_by_the_idle_arm_has_it_step_back(makes_way, monkeyp
         assert result.success, result.reason
     else:
         assert not result.success and "the other arm was in the way of the grasp of bottle" in result.reason
-
-
-def test_no_cloth_is_laid_down_where_the_other_arm_holds_no_point_of_it(robot):
-    # The pour scene has no cloth: the free right arm holds nothing to lower.
-    robot.free_arms = frozenset({"right"})
-    before = robot.commanded_pose("right").pos.copy()
-    assert _drive(robot, lay_cloth_down(robot, "left", "bottle")) is False
-    np.testing.assert_allclose(robot.commanded_pose("right").pos, before)
-
-
-@pytest.mark.slow
-@pytest.mark.parametrize("lays_down", [True, False])
-def test_a_corner_draped_from_the_held_one_is_taken_after_the_held_one_is_lowered(lays_down, monkeypatch):
-    # Real-world protocol, fold towel, seed 37: the right corner slipped out while both corners were
-    # carried over; the left arm held its corner up and the right one hung 6-9 cm above the table,
-    # draped from it. Pinched in the air it slipped out again, then the fingers closed on nothing
-    # three times (each pushed it 3.5 cm away). With the left corner lowered first, the cloth lies
-    # down, the right corner is taken from the table and the towel folded.
-    result = _episode("fold_towel", 37, "real", monkeypatch, None if lays_down else "lay_cloth_down")
-    if lays_down:
-        assert result.success, result.reason
-    else:
-        assert not result.success and "fingers closed but towel_br is not held" in result.reason

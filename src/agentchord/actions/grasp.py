@@ -18,7 +18,7 @@ from agentchord.actions.controller import RobotController
 from agentchord.actions.finger_clearance import TopGraspChoice, clear_top_grasp, crossing_over
 from agentchord.actions.geometry import _matrix, _wrist_margin
 from agentchord.actions.in_hand import grasp_height_share
-from agentchord.actions.make_way import DRAPED_HEIGHT, lay_cloth_down, make_way
+from agentchord.actions.make_way import make_way
 from agentchord.actions.motion import (
     ANGULAR_SPEED,
     EMPTY_HAND_JOINT_SPEED,
@@ -165,14 +165,11 @@ class Grasp(ArmAction):
             if robot.targets[self.arm].grip > 0.0:
                 yield from grip(robot, self.arm, 0.0, ticks=8)
             return
-        made_way = laid_down = False
+        made_way = False
         for attempt in range(self.ATTEMPTS):
             try:
                 yield from self._let_go(robot)
                 yield from wait_for_rest(robot, self.args.obj)
-                feats = robot.frame.objects[self.args.obj]
-                if not laid_down and feats.is_point and feats.pos[2] > DRAPED_HEIGHT:
-                    laid_down = yield from lay_cloth_down(robot, self.arm, self.args.obj)
                 yield from self._attempt(robot)
                 return
             except HeldBackByOtherArm:

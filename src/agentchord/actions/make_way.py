@@ -5,10 +5,6 @@ it) holds that arm back through the IK's arm-arm collision limit. When the arm i
 action of its own in the current step (its part of the step is done), the blocked action may move
 it aside: straight back towards its own shoulder, its tool's orientation kept, so whatever it holds
 stays as it was held.
-
-A free arm holding up a cloth is in the way in another sense: a corner hanging from the cloth it
-holds up cannot be pinched in the air. The grasp has it lower what it holds first, so the cloth
-lies down on the table.
 """
 
 from __future__ import annotations
@@ -18,7 +14,7 @@ from collections.abc import Iterator
 import numpy as np
 
 from agentchord.actions.controller import RobotController
-from agentchord.actions.motion import move_to, settle, wait_for_rest
+from agentchord.actions.motion import move_to, settle
 from agentchord.solvers.ik import PoseTarget
 
 #: How far (m, horizontally) a free arm steps back towards its shoulder to make way.
@@ -71,40 +67,4 @@ def make_way(robot: RobotController, blocked: str, back_off: PoseTarget) -> Iter
     yield from settle(robot, arm)
     yield from move_to(robot, arm, goal)
     yield from settle(robot, arm)
-    return True
-
-
-#: A cloth point (a corner) higher than this (m) above the table hangs in the air, draped from a
-#: point the other arm holds up: a top grasp pushes it away, or pinches it poorly.
-DRAPED_HEIGHT = 0.03
-#: The other arm lowers the point it holds until that point is this high (m): the cloth lies down.
-LAID_HEIGHT = 0.015
-
-
-def _same_cloth(a: str, b: str) -> bool:
-    # A cloth's points are named ``{cloth}_{corner}`` (``towel_bl``; the world's cloth point names).
-    return a.rsplit("_", 1)[0] == b.rsplit("_", 1)[0]
-
-
-def lay_cloth_down(robot: RobotController, grasping: str, point: str) -> Iterator[None]:
-    """Lower the cloth the other arm holds up, so ``point`` (a corner ``grasping`` is to take) lies
-    on the table, if that arm is free to move (yields per tick; returns whether it moved)."""
-    arm = other_arm(robot, grasping)
-    if arm not in robot.free_arms:
-        return False
-    frame = robot.frame
-    held = [
-        name for name, feats in frame.objects.items()
-        if name != point and feats.is_point and _same_cloth(name, point) and frame.is_holding(arm, name)
-    ]
-    if not held:
-        return False
-    drop = float(frame.objects[held[0]].pos[2]) - LAID_HEIGHT
-    if drop < SHORTEST_STEP:
-        return False
-    goal = robot.commanded_pose(arm)
-    goal.pos[2] -= drop
-    yield from move_to(robot, arm, goal)
-    yield from settle(robot, arm)
-    yield from wait_for_rest(robot, point)
     return True
