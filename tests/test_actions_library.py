@@ -7,7 +7,7 @@ from scipy.spatial.transform import Rotation
 from agentchord.actions.base import Status
 from agentchord.actions.controller import RobotController
 from agentchord.actions.finger_clearance import swept_hits
-from agentchord.actions.grasp import GraspMissed, plain_top_grasp
+from agentchord.actions.grasp import GraspMissed
 from agentchord.actions.joint_path import joint_path
 from agentchord.actions.library import make_action
 from agentchord.actions.motion import EMPTY_HAND_JOINT_SPEED
@@ -209,8 +209,6 @@ def test_a_side_grasp_beside_the_arms_own_base_backs_off_less_and_still_holds(po
 
 def _placing(frame_objects, **args):
     from types import SimpleNamespace
-
-    from agentchord.features.frame import make_static_frame
 
     place = make_action("place", "right", {"obj": "spoon", "target": [0.17, 0.0], "relative_to": "plate", "yaw": 90, **args})
     frame = make_static_frame(objects={"plate": {"pos": (0.0, 0.5, 0.01), "extent": (0.2, 0.2, 0.02)}, **frame_objects})
@@ -440,24 +438,6 @@ def test_a_hand_off_spot_is_one_the_taker_reaches_with_the_top_down_grasp_it_wil
     else:
         assert abs(set_down[0] - 0.10) < 0.01  # where it lay
         assert status == Status.FAILURE
-
-
-def test_a_flat_object_upside_down_is_grasped_as_if_the_right_way_up():
-    # A fork that flipped over lies as flat as before: its tilt of 180 deg is not "on its side".
-    along_y = Rotation.from_euler("z", 90, degrees=True)
-
-    def fork(rotation: Rotation):
-        x, y, z, w = rotation.as_quat()
-        axis = rotation.as_matrix()[:, 2]
-        values = {"pos": (-0.1, 0.6, 0.005), "quat": (w, x, y, z), "axis": axis, "extent": (0.165, 0.016, 0.011)}
-        return make_static_frame(objects={"fork": values}).objects["fork"]
-
-    up_dir, up_point = plain_top_grasp(fork(along_y))
-    down_dir, down_point = plain_top_grasp(fork(along_y * Rotation.from_euler("x", 180, degrees=True)))
-    assert tilt_deg(fork(along_y * Rotation.from_euler("x", 180, degrees=True)).axis) == pytest.approx(180.0)
-    np.testing.assert_allclose(down_point, up_point, atol=1e-9)
-    assert abs(float(np.dot(down_dir, up_dir))) == pytest.approx(1.0)
-    assert up_point[2] < 0.05  # the finger tips near the table, not a fork's length above it
 
 
 @pytest.mark.slow

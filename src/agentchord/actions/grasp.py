@@ -2,6 +2,10 @@
 
 The action perceives through the feature frame (``robot.frame``) and starts from the
 robot's current commanded state, so a recovery edge begins wherever the failure left the arm.
+Where each grasp goes is worked out beside it: the side grasp in
+:mod:`~agentchord.actions.side_plan`, the top grasp in :mod:`~agentchord.actions.top_grasp` and
+:mod:`~agentchord.actions.finger_clearance`, the fallen grasp and its turn upright in
+:mod:`~agentchord.actions.fallen_turn`; this module moves through those poses and judges the hold.
 """
 
 from __future__ import annotations
@@ -10,7 +14,6 @@ from collections.abc import Iterator
 from typing import Protocol
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from agentchord.actions import catalog
 from agentchord.actions.base import ActionFailed, ArmAction
@@ -32,9 +35,11 @@ from agentchord.actions.motion import (
     settle,
     wait_for_rest,
 )
-from agentchord.actions.side_plan import SidePlanner, side_point
+from agentchord.actions.fallen_turn import fallen_grasp_frame, turn_pose, turned
+from agentchord.actions.side_plan import SidePlanner, side_point, strikes_top
+from agentchord.actions.top_grasp import plain_top_grasp
 from agentchord.actions.wrist_branch import is_wound, move_above, plan_unflipped_fallen_grasp, turn_unflipped
-from agentchord.features.frame import ObjectFeatures, level_tilt_deg, tilt_deg
+from agentchord.features.frame import ObjectFeatures, tilt_deg
 from agentchord.solvers.ik import ARM_CLEARANCE, PoseTarget
 from agentchord.solvers.poses import top_down_rotation
 from agentchord.robot.aloha import HOME_Q
@@ -47,12 +52,6 @@ MOVED_DURING_APPROACH = 0.01
 BLOCKED_CLEARANCE = 2 * ARM_CLEARANCE
 #: A closed grasp whose grasp point is farther than this (m) from where the tool aimed is off-centre.
 OFF_CENTRE_TOLERANCE = 0.025
-#: The open gripper's footprint around the tool centre (m): from the palm behind it to the finger
-#: tips ahead of it, and across the open fingers.
-PALM_BEHIND = 0.06
-FINGERS_ACROSS = 0.05
-#: The band (m) around an object's top in which a descending gripper over it strikes it.
-TOP_BAND = (-0.03, 0.015)
 
 
 class PlacedCheck(Protocol):
@@ -70,43 +69,6 @@ class HeldBackByOtherArm(GraspMissed):
     """The arm-arm collision limit held the arm back from the grasp: the other arm was in the way."""
 
 
-def lies_on_side(feats: ObjectFeatures) -> bool:
-    """Whether an object lies on its side (its axis near horizontal), not upright or upside down.
-
-    Rearrange stress seed 45: a fork that flipped over when dropped (tilt 180 deg) was taken for a
-    lying cylinder as tall as the fork is long, and the fingers closed 5 cm above it.
-    """
-    return level_tilt_deg(feats.axis) >= Grasp.FALLEN_DEG
-
-
-def long_axis(feats: ObjectFeatures) -> np.ndarray:
-    """An object's long direction: its axis if it lies on its side, else its longer horizontal side."""
-    if lies_on_side(feats):
-        return feats.axis
-    rot = _matrix(feats.quat)
-    return rot[:, 0] if feats.extent[0] >= feats.extent[1] else rot[:, 1]
-
-
-def plain_top_grasp(feats: ObjectFeatures) -> tuple[np.ndarray, np.ndarray]:
-    """The top-down grasp of an object where it lies, before any clearance or offset is applied.
-
-    Returns:
-        ``(long_dir, point)``: the object's long horizontal direction (unit; the fingers close
-        across it) and the tool centre, whose finger tips go 70 % down the object (at most 3 cm)
-        and never closer than 4 mm to the table.
-    """
-    lying = lies_on_side(feats)
-    long_dir = long_axis(feats)
-    long_dir = np.array([long_dir[0], long_dir[1], 0.0])
-    if np.linalg.norm(long_dir) < 1e-6:
-        long_dir = np.array([1.0, 0.0, 0.0])
-    long_dir /= np.linalg.norm(long_dir)
-    top_z = feats.pos[2] + 0.5 * feats.extent[0] if lying else max(feats.top[2], feats.bottom[2])
-    height = top_z - min(feats.bottom[2], feats.top[2]) if not lying else float(feats.extent[0])
-    tips_z = max(top_z - min(0.7 * height, 0.03), 0.004)
-    return long_dir, np.r_[feats.pos[:2], tips_z + Grasp.FINGERTIP_REACH]
-
-
 class Grasp(ArmAction):
     """Grasp an object wherever it is, then lift it; a fallen object is set upright in hand.
 
@@ -122,19 +84,12 @@ class Grasp(ArmAction):
     name = "grasp"
     args: catalog.GraspArgs
 
-    #: Tilt (deg) beyond which the object is treated as lying on its side.
-    FALLEN_DEG = 60.0
     #: Tilt (deg) beyond which an object leaning on something is grasped like a fallen one.
     LEANING_AS_FALLEN_DEG = 40.0
     #: Tries before a grasp that closes on nothing fails.
     ATTEMPTS = 3
     #: Objects shorter than this (m) are grasped from above in ``auto`` mode.
     SIDE_MIN_HEIGHT = 0.08
-    #: The finger tips reach this far past the tool centre (m): keep them off the table.
-    FINGERTIP_REACH = 0.039
-    #: A fallen object is turned upright at least this far (m, horizontally) from the arm's own
-    #: shoulder: its ends sweep a circle as it turns, and beside the base they strike the arm.
-    TURN_FROM_BASE = 0.30
     #: The empty hand goes over a fallen object, on the unflipped wrist branch, this far (m) above the pre-grasp.
     ABOVE_PRE_GRASP = 0.06
     #: With ``reseat``, a fallen object the turn left within this (deg) of upright keeps the
@@ -395,27 +350,10 @@ class Grasp(ArmAction):
         start = robot.commanded_pose(self.arm).pos
         feats = robot.frame.objects[self.args.obj]
         top = max(feats.top[2], feats.bottom[2])
-        if start[2] <= top or not self._strikes_top(start, pre, rotation[:, 0], feats, top):
+        if start[2] <= top or not strikes_top(start, pre, rotation[:, 0], feats, top):
             return
         above = np.r_[pre[:2], max(start[2], top + 0.05)]
         yield from move_to(robot, self.arm, pose_from_matrix(above, rotation))
-
-    def _strikes_top(self, start: np.ndarray, end: np.ndarray, approach_dir: np.ndarray, feats, top: float) -> bool:
-        """Whether the open gripper, moved in a straight line from ``start`` to ``end``, crosses the
-        object's top (at height ``top``) with its footprint over it."""
-        radius = 0.5 * float(max(feats.extent[0], feats.extent[1]))
-        ahead = np.array([approach_dir[0], approach_dir[1], 0.0])
-        ahead /= max(float(np.linalg.norm(ahead)), 1e-9)
-        across = np.array([-ahead[1], ahead[0], 0.0])
-        for s in np.linspace(0.0, 1.0, 41):
-            tool = start + s * (end - start)
-            if not TOP_BAND[0] <= tool[2] - top <= TOP_BAND[1]:
-                continue
-            to_axis = feats.pos - tool
-            along, side = float(np.dot(to_axis, ahead)), float(np.dot(to_axis, across))
-            if -PALM_BEHIND - radius < along < self.FINGERTIP_REACH + radius and abs(side) < FINGERS_ACROSS + radius:
-                return True
-        return False
 
     def _top_frame(self, robot: RobotController, keep_choice: bool = False) -> tuple[np.ndarray, np.ndarray]:
         """Tool rotation (approach down, fingers across the narrow side) and grasp point.
@@ -482,13 +420,8 @@ class Grasp(ArmAction):
         and a finger came down on the cup's rim three times, 6 cm above the grasp. With
         ``keep_slide`` the slide chosen at the attempt's first look is kept.
         """
-        feats = robot.frame.objects[self.args.obj]
-        top_dir = np.array([feats.axis[0], feats.axis[1], 0.0])
-        top_dir /= max(np.linalg.norm(top_dir), 1e-9)
-        rotation = top_down_rotation(top_dir)
-        radius = 0.5 * float(feats.extent[0])
-        # The finger tips reach ~4 cm past the tool centre: stay high enough to miss the table.
-        point = np.r_[feats.pos[:2], max(feats.pos[2] + 0.35 * radius, self.FINGERTIP_REACH + 0.006)]
+        rotation, point = fallen_grasp_frame(robot.frame.objects[self.args.obj])
+        top_dir = rotation[:, 2]
         if not keep_slide or self._fallen_slide is None:
             # Only a slide: the fingers stay across the axis, which the turn upright needs.
             self._fallen_slide = clear_top_grasp(robot.frame, self.args.obj, point, top_dir).slide
@@ -502,10 +435,10 @@ class Grasp(ArmAction):
         pre = pose_from_matrix(point + np.array([0, 0, self.args.pre_grasp_dis]), rotation)
         # On the unflipped wrist branch where every move of it is clear: the turn upright then
         # passes the wrist's singularity without whipping the object round in the hand.
-        lifted, yaw = self._turn_pose(robot, feats, point, rotation)
+        lifted, yaw = turn_pose(feats, point, rotation, self._fallen_slide or 0.0, robot.world.arm_base(arm))
         plan = plan_unflipped_fallen_grasp(
             robot, arm, self.args.obj, pre, pose_from_matrix(point, rotation), self.ABOVE_PRE_GRASP, pose_from_matrix(lifted, rotation),
-            _turned(rotation, yaw, 1.0),
+            turned(rotation, yaw, 1.0),
             held=(np.array([feats.bottom, feats.top]) - point) @ rotation, radius=0.5 * float(feats.extent[0]),
         )
         if plan is not None:
@@ -519,17 +452,17 @@ class Grasp(ArmAction):
         point[:2] = feats.pos[:2] + self._fallen_slide * rotation[:2, 2]  # the slide kept: the fingers' axis
         yield from move_to(robot, arm, pose_from_matrix(point, rotation), speed=0.08)
         yield from self._close_and_check(robot)
-        lifted, yaw = self._turn_pose(robot, feats, point, rotation)
+        lifted, yaw = turn_pose(feats, point, rotation, self._fallen_slide or 0.0, robot.world.arm_base(arm))
         if plan is not None:
             lifted[2] += plan.rise
         yield from move_to(robot, arm, pose_from_matrix(lifted, rotation), speed=0.15)
-        if plan is not None and (yield from turn_unflipped(robot, arm, self.args.obj, _turned(rotation, yaw, 1.0))):
+        if plan is not None and (yield from turn_unflipped(robot, arm, self.args.obj, turned(rotation, yaw, 1.0))):
             yield from settle(robot, arm)
             return
         # Taken flipped, or no joint-space turn is clear: the straight turn, swing and pitch at once.
         ticks = max(int(np.ceil(1.875 * max(abs(yaw), 0.5 * np.pi) / ANGULAR_SPEED * 50)), 5)
         for k in range(1, ticks + 1):
-            robot.set_pose(arm, pose_from_matrix(lifted, _turned(rotation, yaw, min_jerk(k / ticks))))
+            robot.set_pose(arm, pose_from_matrix(lifted, turned(rotation, yaw, min_jerk(k / ticks))))
             yield
         yield from settle(robot, arm)
 
@@ -537,27 +470,3 @@ class Grasp(ArmAction):
         """Go over the neighbours first where the straight move to ``goal`` sweeps the fingers into one."""
         for waypoint in crossing_over(robot.frame, self.args.obj, robot.commanded_pose(self.arm), goal) or []:
             yield from move_to(robot, self.arm, waypoint)
-
-    def _turn_pose(
-        self, robot: RobotController, feats: ObjectFeatures, point: np.ndarray, rotation: np.ndarray
-    ) -> tuple[np.ndarray, float]:
-        """Where a fallen object (``feats``) grasped at ``point`` (tool ``rotation``) is turned upright:
-        the tool's position, lifted clear of the table and away from the arm's base, and the swing
-        (rad, about the vertical) that points the object's top away from the robot."""
-        half_length = 0.5 * float(np.linalg.norm(feats.top - feats.bottom))
-        # Grasped nearer the top (a slide clear of a neighbour), the bottom hangs that much lower.
-        lifted = point + np.array([0.0, 0.0, half_length + max(self._fallen_slide or 0.0, 0.0) + 0.06])
-        base = robot.world.arm_base(self.arm)
-        out = lifted[:2] - base[:2]
-        if 1e-6 < float(np.linalg.norm(out)) < self.TURN_FROM_BASE:
-            lifted[:2] = base[:2] + self.TURN_FROM_BASE * out / np.linalg.norm(out)
-        outward = grasp_frame(lifted - base)[:, 0]
-        top_dir = rotation[:, 2]
-        return lifted, float(np.arctan2(np.cross(top_dir, outward)[2], float(np.dot(top_dir, outward))))
-
-
-def _turned(rotation: np.ndarray, yaw: float, share: float) -> np.ndarray:
-    """A fallen grasp's tool ``rotation`` turned ``share`` of the way upright: the swing ``yaw`` about the
-    vertical and the pitch about the fingers' axis at once, so the object's top only rises. All the
-    way, the tool is in the usual side-grasp frame with the object upright between the fingers."""
-    return Rotation.from_euler("z", share * yaw).as_matrix() @ rotation @ Rotation.from_euler("y", share * (-0.5 * np.pi)).as_matrix()

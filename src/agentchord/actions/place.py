@@ -12,8 +12,9 @@ from agentchord.actions import catalog
 from agentchord.actions.base import ActionFailed, ArmAction, ObjectGone
 from agentchord.actions.controller import RobotController
 from agentchord.actions.geometry import _level, _yaw_turn
-from agentchord.actions.grasp import UPRIGHT_TOLERANCE_DEG, Grasp, long_axis, plain_top_grasp
+from agentchord.actions.grasp import UPRIGHT_TOLERANCE_DEG, Grasp
 from agentchord.actions.motion import grip, move_to, pose_from_matrix, settle, wait_for_rest
+from agentchord.actions.top_grasp import long_axis, plain_top_grasp
 from agentchord.features.frame import FeatureFrame, ObjectFeatures, tilt_deg
 from agentchord.solvers.exceptions import NoHandoffSpotError
 from agentchord.solvers.handoff import TAKER_MARGIN, handoff_spot

@@ -24,7 +24,8 @@ from agentchord.actions.catalog import GraspArgs
 from agentchord.actions.controller import RobotController
 from agentchord.actions.finger_clearance import side_approach_blocking
 from agentchord.actions.motion import grasp_frame, pose_from_matrix
-from agentchord.features.frame import tilt_deg
+from agentchord.actions.top_grasp import FINGERTIP_REACH
+from agentchord.features.frame import ObjectFeatures, tilt_deg
 from agentchord.solvers.ik import solve_from_scratch
 
 #: Side grasps tried in order where the asked one cannot be reached: (share of the pre-grasp
@@ -38,6 +39,12 @@ CLEAR_TURNS_DEG = (15.0, -15.0, 30.0, -30.0, 45.0, -45.0)
 #: (share of the object's height).
 LYING_DEG = 60.0
 CLEAR_HEIGHT = 0.8
+#: The open gripper's footprint around the tool centre (m): from the palm behind it to the finger
+#: tips ahead of it, and across the open fingers.
+PALM_BEHIND = 0.06
+FINGERS_ACROSS = 0.05
+#: The band (m) around an object's top in which a descending gripper over it strikes it.
+TOP_BAND = (-0.03, 0.015)
 
 
 @dataclass(frozen=True)
@@ -163,3 +170,21 @@ class SidePlanner:
         plan = self.variant(REACH_VARIANTS[0])
         hit = side_approach_blocking(self.robot.frame, self.args.obj, plan.pre, plan.point, plan.rotation)
         return any(tilt_deg(self.robot.frame.objects[name].axis) >= LYING_DEG for name in hit)
+
+
+def strikes_top(start: np.ndarray, end: np.ndarray, approach_dir: np.ndarray, feats: ObjectFeatures, top: float) -> bool:
+    """Whether the open gripper, moved in a straight line from ``start`` to ``end`` with its fingers
+    pointing along ``approach_dir``, crosses the object's top (at height ``top``) with its footprint over it."""
+    radius = 0.5 * float(max(feats.extent[0], feats.extent[1]))
+    ahead = np.array([approach_dir[0], approach_dir[1], 0.0])
+    ahead /= max(float(np.linalg.norm(ahead)), 1e-9)
+    across = np.array([-ahead[1], ahead[0], 0.0])
+    for s in np.linspace(0.0, 1.0, 41):
+        tool = start + s * (end - start)
+        if not TOP_BAND[0] <= tool[2] - top <= TOP_BAND[1]:
+            continue
+        to_axis = feats.pos - tool
+        along, side = float(np.dot(to_axis, ahead)), float(np.dot(to_axis, across))
+        if -PALM_BEHIND - radius < along < FINGERTIP_REACH + radius and abs(side) < FINGERS_ACROSS + radius:
+            return True
+    return False

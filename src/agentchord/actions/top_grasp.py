@@ -1,0 +1,56 @@
+"""Where a top-down grasp takes an object: its long direction and the tool centre.
+
+A top grasp (a short or flat object: a block, a capsule, cutlery) comes straight down with the
+fingers closing across the object's narrow horizontal side. This is the plain grasp, before any
+clearance of a neighbour (:mod:`~agentchord.actions.finger_clearance`) or offset the graph asks
+for; the place action uses it too, to put an object down where a top grasp can take it again.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from agentchord.actions.geometry import _matrix
+from agentchord.features.frame import ObjectFeatures, level_tilt_deg
+
+#: Tilt (deg) beyond which an object is treated as lying on its side.
+FALLEN_DEG = 60.0
+#: The finger tips reach this far past the tool centre (m): keep them off the table.
+FINGERTIP_REACH = 0.039
+
+
+def lies_on_side(feats: ObjectFeatures) -> bool:
+    """Whether an object lies on its side (its axis near horizontal), not upright or upside down.
+
+    Rearrange stress seed 45: a fork that flipped over when dropped (tilt 180 deg) was taken for a
+    lying cylinder as tall as the fork is long, and the fingers closed 5 cm above it.
+    """
+    return level_tilt_deg(feats.axis) >= FALLEN_DEG
+
+
+def long_axis(feats: ObjectFeatures) -> np.ndarray:
+    """An object's long direction: its axis if it lies on its side, else its longer horizontal side."""
+    if lies_on_side(feats):
+        return feats.axis
+    rot = _matrix(feats.quat)
+    return rot[:, 0] if feats.extent[0] >= feats.extent[1] else rot[:, 1]
+
+
+def plain_top_grasp(feats: ObjectFeatures) -> tuple[np.ndarray, np.ndarray]:
+    """The top-down grasp of an object where it lies, before any clearance or offset is applied.
+
+    Returns:
+        ``(long_dir, point)``: the object's long horizontal direction (unit; the fingers close
+        across it) and the tool centre, whose finger tips go 70 % down the object (at most 3 cm)
+        and never closer than 4 mm to the table.
+    """
+    lying = lies_on_side(feats)
+    long_dir = long_axis(feats)
+    long_dir = np.array([long_dir[0], long_dir[1], 0.0])
+    if np.linalg.norm(long_dir) < 1e-6:
+        long_dir = np.array([1.0, 0.0, 0.0])
+    long_dir /= np.linalg.norm(long_dir)
+    top_z = feats.pos[2] + 0.5 * feats.extent[0] if lying else max(feats.top[2], feats.bottom[2])
+    height = top_z - min(feats.bottom[2], feats.top[2]) if not lying else float(feats.extent[0])
+    tips_z = max(top_z - min(0.7 * height, 0.03), 0.004)
+    return long_dir, np.r_[feats.pos[:2], tips_z + FINGERTIP_REACH]

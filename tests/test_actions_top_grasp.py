@@ -1,0 +1,51 @@
+"""Where a top-down grasp takes an object: its long direction and the tool centre."""
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from agentchord.actions.top_grasp import FINGERTIP_REACH, lies_on_side, long_axis, plain_top_grasp
+from agentchord.features.frame import make_static_frame, tilt_deg
+
+
+def _object(rotation: Rotation, extent=(0.165, 0.016, 0.011), pos=(-0.1, 0.6, 0.005)):
+    x, y, z, w = rotation.as_quat()
+    values = {"pos": pos, "quat": (w, x, y, z), "axis": rotation.as_matrix()[:, 2], "extent": extent}
+    return make_static_frame(objects={"obj": values}).objects["obj"]
+
+
+def test_a_flat_object_upside_down_is_grasped_as_if_the_right_way_up():
+    # A fork that flipped over lies as flat as before: its tilt of 180 deg is not "on its side".
+    along_y = Rotation.from_euler("z", 90, degrees=True)
+    flipped = along_y * Rotation.from_euler("x", 180, degrees=True)
+    up_dir, up_point = plain_top_grasp(_object(along_y))
+    down_dir, down_point = plain_top_grasp(_object(flipped))
+    assert tilt_deg(_object(flipped).axis) == pytest.approx(180.0)
+    assert not lies_on_side(_object(flipped))
+    np.testing.assert_allclose(down_point, up_point, atol=1e-9)
+    assert abs(float(np.dot(down_dir, up_dir))) == pytest.approx(1.0)
+    assert up_point[2] < 0.05  # the finger tips near the table, not a fork's length above it
+
+
+def test_the_fingers_close_across_the_longer_horizontal_side():
+    fork = _object(Rotation.from_euler("z", 90, degrees=True))  # its 16.5 cm side along world y
+    long_dir, _ = plain_top_grasp(fork)
+    np.testing.assert_allclose(np.abs(long_dir), [0.0, 1.0, 0.0], atol=1e-9)
+    np.testing.assert_allclose(np.abs(long_axis(fork)), [0.0, 1.0, 0.0], atol=1e-9)
+
+
+def test_a_bottle_lying_on_its_side_is_taken_along_its_axis_from_its_upper_side():
+    # Axis along world x, 6 cm across, lying with its centre 3 cm above the table.
+    lying = _object(Rotation.from_euler("y", 90, degrees=True), extent=(0.06, 0.06, 0.2), pos=(0.1, 0.5, 0.03))
+    assert lies_on_side(lying)
+    long_dir, point = plain_top_grasp(lying)
+    np.testing.assert_allclose(np.abs(long_dir), [1.0, 0.0, 0.0], atol=1e-9)
+    np.testing.assert_allclose(point[:2], [0.1, 0.5])
+    # The top at 6 cm, the finger tips 3 cm below it (70 % of 6 cm is more than the 3 cm cap).
+    assert point[2] - FINGERTIP_REACH == pytest.approx(0.03)
+
+
+def test_the_finger_tips_stay_off_the_table_for_a_flat_object():
+    card = _object(Rotation.identity(), extent=(0.08, 0.05, 0.002), pos=(0.0, 0.5, 0.001))
+    _, point = plain_top_grasp(card)
+    assert point[2] - FINGERTIP_REACH == pytest.approx(0.004)
