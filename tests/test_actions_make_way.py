@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from agentchord.actions.controller import RobotController
-from agentchord.actions.make_way import NEAREST_TO_SHOULDER, STEP_BACK, make_way, other_arm, step_back_pose
+from agentchord.actions.make_way import NEAREST_TO_SHOULDER, STEP_BACK, make_way, step_back_pose
 from agentchord.features.oracle import OracleExtractor
 from agentchord.solvers.ik import PoseTarget
 from agentchord.worlds.sim.world import SimWorld
@@ -38,11 +38,6 @@ def _drive(robot, script):
             return stop.value
         robot.step()
         robot.extractor.update()
-
-
-def test_other_arm_is_the_arm_that_is_not_the_one_given(robot):
-    assert other_arm(robot, "left") == "right"
-    assert other_arm(robot, "right") == "left"
 
 
 def test_the_step_back_goes_towards_the_shoulder_at_the_same_height_and_orientation(robot):

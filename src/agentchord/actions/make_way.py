@@ -15,6 +15,7 @@ import numpy as np
 
 from agentchord.actions.controller import RobotController
 from agentchord.actions.motion import move_to, settle
+from agentchord.robot.aloha import other_arm
 from agentchord.solvers.ik import PoseTarget
 
 #: How far (m, horizontally) a free arm steps back towards its shoulder to make way.
@@ -24,11 +25,6 @@ STEP_BACK = 0.10
 NEAREST_TO_SHOULDER = 0.22
 #: A step back shorter than this (m) would free nothing: the arm is left where it is.
 SHORTEST_STEP = 0.02
-
-
-def other_arm(robot: RobotController, arm: str) -> str:
-    """The arm that is not ``arm``."""
-    return next(a for a in robot.targets if a != arm)
 
 
 def step_back_pose(robot: RobotController, arm: str) -> PoseTarget | None:
@@ -55,7 +51,7 @@ def make_way(robot: RobotController, blocked: str, back_off: PoseTarget) -> Iter
     one already as near its shoulder as it may go, or one the collision limit holds still, is left
     where it is.
     """
-    arm = other_arm(robot, blocked)
+    arm = other_arm(blocked)
     # Arms whose collision proxies already overlap (a bottle caught on the hand at home, reached
     # for by the other arm) are both held still by the collision limit: no step back is followed.
     if arm not in robot.free_arms or robot.ik.arm_clearance() < 0.0:

@@ -13,6 +13,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from agentchord.robot.aloha import ARMS  # re-exported: the frame's arms
+
 #: World "up": gravity points along -UP.
 UP = np.array([0.0, 0.0, 1.0])
 
@@ -20,8 +22,6 @@ UP = np.array([0.0, 0.0, 1.0])
 OBJECT_ATTRIBUTES = ("pos", "quat", "axis", "extent", "top", "bottom", "points")
 #: Attributes an expression may read on an arm (``right.width``).
 ARM_ATTRIBUTES = ("ee", "ee_quat", "q", "width", "closed")
-#: Arm names of the bimanual robot.
-ARMS = ("left", "right")
 
 
 def tilt_deg(axis) -> float:

@@ -9,11 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from agentchord.robot.aloha import ARM_JOINTS, FINGER_GAP_OFFSET, FINGER_RANGE
+from agentchord.robot.aloha import ARM_JOINTS, ARMS, FINGER_GAP_OFFSET, FINGER_RANGE
 from agentchord.worlds.protocol import ArmCommand, World
 
-#: Arms in ALOHA's order.
-ARMS = ("left", "right")
 #: Names of the 14 entries of state and action.
 JOINT_NAMES = [f"{arm}_{j}" for arm in ARMS for j in (*ARM_JOINTS, "gripper")]
 

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
+#: The two arms, in ALOHA's order (every per-arm vector: actions, observations, joint states).
+ARMS = ("left", "right")
 #: Arm name -> prefix of its bodies and joints in the model files.
 ARM_PREFIX = {"left": "vx300s_left", "right": "vx300s_right"}
 #: The six arm joints of each arm, base to wrist.
@@ -30,3 +32,8 @@ COLLISION_PROXIES = (
     ("gripper_link", (-0.04, 0.0, 0.0), (0.06, 0.0, 0.0), 0.05),
     ("gripper_link", (0.07, 0.0, 0.0), (0.155, 0.0, 0.0), 0.045),
 )
+
+
+def other_arm(arm: str) -> str:
+    """The arm that is not ``arm``."""
+    return ARMS[1] if arm == ARMS[0] else ARMS[0]

@@ -16,10 +16,10 @@ from typing import Any
 import numpy as np
 import zmq
 
+from agentchord.robot.aloha import ARMS
 from agentchord.worlds.protocol import ArmCommand, CameraFrame, ObjectInfo
 from agentchord.worlds.wire import PROTOCOL_VERSION, pack, unpack
 
-ARMS = ("left", "right")
 #: Seconds a reply may take before the server counts as gone (a camera frame or a trial's set-up included).
 DEFAULT_TIMEOUT_S = 120.0
 

@@ -11,8 +11,8 @@ import copy
 from dataclasses import dataclass, field
 
 from agentchord.graph.models import ActionCall, Edge, Step
+from agentchord.robot.aloha import ARMS
 
-ARMS = ("left", "right")
 #: Motions relative to the arm's current pose (replayed after a regrasp; the others aim at a pose or an object).
 RELATIVE = frozenset({"rotate_eef", "move_by_offset"})
 

@@ -22,16 +22,12 @@ import re
 from collections.abc import Iterable
 
 from agentchord.graph.models import ActionCall, Edge, Step, TaskGraph
+from agentchord.robot.aloha import other_arm
 
-ARMS = ("left", "right")
 #: Suffix of an alternative's id: ``<entry id>_via_<arm>``.
 VIA = "_via_"
 #: Grasp arguments the other arm keeps (the rest are the first arm's geometry: yaw, offsets).
 PORTABLE_GRASP_ARGS = ("obj", "mode", "height")
-
-
-def _other(arm: str) -> str:
-    return "right" if arm == "left" else "left"
 
 
 def _single_arm_grasp(step: Step) -> tuple[str, ActionCall] | None:
@@ -68,7 +64,7 @@ def arm_switch_alternative(entry: Edge, rigid: Iterable[str], regrasp: dict[tupl
     rigid = set(rigid)
     if obj not in rigid:
         return None
-    other = _other(arm)
+    other = other_arm(arm)
     busy = _held_by(entry, other) - {obj}
     other_first = entry.steps[0].get(other)
     args = {key: grasp.args[key] for key in PORTABLE_GRASP_ARGS if key in grasp.args}

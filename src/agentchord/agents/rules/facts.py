@@ -21,9 +21,9 @@ from agentchord.agents.scene import Scene, SceneObject
 from agentchord.agents.rules import knowledge as kb
 from agentchord.agents.rules.goals import Folded, GoalSpec, HandedOver, Inside, On, Placed, Poured
 from agentchord.agents.rules.planner import Fact
+from agentchord.robot.aloha import ARMS  # re-exported: the arms, as facts name them
 
-#: The arms, as facts name them.
-ARMS = ("left", "right")
+
 #: Facts that record an event: a constraint of the node where they became true only.
 EVENT_FACTS = frozenset({"poured", "handed"})
 

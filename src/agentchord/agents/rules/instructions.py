@@ -30,6 +30,7 @@ from agentchord.agents.scene import Scene
 from agentchord.agents.rules import knowledge as kb
 from agentchord.agents.rules.goals import Folded, Goal, GoalSpec, HandedOver, Inside, On, Placed, Poured
 from agentchord.agents.rules.language import Clause, NounPhrase, ParseError, Where, parse
+from agentchord.robot.aloha import other_arm
 
 #: Size words: the candidate with the largest (True) or smallest (False) measure.
 _SIZE_WORDS = {
@@ -182,10 +183,6 @@ class _Context:
         return self.held_by.get(obj) if obj else None
 
 
-def _other(arm: str) -> str:
-    return "right" if arm == "left" else "left"
-
-
 # --- clauses -> goals ---------------------------------------------------------------------
 
 
@@ -222,8 +219,8 @@ def _handover(c: Clause, ctx: _Context) -> list[Goal]:
     obj_ = ctx.objects[obj]
     giver = c.giver if c.giver in ("left", "right") else None
     receiver = c.receiver if c.receiver in ("left", "right") else None
-    giver = giver or ctx.held_by.get(obj) or (_other(receiver) if receiver else kb.near_arm(obj_))
-    receiver = receiver or _other(giver)
+    giver = giver or ctx.held_by.get(obj) or (other_arm(receiver) if receiver else kb.near_arm(obj_))
+    receiver = receiver or other_arm(giver)
     if giver == receiver:
         raise ctx.error(c.text, f"hands the {obj} from the {giver} arm to itself")
     ctx.held_by[obj] = receiver

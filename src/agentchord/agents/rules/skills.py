@@ -15,11 +15,7 @@ from agentchord.agents.rules.constraints import rounded
 from agentchord.agents.rules.facts import ARMS, placed_key
 from agentchord.agents.rules.goals import GoalSpec, HandedOver, Inside, On, Placed, Poured
 from agentchord.agents.rules.planner import Fact, Operator
-
-
-def other(arm: str) -> str:
-    """The other arm."""
-    return "right" if arm == "left" else "left"
+from agentchord.robot.aloha import other_arm
 
 
 def _call(fn: str, **args) -> dict:
@@ -224,7 +220,7 @@ def _pour_ops(goal: Poured) -> list[Operator]:
     for arm in ARMS:
         if goal.arm and arm != goal.arm:
             continue
-        held_by = other(arm)
+        held_by = other_arm(arm)
         for mode, support in (("table", {("on_table", c), ("upright", c)}), ("held", {("presented", held_by, c)})):
             ops.append(
                 Operator(
@@ -331,7 +327,7 @@ def _set_upright_ops(obj: SceneObject) -> list[Operator]:
     name = obj.name
     ops = []
     for arm in ARMS:
-        busy = other(arm)
+        busy = other_arm(arm)
         steps = ({arm: _call("grasp", obj=name)}, {arm: _call("place", obj=name)}, {arm: _call("back")})
         ops.append(
             Operator(

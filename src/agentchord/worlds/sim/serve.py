@@ -23,6 +23,7 @@ import numpy as np
 import zmq
 from scipy.spatial.transform import Rotation
 
+from agentchord.robot.aloha import ARMS
 from agentchord.worlds.protocol import CONTROL_HZ, ArmCommand
 from agentchord.worlds.sim.cameras import DepthCamera
 from agentchord.worlds.sim.hand import Waypoint
@@ -31,7 +32,6 @@ from agentchord.worlds.sim.trial import open_world
 from agentchord.worlds.sim.world import SimWorld
 from agentchord.worlds.wire import PROTOCOL_VERSION, WireError, pack, unpack
 
-ARMS = ("left", "right")
 #: The simulator's own calls a client may make (``sim``), and whether each changes the world.
 SIM_CALLS: dict[str, bool] = {
     "object_velocity": False,
