@@ -28,7 +28,8 @@ from agentchord.features.frame import FeatureFrame, make_static_frame  # noqa: E
 from agentchord.solvers.constraints import expression_costs  # noqa: E402
 from agentchord.solvers.obstacles import held_spheres, scene_spheres  # noqa: E402
 from agentchord.solvers.path import RecedingHorizonPathSolver, plan_path  # noqa: E402
-from agentchord.solvers.subgoal import SubgoalProblem, SubgoalSolution, SubgoalSolver  # noqa: E402
+from agentchord.solvers.subgoal import SubgoalSolver  # noqa: E402
+from agentchord.solvers.subgoal_problem import SubgoalProblem, SubgoalSolution  # noqa: E402
 
 #: Targets (ms) per row kind.
 TARGET_MS = {"cold": 1000.0, "warm": 50.0, "path": 50.0}

@@ -8,7 +8,8 @@ from agentchord.solvers.constraints import UserCost, expression_costs
 from agentchord.solvers.exceptions import InfeasibleSubgoalError, SolverProblemError
 from agentchord.solvers.obstacles import Spheres, scene_spheres
 from agentchord.solvers.reach import REACH
-from agentchord.solvers.subgoal import SubgoalProblem, SubgoalSolver, SubgoalWeights, tool_yaw
+from agentchord.solvers.subgoal import SubgoalSolver
+from agentchord.solvers.subgoal_problem import SubgoalProblem, SubgoalWeights
 
 OBSTACLE = np.array([0.05, 0.5, 0.2])
 
@@ -150,18 +151,7 @@ def test_a_held_object_turns_with_the_yaw_to_clear_an_obstacle():
     assert np.linalg.norm(turned - (point + [0.12, 0.0, 0.0])) >= 0.08 - 1e-3
 
 
-def test_tool_yaw_reads_the_approach_axis():
-    half = np.pi / 8
-    assert tool_yaw(np.array([np.cos(half), 0.0, 0.0, np.sin(half)])) == pytest.approx(np.pi / 4)
-
-
-def test_malformed_problems_and_warm_starts_are_refused():
-    with pytest.raises(SolverProblemError, match="unknown arm"):
-        SubgoalProblem(arms=("middle",))
-    with pytest.raises(SolverProblemError, match="both decided and fixed"):
-        SubgoalProblem(arms=("right",), fixed={"right": np.zeros(3)})
-    with pytest.raises(SolverProblemError, match="empty box"):
-        SubgoalProblem(low=np.ones(3), high=np.zeros(3))
+def test_a_warm_start_for_other_arms_is_refused():
     solver = SubgoalSolver()
     left = solver.solve(SubgoalProblem(arms=("left",)))
     with pytest.raises(SolverProblemError, match="warm start"):

@@ -22,7 +22,7 @@ class InfeasibleSubgoalError(SolverError):
     """The sub-goal solver found no point meeting every hard constraint (raised on request only).
 
     Attributes:
-        solution: The best compromise found (a :class:`~agentchord.solvers.subgoal.SubgoalSolution`);
+        solution: The best compromise found (a :class:`~agentchord.solvers.subgoal_problem.SubgoalSolution`);
             ``solution.violations`` says which constraints fail.
     """
 

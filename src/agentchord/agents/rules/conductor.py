@@ -27,7 +27,8 @@ from agentchord.agents.rules.arranger import Arranger
 from agentchord.graph.models import ActionCall, Edge, TaskGraph
 from agentchord.features.frame import FeatureFrame, make_static_frame
 from agentchord.solvers.obstacles import object_spheres, scene_spheres
-from agentchord.solvers.subgoal import SubgoalProblem, SubgoalSolution, SubgoalSolver
+from agentchord.solvers.subgoal import SubgoalSolver
+from agentchord.solvers.subgoal_problem import SubgoalProblem, SubgoalSolution
 
 #: Clearance (m) kept between a keyframe (tool, held or placed object) and other objects.
 MARGIN = 0.02
