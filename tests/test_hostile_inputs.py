@@ -396,6 +396,12 @@ def test_writing_to_a_device_or_through_a_symlink_keeps_them(tmp_path):
     assert link.is_symlink() and target.read_text() == "{}"
 
 
+def test_an_output_in_a_folder_that_takes_no_new_file_names_the_folder():
+    # /proc exists, but no file can be created in it (the kernel answers ENOENT).
+    with pytest.raises(OutputPathError, match=r"no file can be created in its folder '/proc' \(No such file or directory\)"):
+        check_output_path("/proc/x.yaml", (".yaml",), "-o")
+
+
 def test_check_output_path_leaves_nothing_behind(tmp_path):
     path = check_output_path(tmp_path / "new" / "x.json", (".json",), "--json")
     assert path.parent.is_dir() and os.listdir(path.parent) == []

@@ -57,7 +57,8 @@ def check_output_path(path: str | Path, suffixes: Iterable[str] = (), option: st
     try:  # os.access is not enough (read-only mounts, ACLs): write a probe
         fd, probe = tempfile.mkstemp(prefix=".agentchord-probe-", dir=folder)
     except OSError as error:
-        raise OutputPathError(given, f"its folder {str(folder)!r} is not writable: {_reason(error)}", option) from None
+        # /proc says "No such file or directory", a read-only mount "Read-only file system".
+        raise OutputPathError(given, f"no file can be created in its folder {str(folder)!r} ({_reason(error)})", option) from None
     os.close(fd)
     os.unlink(probe)
     return path
