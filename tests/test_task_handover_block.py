@@ -176,18 +176,20 @@ def test_a_block_taken_askew_at_the_hand_over_is_set_upright_in_hand_before_it_i
     # Real-world protocol, seed 43: the block was pushed as the right hand closed on it at the hand-over
     # and was held 39 deg askew. Turned upright over its spot, it is placed standing; with the old
     # bound (the 25 deg upright tolerance) it was set down askew, leant on the opening fingers, and
-    # was dragged by the retreat to where neither arm's IK finds a grasp: "unrecoverable".
+    # was dragged over by the retreat (then out of both arms' reach: "unrecoverable", until the
+    # approach's detour where the live IK loses its line took it from there).
     from agentchord.actions import place
     from agentchord.worlds.sim.disturbances import PRESETS
 
     if max_tilt is not None:
         monkeypatch.setattr(place, "UPRIGHT_IN_HAND_MAX_DEG", max_tilt)
     result = run_episode(EpisodeSpec(TASK, seed=43, protocol=True, disturb=PRESETS["real"]))
+    knocked_at_the_place = [d for d in result.trace.of("failure_detected") if d["edge"] == "e5"]
     if max_tilt is None:
         assert result.success, result.reason
-        assert not [d for d in result.trace.of("failure_detected") if d["edge"] == "e5"]  # placed standing
+        assert not knocked_at_the_place  # placed standing
     else:
-        assert not result.success and result.reason.startswith("unrecoverable")
+        assert [d["failure"] for d in knocked_at_the_place] == ["block_knocked"]
 
 
 @pytest.mark.parametrize("taken_as_anticipated", [True, False])
@@ -223,7 +225,7 @@ def test_a_block_set_down_near_the_right_shoulder_is_approached_on_a_branch_that
     from agentchord.worlds.sim.disturbances import ScriptedDisturbance
 
     if not checks_the_line_ahead:
-        monkeypatch.setattr(grasp, "approach", lambda robot, arm, goal, then=None: motion.approach(robot, arm, goal))
+        monkeypatch.setattr(grasp, "approach", lambda robot, arm, goal, then=None, clear=None: motion.approach(robot, arm, goal))
     pull = ScriptedDisturbance("grasp", "pull", after=180, seed=0, spot=(0.3, 0.7), lying=False)
     result = run_episode(EpisodeSpec(TASK, seed=0, disturbance=pull))
     assert result.trace.of("recovery_bound")[0]["edge"] == "e1_r_block_dropped_via_right"

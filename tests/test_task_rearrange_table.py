@@ -159,12 +159,12 @@ def test_a_fork_that_flipped_over_is_grasped_lying_flat(level, monkeypatch):
     # Stress protocol, seed 45: the fork, shifted against the plate's rim, is dropped by the right arm
     # taking it for the left and lands upside down. Read as lying on its side (tilt 180 deg), its top
     # grasp aimed 5 cm above it and the fingers closed on nothing three times.
-    from agentchord.actions import grasp as grasp_module
+    from agentchord.actions import top_grasp
     from agentchord.features.frame import tilt_deg
     from agentchord.worlds.sim.disturbances import PRESETS
 
     if not level:
-        monkeypatch.setattr(grasp_module, "level_tilt_deg", tilt_deg)
+        monkeypatch.setattr(top_grasp, "level_tilt_deg", tilt_deg)
     result = run_episode(EpisodeSpec(TASK, seed=45, protocol=True, disturb=PRESETS["stress"]))
     if level:
         assert result.success, result.reason

@@ -10,7 +10,7 @@ Where each grasp goes is worked out beside it: the side grasp in
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from typing import Protocol
 
 import numpy as np
@@ -18,7 +18,7 @@ import numpy as np
 from agentchord.actions import catalog
 from agentchord.actions.base import ActionFailed, ArmAction
 from agentchord.actions.controller import RobotController
-from agentchord.actions.finger_clearance import TopGraspChoice, clear_top_grasp, crossing_over
+from agentchord.actions.finger_clearance import TopGraspChoice, clear_top_grasp, crossing_over, swept_hits
 from agentchord.actions.geometry import _matrix, _wrist_margin
 from agentchord.actions.in_hand import grasp_height_share
 from agentchord.actions.make_way import make_way
@@ -246,6 +246,10 @@ class Grasp(ArmAction):
             yield from move_to(robot, arm, pose_from_matrix(robot.commanded_pose(arm).pos + back, rotation), speed=0.2)
         robot.set_grip(arm, 0.0)
 
+    def _fingers_clear(self, robot: RobotController) -> Callable[[list[tuple[np.ndarray, np.ndarray]]], bool]:
+        """Whether the open fingers pass clear of every object, this one too, along tool poses."""
+        return lambda tool_poses: not swept_hits(robot.frame, None, tool_poses)
+
     def _side_point(self, robot: RobotController, height_fraction: float | None = None) -> np.ndarray:
         return side_point(robot, self.args, self._offset(robot.frame.objects[self.args.obj]), height_fraction)
 
@@ -330,7 +334,7 @@ class Grasp(ArmAction):
         if np.linalg.norm(robot.commanded_pose(arm).pos[:2] - pre[:2]) > 0.05:
             yield from self._clear_from_below(robot, pre[2] + 0.08)
         yield from self._pass_over(robot, pre, rotation)
-        yield from approach(robot, arm, pose_from_matrix(pre, rotation), then=pose_from_matrix(point, rotation))
+        yield from approach(robot, arm, pose_from_matrix(pre, rotation), then=pose_from_matrix(point, rotation), clear=self._fingers_clear(robot))
         self._still_standing(robot, "during the approach")
         # Re-observe: the object may have moved while the arm approached.
         point = self._side_point(robot, self._height_fraction)
@@ -400,7 +404,7 @@ class Grasp(ArmAction):
         rotation, point = self._top_frame(robot)
         above = point + np.array([0.0, 0.0, self.args.pre_grasp_dis])
         yield from self._clear_from_below(robot, above[2])
-        yield from approach(robot, arm, pose_from_matrix(above, rotation), then=pose_from_matrix(point, rotation))
+        yield from approach(robot, arm, pose_from_matrix(above, rotation), then=pose_from_matrix(point, rotation), clear=self._fingers_clear(robot))
         # A top-down tool often flips the forearm roll: let the IK converge before descending.
         yield from settle(robot, arm, tolerance=0.003, max_ticks=60, required=0.015)
         rotation, point = self._top_frame(robot, keep_choice=True)
@@ -445,7 +449,7 @@ class Grasp(ArmAction):
             yield from move_above(robot, arm, plan)
         else:
             yield from self._cross_over(robot, pre)
-        yield from approach(robot, arm, pre, then=pose_from_matrix(point, rotation))
+        yield from approach(robot, arm, pre, then=pose_from_matrix(point, rotation), clear=self._fingers_clear(robot))
         # A top-down tool often flips the forearm roll: let the IK converge before descending.
         yield from settle(robot, arm, tolerance=0.003, max_ticks=60, required=0.015)
         feats = robot.frame.objects[self.args.obj]

@@ -14,6 +14,7 @@ from scipy.spatial.transform import Rotation, Slerp
 
 from agentchord.actions.base import ActionFailed
 from agentchord.actions.controller import RobotController
+from agentchord.actions.joint_path import joint_path
 from agentchord.robot.aloha import HOME_Q, TABLE_HALF
 from agentchord.solvers.ik import PoseTarget, solve_from_scratch
 from agentchord.solvers.obstacles import Spheres
@@ -71,11 +72,23 @@ def move_to(robot: RobotController, arm: str, goal: PoseTarget, speed: float = L
 
 #: A tool farther than this (m) from an approach pose once the move ends has stalled on the way.
 APPROACH_TOLERANCE = 0.015
+#: The live IK's tool farther than this (m) from the line it is sent along has lost it: a wrist
+#: joint at its limit, the IK trades the tool's position for its turn (elsewhere it keeps within 1 cm).
+LINE_LOST = 0.03
+
+
+def _follow_line(robot: RobotController, arm: str, goal: PoseTarget, speed: float) -> Iterator[None]:
+    """:func:`move_to`, stopped where the live IK loses the line; returns whether it did."""
+    for _ in move_to(robot, arm, goal, speed=speed):
+        yield
+        if robot.ik.residual(arm, robot.commanded_pose(arm)) > LINE_LOST:
+            return True
+    return False
 
 
 def approach(
     robot: RobotController, arm: str, goal: PoseTarget, speed: float = LINEAR_SPEED, settle_ticks: int = 60,
-    then: PoseTarget | None = None,
+    then: PoseTarget | None = None, clear: Callable[[list[tuple[np.ndarray, np.ndarray]]], bool] | None = None,
 ) -> Iterator[None]:
     """Move the tool to ``goal`` in a straight line; where it stalls, go round through home.
 
@@ -99,8 +112,22 @@ def approach(
         settle_ticks: Ticks the IK gets to converge at the end of the line (a tool turning
             its forearm roll needs many) before it counts as stalled.
         then: The pose the next straight move goes to from ``goal`` (None: no check).
+        clear: Whether the open fingers pass clear of every object along sampled tool poses
+            (position, rotation matrix): where the live IK loses the line, the detour through
+            home is taken only if both of its joint-space moves are clear (None: not checked).
     """
-    yield from move_to(robot, arm, goal, speed=speed)
+    if (yield from _follow_line(robot, arm, goal, speed)):
+        # Lost on the way (rearrange, stress seed 35: the wrist-rotate joint at its limit as a
+        # tilted tool turned top-down, the tool 12 cm under the line, down on the fork, and the
+        # arm whipped back when it broke free): through home, where the goal is reached from there.
+        q_goal = solve_from_scratch(
+            robot.scratch_ik(), robot.ik.configuration.q.copy(), arm, [goal] if then is None else [goal, then],
+            from_current=False, joints_at=0,
+        )
+        if q_goal is not None and (clear is None or _detour_clear(robot, arm, q_goal, clear)):
+            yield from _through_home(robot, arm, goal, q_goal, settle_ticks)
+            return
+        yield from move_to(robot, arm, goal, speed=speed)  # the rest of the line, as it was
     yield from settle(robot, arm, tolerance=APPROACH_TOLERANCE, max_ticks=settle_ticks)
     reached = float(np.linalg.norm(robot.frame.arms[arm].ee - goal.pos)) < APPROACH_TOLERANCE
     if reached and then is None:
@@ -114,8 +141,20 @@ def approach(
         if solve_from_scratch(ik, q, arm, [goal], from_home=False) is not None:
             return  # slow, not stalled
         q_goal = solve_from_scratch(ik, q, arm, [goal], from_current=False)
-    if q_goal is None:
-        return
+    if q_goal is not None:
+        yield from _through_home(robot, arm, goal, q_goal, settle_ticks)
+
+
+def _detour_clear(
+    robot: RobotController, arm: str, q_goal: np.ndarray, clear: Callable[[list[tuple[np.ndarray, np.ndarray]]], bool]
+) -> bool:
+    """Whether both joint-space moves of the detour, home and on to ``q_goal``, pass ``clear``."""
+    home = joint_path(robot, arm, HOME_Q)
+    return clear(list(home.tool_poses)) and clear(list(joint_path(robot, arm, q_goal, q_start=HOME_Q).tool_poses))
+
+
+def _through_home(robot: RobotController, arm: str, goal: PoseTarget, q_goal: np.ndarray, settle_ticks: int) -> Iterator[None]:
+    """The approach's detour: home, then to ``q_goal`` (the joints at ``goal``), in joint space."""
     # The hand is empty (it is on its way to grasp).
     yield from move_joints(robot, arm, HOME_Q, speed=EMPTY_HAND_JOINT_SPEED)
     yield from move_joints(robot, arm, q_goal, speed=EMPTY_HAND_JOINT_SPEED)
