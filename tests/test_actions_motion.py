@@ -18,7 +18,7 @@ TILTED = np.array([0.16, -0.35, 0.68, 2.08, -0.88, -0.88])
 ABOVE_FORK = motion.pose_from_matrix(np.array([-0.09, 0.486, 0.127]), top_down_rotation(np.array([-0.02, 1.0, 0.0]) / np.hypot(0.02, 1.0)))
 
 
-def _approach_from_tilted() -> tuple[float, float, RobotController]:
+def _approach_from_tilted(clear=None) -> tuple[float, float, RobotController]:
     """Run the approach; returns the live IK's worst distance from the line, the tool's lowest height, the robot."""
     world = SimWorld(SIM_TASKS["rearrange_table"].sample_scene(np.random.default_rng(0)))
     robot = RobotController(world)
@@ -36,7 +36,7 @@ def _approach_from_tilted() -> tuple[float, float, RobotController]:
 
     run(motion.move_joints(robot, "left", TILTED))
     robot.set_pose("left", robot.ik.tcp_pose("left"))
-    worst, lowest = run(motion.approach(robot, "left", ABOVE_FORK))
+    worst, lowest = run(motion.approach(robot, "left", ABOVE_FORK, clear=clear))
     return worst, lowest, robot
 
 
@@ -45,6 +45,18 @@ def test_an_approach_the_live_ik_loses_goes_round_through_home_and_ends_at_its_p
     assert worst < motion.LINE_LOST + 0.01  # stopped as soon as the line was lost
     assert lowest > ABOVE_FORK.pos[2] - 0.01  # never under the line (home is higher)
     assert np.linalg.norm(robot.frame.arms["left"].ee - ABOVE_FORK.pos) < motion.APPROACH_TOLERANCE
+
+
+def test_a_detour_that_would_sweep_the_fingers_through_something_is_not_taken():
+    seen = []
+
+    def nothing_is_clear(tool_poses):
+        seen.append(len(tool_poses))
+        return False
+
+    worst, lowest, _ = _approach_from_tilted(clear=nothing_is_clear)
+    assert seen  # the detour was checked ...
+    assert lowest < 0.03  # ... refused, and the line went on as it always did
 
 
 def test_followed_to_the_end_the_lost_line_drives_the_tool_down_to_the_table(monkeypatch):

@@ -10,7 +10,7 @@ Where each grasp goes is worked out beside it: the side grasp in
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from typing import Protocol
 
 import numpy as np
@@ -25,6 +25,7 @@ from agentchord.actions.make_way import make_way
 from agentchord.actions.motion import (
     ANGULAR_SPEED,
     EMPTY_HAND_JOINT_SPEED,
+    PathClear,
     approach,
     grasp_frame,
     grip,
@@ -246,7 +247,7 @@ class Grasp(ArmAction):
             yield from move_to(robot, arm, pose_from_matrix(robot.commanded_pose(arm).pos + back, rotation), speed=0.2)
         robot.set_grip(arm, 0.0)
 
-    def _fingers_clear(self, robot: RobotController) -> Callable[[list[tuple[np.ndarray, np.ndarray]]], bool]:
+    def _fingers_clear(self, robot: RobotController) -> PathClear:
         """Whether the open fingers pass clear of every object, this one too, along tool poses."""
         return lambda tool_poses: not swept_hits(robot.frame, None, tool_poses)
 

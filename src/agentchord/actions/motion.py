@@ -72,6 +72,8 @@ def move_to(robot: RobotController, arm: str, goal: PoseTarget, speed: float = L
 
 #: A tool farther than this (m) from an approach pose once the move ends has stalled on the way.
 APPROACH_TOLERANCE = 0.015
+#: Whether the open fingers pass clear of every object along sampled tool poses (position, rotation matrix).
+PathClear = Callable[[list[tuple[np.ndarray, np.ndarray]]], bool]
 #: The live IK's tool farther than this (m) from the line it is sent along has lost it: a wrist
 #: joint at its limit, the IK trades the tool's position for its turn (elsewhere it keeps within 1 cm).
 LINE_LOST = 0.03
@@ -88,7 +90,7 @@ def _follow_line(robot: RobotController, arm: str, goal: PoseTarget, speed: floa
 
 def approach(
     robot: RobotController, arm: str, goal: PoseTarget, speed: float = LINEAR_SPEED, settle_ticks: int = 60,
-    then: PoseTarget | None = None, clear: Callable[[list[tuple[np.ndarray, np.ndarray]]], bool] | None = None,
+    then: PoseTarget | None = None, clear: PathClear | None = None,
 ) -> Iterator[None]:
     """Move the tool to ``goal`` in a straight line; where it stalls, go round through home.
 
@@ -98,6 +100,11 @@ def approach(
     but one from home reaches the pose, the arm goes there in joint space: back to home first,
     so the detour starts from a posture clear of the table. Otherwise nothing more happens
     here: the action's own checks judge the pose as they always did.
+
+    The live IK can also lose the line on the way: a wrist joint at its limit, it trades the tool's
+    position for its turn, and the tool leaves the line, down towards the table. The line then
+    stops as soon as the tool is :data:`LINE_LOST` off it, and the same detour is taken where
+    ``clear`` passes both of its joint-space moves (else the line goes on, as it always did).
 
     The same detour is taken where ``goal`` is reached on a wrist branch from which ``then``
     (the grasp point the tool moves to next, in a straight line) is not, but from home's branch
@@ -112,9 +119,8 @@ def approach(
         settle_ticks: Ticks the IK gets to converge at the end of the line (a tool turning
             its forearm roll needs many) before it counts as stalled.
         then: The pose the next straight move goes to from ``goal`` (None: no check).
-        clear: Whether the open fingers pass clear of every object along sampled tool poses
-            (position, rotation matrix): where the live IK loses the line, the detour through
-            home is taken only if both of its joint-space moves are clear (None: not checked).
+        clear: Whether a detour taken where the live IK loses the line sweeps the open fingers
+            through nothing (None: not checked).
     """
     if (yield from _follow_line(robot, arm, goal, speed)):
         # Lost on the way (rearrange, stress seed 35: the wrist-rotate joint at its limit as a
@@ -146,7 +152,7 @@ def approach(
 
 
 def _detour_clear(
-    robot: RobotController, arm: str, q_goal: np.ndarray, clear: Callable[[list[tuple[np.ndarray, np.ndarray]]], bool]
+    robot: RobotController, arm: str, q_goal: np.ndarray, clear: PathClear
 ) -> bool:
     """Whether both joint-space moves of the detour, home and on to ``q_goal``, pass ``clear``."""
     home = joint_path(robot, arm, HOME_Q)
