@@ -74,16 +74,20 @@ def move_to(robot: RobotController, arm: str, goal: PoseTarget, speed: float = L
 APPROACH_TOLERANCE = 0.015
 #: Whether the open fingers pass clear of every object along sampled tool poses (position, rotation matrix).
 PathClear = Callable[[list[tuple[np.ndarray, np.ndarray]]], bool]
-#: The live IK's tool farther than this (m) from the line it is sent along has lost it: a wrist
-#: joint at its limit, the IK trades the tool's position for its turn (elsewhere it keeps within 1 cm).
+#: The live IK's tool farther than this (m) from the line it is sent along, and lower than it by
+#: at least ``LINE_LOST_BELOW``, has lost it: a wrist joint at its limit, the IK trades the tool's
+#: position for its turn, down towards the table. (Lagging above or beside the line, it is only
+#: slow: re-planned approaches lag up to 6 cm, above the line, and catch up.)
 LINE_LOST = 0.03
+LINE_LOST_BELOW = 0.01
 
 
 def _follow_line(robot: RobotController, arm: str, goal: PoseTarget, speed: float) -> Iterator[None]:
     """:func:`move_to`, stopped where the live IK loses the line; returns whether it did."""
     for _ in move_to(robot, arm, goal, speed=speed):
         yield
-        if robot.ik.residual(arm, robot.commanded_pose(arm)) > LINE_LOST:
+        off = robot.ik.tcp_pose(arm).pos - robot.commanded_pose(arm).pos
+        if float(np.linalg.norm(off)) > LINE_LOST and off[2] < -LINE_LOST_BELOW:
             return True
     return False
 
