@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from agentchord.actions.top_grasp import FINGERTIP_REACH, lies_on_side, long_axis, plain_top_grasp
+from agentchord.actions.top_grasp import FINGERTIP_REACH, lies_on_side, long_axis, on_its_edge, plain_top_grasp
 from agentchord.features.frame import make_static_frame, tilt_deg
 
 
@@ -49,3 +49,25 @@ def test_the_finger_tips_stay_off_the_table_for_a_flat_object():
     card = _object(Rotation.identity(), extent=(0.08, 0.05, 0.002), pos=(0.0, 0.5, 0.001))
     _, point = plain_top_grasp(card)
     assert point[2] - FINGERTIP_REACH == pytest.approx(0.004)
+
+
+def test_a_flat_object_on_its_edge_is_taken_across_its_faces_at_its_own_height():
+    # Rearrange, stress seed 35: a fork (14 cm long, 1.6 cm wide) standing on its edge against the
+    # plate was taken for a bottle lying down: the fingers closed 8 cm above it, across its length.
+    # Here its length (local x) lies along world y, its width (local y) stands up, its faces
+    # (local z, its axis) look along world x.
+    on_edge = Rotation.from_matrix(np.column_stack([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]]))
+    fork = _object(on_edge, extent=(0.141, 0.016, 0.009), pos=(-0.15, 0.58, 0.008))
+    assert lies_on_side(fork) and on_its_edge(fork)
+    long_dir, point = plain_top_grasp(fork)
+    np.testing.assert_allclose(np.abs(long_dir), [0.0, 1.0, 0.0], atol=1e-9)  # the fingers close along x
+    np.testing.assert_allclose(np.abs(long_axis(fork)), [0.0, 1.0, 0.0], atol=1e-9)
+    # 1.6 cm high: the finger tips 70 % of the way down it, not 8 cm above it.
+    assert point[2] - FINGERTIP_REACH == pytest.approx(0.016 - 0.7 * 0.016)
+
+
+def test_a_bottle_or_capsule_lying_down_is_not_on_its_edge():
+    lying = _object(Rotation.from_euler("y", 90, degrees=True), extent=(0.06, 0.06, 0.2), pos=(0.1, 0.5, 0.03))
+    assert lies_on_side(lying) and not on_its_edge(lying)
+    flat = _object(Rotation.identity())
+    assert not lies_on_side(flat) and not on_its_edge(flat)

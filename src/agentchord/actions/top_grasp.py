@@ -28,11 +28,25 @@ def lies_on_side(feats: ObjectFeatures) -> bool:
     return level_tilt_deg(feats.axis) >= FALLEN_DEG
 
 
+def on_its_edge(feats: ObjectFeatures) -> bool:
+    """Whether a flat object (its axis its thinnest side: a fork, a spoon, a card) lies on its side,
+    standing on an edge, not flat; a bottle or a capsule lying down (its axis its longest side) does not."""
+    return lies_on_side(feats) and feats.extent[2] < max(feats.extent[0], feats.extent[1])
+
+
 def long_axis(feats: ObjectFeatures) -> np.ndarray:
-    """An object's long direction: its axis if it lies on its side, else its longer horizontal side."""
+    """An object's long direction: its axis if it lies on its side, else its longer horizontal side.
+
+    A flat object on its edge lies along the longer of its sides, whichever of them is level (rearrange,
+    stress seed 35: a fork on its edge against the plate, taken along its thickness, with the fingers
+    across its 14 cm length).
+    """
+    rot = _matrix(feats.quat)
+    if on_its_edge(feats):
+        level = [feats.extent[i] * float(np.linalg.norm(rot[:2, i])) for i in (0, 1)]
+        return rot[:, 0] if level[0] >= level[1] else rot[:, 1]
     if lies_on_side(feats):
         return feats.axis
-    rot = _matrix(feats.quat)
     return rot[:, 0] if feats.extent[0] >= feats.extent[1] else rot[:, 1]
 
 
@@ -50,7 +64,12 @@ def plain_top_grasp(feats: ObjectFeatures) -> tuple[np.ndarray, np.ndarray]:
     if np.linalg.norm(long_dir) < 1e-6:
         long_dir = np.array([1.0, 0.0, 0.0])
     long_dir /= np.linalg.norm(long_dir)
-    top_z = feats.pos[2] + 0.5 * feats.extent[0] if lying else max(feats.top[2], feats.bottom[2])
-    height = top_z - min(feats.bottom[2], feats.top[2]) if not lying else float(feats.extent[0])
+    # Lying, an object is as high as it is across (a bottle's diameter); a flat one on its edge as
+    # high as its sides stand.
+    across = float(feats.extent[0])
+    if on_its_edge(feats):
+        across = float(np.abs(_matrix(feats.quat)[2]) @ np.asarray(feats.extent, dtype=float))
+    top_z = feats.pos[2] + 0.5 * across if lying else max(feats.top[2], feats.bottom[2])
+    height = top_z - min(feats.bottom[2], feats.top[2]) if not lying else across
     tips_z = max(top_z - min(0.7 * height, 0.03), 0.004)
     return long_dir, np.r_[feats.pos[:2], tips_z + FINGERTIP_REACH]
