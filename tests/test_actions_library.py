@@ -211,6 +211,11 @@ def test_a_side_grasp_beside_the_arms_own_base_backs_off_less_and_still_holds(po
     assert status == Status.SUCCESS and world.holding("left", "cup")
 
 
+#: A spoon as the frame sees one lying flat: its axis (the thinnest side) up, its 15 cm length
+#: (local x) turned to world y.
+FLAT_SPOON_ALONG_Y = {"quat": (np.cos(np.pi / 4), 0.0, 0.0, np.sin(np.pi / 4)), "axis": (0.0, 0.0, 1.0), "extent": (0.15, 0.03, 0.01)}
+
+
 def _placing(frame_objects, **args):
     from types import SimpleNamespace
 
@@ -223,10 +228,10 @@ def _placing(frame_objects, **args):
     ({"pos": (0.18, 0.51, 0.01)}, True),                            # 1.4 cm off, along y: placed
     ({"pos": (0.22, 0.5, 0.01)}, False),                            # 5 cm off
     ({"pos": (0.17, 0.5, 0.15)}, False),                            # over the spot, in mid-air
-    ({"pos": (0.17, 0.5, 0.01), "axis": (1.0, 0.0, 0.0)}, False),   # on the spot, along x: wrong yaw
+    ({"pos": (0.17, 0.5, 0.01), "quat": (1.0, 0.0, 0.0, 0.0)}, False),  # on the spot, along x: wrong yaw
 ])
 def test_a_place_knows_when_its_object_already_lies_at_the_target(spoon, placed):
-    spoon = {"axis": (0.0, 1.0, 0.0), "extent": (0.005, 0.15, 0.02), **spoon}
+    spoon = {**FLAT_SPOON_ALONG_Y, **spoon}
     place, robot = _placing({"spoon": spoon})
     assert place.lies_at_target(robot) is placed
     robot.frame.holding = {("right", "spoon")}
@@ -235,7 +240,7 @@ def test_a_place_knows_when_its_object_already_lies_at_the_target(spoon, placed)
 
 def test_a_place_with_a_sub_goal_check_takes_an_object_released_where_it_holds_as_placed():
     # 5 cm off the place's own target, but where the recovery's merge node wants it.
-    spoon = {"pos": (0.22, 0.5, 0.01), "axis": (0.0, 1.0, 0.0), "extent": (0.005, 0.15, 0.02)}
+    spoon = {**FLAT_SPOON_ALONG_Y, "pos": (0.22, 0.5, 0.01)}
     place, robot = _placing({"spoon": spoon})
     assert place.lies_at_target(robot) is False
     place.meets_subgoal = lambda frame: frame.objects["spoon"].pos[0] > 0.2

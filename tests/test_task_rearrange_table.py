@@ -165,6 +165,9 @@ def test_a_fork_that_flipped_over_is_grasped_lying_flat(level, monkeypatch):
 
     if not level:
         monkeypatch.setattr(top_grasp, "level_tilt_deg", tilt_deg)
+        # Taken as lying on its side, a flat fork would now be taken as one on its edge, at its own
+        # height (top_grasp.on_its_edge): keep the old reading, a bottle lying down.
+        monkeypatch.setattr(top_grasp, "on_its_edge", lambda feats: False)
     result = run_episode(EpisodeSpec(TASK, seed=45, protocol=True, disturb=PRESETS["stress"]))
     if level:
         assert result.success, result.reason
