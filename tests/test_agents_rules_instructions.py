@@ -47,6 +47,13 @@ def test_handover_then_region():
     assert goal.goals == [HandedOver(obj="block", giver="left", receiver="right"), Placed(obj="block", region="target", arm="right")]
 
 
+@pytest.mark.parametrize(("giver", "receiver"), [("left", "right"), ("right", "left")])
+def test_the_other_hand_is_the_arm_not_holding_the_object(giver, receiver):
+    scene = Scene(objects=[_obj("block", "orange block")], regions=[Region(name="target", description="target region", center=(0.1, 0.4))])
+    goal = ground_instruction(f"Pick up the block with the {giver} arm, hand it to the other hand, and place it in the target region.", scene)
+    assert goal.goals == [HandedOver(obj="block", giver=giver, receiver=receiver), Placed(obj="block", region="target", arm=receiver)]
+
+
 def test_coffee_tray_head_noun_and_direction_region():
     scene = Scene(objects=[_obj("tray"), _obj("capsule", "brown capsule")], regions=[Region(name="forward", center=(0.0, 0.67))])
     goal = ground_instruction("Place the coffee capsule into the tray and move the tray forward.", scene)

@@ -107,8 +107,9 @@ def approach(
 
     The live IK can also lose the line on the way: a wrist joint at its limit, it trades the tool's
     position for its turn, and the tool leaves the line, down towards the table. The line then
-    stops as soon as the tool is :data:`LINE_LOST` off it, and the same detour is taken where
-    ``clear`` passes both of its joint-space moves (else the line goes on, as it always did).
+    stops as soon as the tool is :data:`LINE_LOST` off it and :data:`LINE_LOST_BELOW` under it,
+    and the same detour is taken where ``clear`` passes both of its joint-space moves (else the
+    line goes on, as it always did).
 
     The same detour is taken where ``goal`` is reached on a wrist branch from which ``then``
     (the grasp point the tool moves to next, in a straight line) is not, but from home's branch

@@ -179,7 +179,7 @@ class _Context:
         if said in ("left", "right"):
             return said
         if said == "other" and obj in self.held_by:
-            return "right" if self.held_by[obj] == "left" else "left"
+            return other_arm(self.held_by[obj])
         return self.held_by.get(obj) if obj else None
 
 
