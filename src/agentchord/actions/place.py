@@ -1,4 +1,5 @@
-"""The place action: carry the held object over its spot, stand it upright in hand, lower, release, retreat."""
+"""The place action: carry the held object over its spot, stand it upright in hand, lower, release
+(and tip a thin one set down on its edge flat), retreat."""
 
 from __future__ import annotations
 
@@ -14,6 +15,7 @@ from agentchord.actions.controller import RobotController
 from agentchord.actions.geometry import _level, _yaw_turn
 from agentchord.actions.grasp import UPRIGHT_TOLERANCE_DEG, Grasp
 from agentchord.actions.motion import grip, move_to, pose_from_matrix, settle, wait_for_rest
+from agentchord.actions.tip_flat import PUSH_SPEED, lowest_point, push_length, thin_on_edge, tip_push, tip_start
 from agentchord.actions.top_grasp import long_axis, plain_top_grasp
 from agentchord.features.frame import FeatureFrame, ObjectFeatures, tilt_deg
 from agentchord.solvers.exceptions import NoHandoffSpotError
@@ -123,11 +125,18 @@ class Place(ArmAction):
         yield from move_to(robot, arm, pose_from_matrix(above, rotation))
         rotation = yield from self._upright_in_hand(robot, rotation)
         obj = robot.frame.objects[self.args.obj]
-        drop = obj.bottom[2] - (self.args.z_offset + 0.004)
-        down = robot.commanded_pose(arm).pos - np.array([0.0, 0.0, drop])
+        tool = robot.commanded_pose(arm).pos
+        # A thin object held on its edge (a fork) is tipped flat once released: set down short of its spot.
+        tip = tip_push(robot.frame, self.args.obj, tool, rotation, self.args.z_offset)
+        lowest = obj.bottom[2] if tip is None else lowest_point(obj)
+        down = tool - np.array([0.0, 0.0, lowest - (self.args.z_offset + 0.004)])
+        if tip is not None:
+            down -= tip[1] * tip[0]
         yield from move_to(robot, arm, pose_from_matrix(down, rotation), speed=0.12)
         yield from settle(robot, arm, max_ticks=10)
         yield from grip(robot, arm, self._release_grip(robot), ticks=8)
+        if tip is not None:
+            down = yield from self._tip_over(robot, tip[0], rotation)
         # Back off along the approach (straight up after a top grasp).
         retreat = down - 0.08 * rotation[:, 0] + np.array([0.0, 0.0, 0.04 if rotation[2, 0] > -0.7 else 0.0])
         yield from move_to(robot, arm, pose_from_matrix(retreat, rotation))
@@ -182,6 +191,19 @@ class Place(ArmAction):
         yield from move_to(robot, self.arm, pose_from_matrix(goal, turned), speed=0.08)
         yield from settle(robot, self.arm, max_ticks=10)
         return turned
+
+    def _tip_over(self, robot: RobotController, push: np.ndarray, rotation: np.ndarray) -> Iterator[None]:
+        """Push the top edge of the released object, standing on its edge, across with the open fingers,
+        so it falls on its face (:mod:`~agentchord.actions.tip_flat`). Returns where the tool ends."""
+        tool = robot.commanded_pose(self.arm).pos
+        feats = robot.frame.objects[self.args.obj]
+        if not thin_on_edge(feats):
+            return tool  # it fell flat as it was let go
+        start = tip_start(tool, feats, self.args.z_offset)
+        yield from move_to(robot, self.arm, pose_from_matrix(start, rotation), speed=0.1)
+        end = start + push_length(tool, feats, push) * push
+        yield from move_to(robot, self.arm, pose_from_matrix(end, rotation), speed=PUSH_SPEED)
+        return end
 
     def _release_grip(self, robot: RobotController) -> float:
         """Fully open, unless the object sits inside a rim (a cup): then just wider than the object,
