@@ -5,7 +5,7 @@ The alternative to :class:`~agentchord.features.oracle.OracleExtractor`
 camera rate (10 Hz, every 5th control tick at 50 Hz), a :class:`Segmenter`
 gives one mask per object and camera, the masked depth pixels are
 back-projected into world points, the views are fused, and a cylinder or box is
-fitted to the fused cloud (:mod:`agentchord.features.pointcloud`). Between
+fitted to the fused cloud (:mod:`agentchord.features.shape_fit`). Between
 camera frames the last estimate is kept. The robot's own signals (end
 effectors, joints, gripper width, the grasp signal) and the contact-based
 ``holding`` relation come from the robot every tick, as in oracle mode: they are
@@ -24,7 +24,8 @@ import numpy as np
 
 from agentchord.features.frame import ARMS, ArmFeatures, FeatureFrame, ObjectFeatures
 from agentchord.features.oracle import update_robot_signals
-from agentchord.features.pointcloud import ShapeFit, backproject, fit_box, fit_cylinder, quat_from_axis, quat_from_matrix, voxel_downsample
+from agentchord.features.pointcloud import backproject, quat_from_axis, quat_from_matrix, voxel_downsample
+from agentchord.features.shape_fit import ShapeFit, fit_box, fit_cylinder
 from agentchord.features.segmentation import LabelSegmenter, Segmenter
 from agentchord.worlds.protocol import CONTROL_HZ, Camera, CameraFrame, World
 
