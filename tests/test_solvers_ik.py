@@ -76,26 +76,3 @@ def test_a_scratch_solve_returns_the_joints_at_the_pose_asked_for():
         ik.reset(home)
         ik.set_arm_q("left", q)
         assert np.linalg.norm(ik.tcp_pose("left").pos - where) < 0.01
-
-
-def test_a_top_grasp_with_the_wrist_turned_back_is_reached_from_a_wound_wrist(monkeypatch):
-    # Single-arm pour, stress seed 99: a cup knocked over lies with its top pointing back at the left
-    # shoulder. Its fallen grasp comes down with the fingers' axis along the cup, towards its top: the
-    # wrist turned half round. From where the arms were (the left at home, the right holding the
-    # bottle up) the solver ran the waist into its limit, 25 cm off, and the cup was given up as out
-    # of reach of both arms. The poses and the configuration are that episode's.
-    from agentchord.solvers import ik as ik_module
-    from agentchord.solvers.ik import solve_from_scratch
-
-    ik = BimanualIK(iterations=150, avoid_arm_collisions=False, converged_step=1e-4)  # the feasibility check's
-    q = np.array([0.0, -0.96, 1.16, 0.0, -0.3, 0.0, 0.021, -0.021, -0.1678, 0.1023, 1.0193, 0.0, -1.1216, 0.0, 0.021, -0.021])
-    quat = np.array([0.07027212982180098, 0.7036063016846196, 0.07027212982180098, -0.7036063016846196])
-    point = np.array([-0.17259403601980827, 0.6004038944172435, 0.045])
-    poses = [PoseTarget(point + np.array([0.0, 0.0, 0.08]), quat), PoseTarget(point, quat)]
-    joints = solve_from_scratch(ik, q, "left", poses)
-    assert joints is not None
-    ik.reset(q)
-    ik.set_arm_q("left", joints)
-    assert np.linalg.norm(ik.tcp_pose("left").pos - point) < 0.01
-    monkeypatch.setattr(ik_module, "WOUND_HOMES", ())
-    assert solve_from_scratch(ik, q, "left", poses) is None

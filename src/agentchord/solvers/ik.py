@@ -148,13 +148,6 @@ class BimanualIK:
         return float(np.linalg.norm(self.tcp_pose(arm).pos - target.pos))
 
 
-#: Home with the wrist wound a quarter turn either way: the last starts of a scratch solve. A fallen
-#: cup whose top points back at the left arm's shoulder is taken top-down with the tool's fingers'
-#: axis pointing back too (wrist rotated ~180 deg); from home and from where the arm was, the solver
-#: ran the waist into its limit, 25 cm off, and the cup was given up as out of both arms' reach
-#: (single-arm pour, stress seed 99). From a wound wrist it reaches the grasp.
-WOUND_HOMES = tuple(np.r_[HOME_Q[:5], turn] for turn in (np.pi / 2, -np.pi / 2))
-
 #: Position residual (m) under which a scratch solve counts a pose as reached: the feasibility check
 #: before a recovery binds and the hand-off's check of the taker's grasp use the same.
 REACHED_TOLERANCE = 0.01
@@ -183,13 +176,11 @@ def solve_from_scratch(
     Returns:
         The arm's six joints at ``poses[joints_at]``, or None where no start reaches every pose.
     """
-    starts: list[np.ndarray | None] = [None] if from_current else []
-    if from_home:
-        starts += [HOME_Q, *WOUND_HOMES]
-    for start in starts:
+    starts = [start for start, wanted in ((False, from_current), (True, from_home)) if wanted]
+    for at_home in starts:
         ik.reset(q)
-        if start is not None:
-            ik.set_arm_q(arm, start)
+        if at_home:
+            ik.set_arm_q(arm, HOME_Q)
         reached, joints = True, []
         for pose in poses:
             ik.solve({arm: pose})
