@@ -69,5 +69,11 @@ def test_a_flat_object_on_its_edge_is_taken_across_its_faces_at_its_own_height()
 def test_a_bottle_or_capsule_lying_down_is_not_on_its_edge():
     lying = _object(Rotation.from_euler("y", 90, degrees=True), extent=(0.06, 0.06, 0.2), pos=(0.1, 0.5, 0.03))
     assert lies_on_side(lying) and not on_its_edge(lying)
+    # Coffee tray, real seed 84: a capsule 2.7 cm tall and 3.3 cm across lying on its round side is
+    # taken across its round side (its axis the long direction), not across its flat ends.
+    capsule = _object(Rotation.from_euler("y", 90, degrees=True), extent=(0.033, 0.033, 0.027), pos=(-0.14, 0.6, 0.017))
+    assert lies_on_side(capsule) and not on_its_edge(capsule)
+    long_dir, _ = plain_top_grasp(capsule)
+    np.testing.assert_allclose(np.abs(long_dir), [1.0, 0.0, 0.0], atol=1e-9)
     flat = _object(Rotation.identity())
     assert not lies_on_side(flat) and not on_its_edge(flat)

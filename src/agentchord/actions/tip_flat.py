@@ -20,9 +20,6 @@ from agentchord.actions.geometry import _matrix
 from agentchord.actions.top_grasp import FINGERTIP_REACH, on_its_edge
 from agentchord.features.frame import FeatureFrame, ObjectFeatures
 
-#: An object thinner than this share of its length (cutlery, a card) is put down lying flat,
-#: never on its edge; a capsule or a block is not thin.
-THIN_SHARE = 0.25
 #: The finger tips push this far (m) under the object's top edge: high, so it tips before it slides.
 TIP_BELOW_TOP = 0.004
 #: The pushing finger's inner face ends this far (m) past where the object's face stood, beyond
@@ -42,10 +39,9 @@ TOP_DOWN_COS = 0.9
 
 
 def thin_on_edge(feats: ObjectFeatures) -> bool:
-    """Whether a thin object (:data:`THIN_SHARE`) stands on its edge, its face upright."""
-    if feats.is_point or not on_its_edge(feats):
-        return False
-    return float(feats.extent[2]) < THIN_SHARE * float(max(feats.extent[0], feats.extent[1]))
+    """Whether a flat object (:data:`~agentchord.actions.top_grasp.FLAT_SHARE`) stands on its edge,
+    its face upright; a cloth's corner (a point) never does."""
+    return not feats.is_point and on_its_edge(feats)
 
 
 def standing_height(feats: ObjectFeatures) -> float:

@@ -15,6 +15,9 @@ from agentchord.features.frame import ObjectFeatures, level_tilt_deg
 
 #: Tilt (deg) beyond which an object is treated as lying on its side.
 FALLEN_DEG = 60.0
+#: An object thinner than this share of its longer side (along its axis: cutlery, a card) is flat;
+#: a capsule (0.8) or a block (1.0) is not.
+FLAT_SHARE = 0.25
 #: The finger tips reach this far past the tool centre (m): keep them off the table.
 FINGERTIP_REACH = 0.039
 
@@ -29,9 +32,14 @@ def lies_on_side(feats: ObjectFeatures) -> bool:
 
 
 def on_its_edge(feats: ObjectFeatures) -> bool:
-    """Whether a flat object (its axis its thinnest side: a fork, a spoon, a card) lies on its side,
-    standing on an edge, not flat; a bottle or a capsule lying down (its axis its longest side) does not."""
-    return lies_on_side(feats) and feats.extent[2] < max(feats.extent[0], feats.extent[1])
+    """Whether a flat object (:data:`FLAT_SHARE`: a fork, a spoon, a card) lies on its side, standing
+    on an edge, not flat; a bottle or a capsule lying down (a cylinder on its round side) does not.
+
+    Coffee tray, real seed 84: a capsule 2.7 cm tall and 3.3 cm across, lying on its side beside the
+    tray's handle, passed the older test (its axis merely its shortest side). It was taken across
+    its flat ends, and a finger came down on the handle three times.
+    """
+    return lies_on_side(feats) and float(feats.extent[2]) < FLAT_SHARE * float(max(feats.extent[0], feats.extent[1]))
 
 
 def long_axis(feats: ObjectFeatures) -> np.ndarray:
