@@ -15,7 +15,7 @@ from agentchord.actions.controller import RobotController
 from agentchord.actions.geometry import _level, _yaw_turn
 from agentchord.actions.grasp import UPRIGHT_TOLERANCE_DEG, Grasp
 from agentchord.actions.motion import grip, move_to, pose_from_matrix, settle, wait_for_rest
-from agentchord.actions.tip_flat import PUSH_SPEED, lowest_point, push_length, thin_on_edge, tip_push, tip_start
+from agentchord.actions.tip_flat import PUSH_SPEED, push_length, standing_height, thin_on_edge, tip_push, tip_start
 from agentchord.actions.top_grasp import long_axis, plain_top_grasp
 from agentchord.features.frame import FeatureFrame, ObjectFeatures, tilt_deg
 from agentchord.solvers.exceptions import NoHandoffSpotError
@@ -128,7 +128,7 @@ class Place(ArmAction):
         tool = robot.commanded_pose(arm).pos
         # A thin object held on its edge (a fork) is tipped flat once released: set down short of its spot.
         tip = tip_push(robot.frame, self.args.obj, tool, rotation, self.args.z_offset)
-        lowest = obj.bottom[2] if tip is None else lowest_point(obj)
+        lowest = obj.bottom[2] if tip is None else obj.pos[2] - 0.5 * standing_height(obj)
         down = tool - np.array([0.0, 0.0, lowest - (self.args.z_offset + 0.004)])
         if tip is not None:
             down -= tip[1] * tip[0]
