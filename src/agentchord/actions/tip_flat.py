@@ -49,8 +49,9 @@ def standing_height(feats: ObjectFeatures) -> float:
 
     The place lowers the object's centre to half this over the table. A fork hanging pitched in the
     fingers (30-40 deg, swung while the place turned it to its yaw) then touches down with one end
-    and is pressed level; lowered only until its lower end touched, it was let go hanging, dropped
-    and slid 4-5 cm (3 of 40 forks and spoons stood on their edge; 1 of 40 lowered so).
+    and is pressed level. Lowered only until its lower end touched, it was let go hanging, dropped
+    and slid 4-5 cm: 3 of 40 forks and spoons stood on their edge ended more than 3 cm off their
+    spot that way, 1 of 40 this way (3.1 cm).
     """
     return float(min(feats.extent[0], feats.extent[1]))
 
