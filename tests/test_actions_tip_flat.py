@@ -8,7 +8,8 @@ from agentchord.actions import place as place_module
 from agentchord.actions.base import Status
 from agentchord.actions.controller import RobotController
 from agentchord.actions.library import make_action
-from agentchord.actions.tip_flat import fall_shift, standing_height, thin_on_edge, tip_push
+from agentchord.actions.tip_flat import fall_shift, standing_height, tip_push
+from agentchord.actions.top_grasp import on_its_edge
 from agentchord.features.frame import level_tilt_deg, make_static_frame
 from agentchord.features.oracle import OracleExtractor
 from agentchord.solvers.poses import top_down_rotation
@@ -31,16 +32,6 @@ def _frame(fork: dict, **others: dict):
     return make_static_frame(objects={"fork": fork, **others})
 
 
-def test_only_a_thin_object_standing_on_its_edge_is_tipped():
-    assert thin_on_edge(_frame(_values(ON_EDGE)).objects["fork"])
-    assert not thin_on_edge(_frame(_values(Rotation.identity())).objects["fork"])  # lying flat
-    # A capsule on its side (3 cm tall, 3.5 cm across) and a bottle lying down are not thin.
-    capsule = _values(Rotation.from_euler("y", 90, degrees=True), extent=(0.035, 0.035, 0.03))
-    bottle = _values(Rotation.from_euler("y", 90, degrees=True), extent=(0.06, 0.06, 0.2))
-    assert not thin_on_edge(_frame(capsule).objects["fork"])
-    assert not thin_on_edge(_frame(bottle).objects["fork"])
-
-
 def test_a_fork_stands_as_high_as_it_is_wide_and_falls_half_its_width_and_thickness_over():
     fork = _frame(_values(ON_EDGE, pos=(-0.15, 0.58, 0.01))).objects["fork"]
     assert standing_height(fork) == pytest.approx(0.02)
@@ -53,6 +44,21 @@ def test_a_fork_stands_as_high_as_it_is_wide_and_falls_half_its_width_and_thickn
 def _tool_over_fork():
     # Top-down, the fingers closing along world x (across the fork's faces), the tool 4 cm above it.
     return np.array([-0.15, 0.58, 0.10]), top_down_rotation(np.array([0.0, 1.0, 0.0]))
+
+
+def test_only_a_flat_object_standing_on_its_edge_is_tipped():
+    tool, rotation = _tool_over_fork()
+    assert tip_push(_frame(_values(ON_EDGE)), "fork", tool, rotation, 0.0) is not None
+    # A capsule on its side (3 cm tall, 3.5 cm across), a bottle lying down, a fork lying flat and a
+    # cloth's corner (a point) are put down as they are held.
+    lying = Rotation.from_euler("y", 90, degrees=True)
+    for values in (
+        _values(lying, extent=(0.035, 0.035, 0.03)),
+        _values(lying, extent=(0.06, 0.06, 0.2)),
+        _values(Rotation.identity()),
+        _values(lying, extent=(0.004, 0.004, 0.004)),
+    ):
+        assert tip_push(_frame(values), "fork", tool, rotation, 0.0) is None
 
 
 def test_the_push_goes_across_the_fingers_and_sets_the_fork_down_short_by_its_fall():
@@ -108,7 +114,7 @@ def _place_fork_from_its_edge(seed: int, offset: tuple[float, float], yaw_deg: f
     robot = RobotController(world)
     extractor = OracleExtractor(world, grasp_signal=lambda arm: robot.targets[arm].grip_closed_settled)
     robot.frame = extractor.update()
-    assert thin_on_edge(robot.frame.objects["fork"])
+    assert on_its_edge(robot.frame.objects["fork"])
     assert _run(robot, extractor, make_action("grasp", "left", {"obj": "fork"})) == Status.SUCCESS
     args = {"obj": "fork", "target": list(TARGET_OFFSET["fork"]), "relative_to": "plate", "yaw": 90.0}
     assert _run(robot, extractor, make_action("place", "left", args)) == Status.SUCCESS

@@ -15,8 +15,8 @@ from agentchord.actions.controller import RobotController
 from agentchord.actions.geometry import _level, _yaw_turn
 from agentchord.actions.grasp import UPRIGHT_TOLERANCE_DEG, Grasp
 from agentchord.actions.motion import grip, move_to, pose_from_matrix, settle, wait_for_rest
-from agentchord.actions.tip_flat import PUSH_SPEED, push_length, standing_height, thin_on_edge, tip_push, tip_start
-from agentchord.actions.top_grasp import long_axis, plain_top_grasp
+from agentchord.actions.tip_flat import PUSH_SPEED, push_length, standing_height, tip_push, tip_start
+from agentchord.actions.top_grasp import long_axis, on_its_edge, plain_top_grasp
 from agentchord.features.frame import FeatureFrame, ObjectFeatures, tilt_deg
 from agentchord.solvers.exceptions import NoHandoffSpotError
 from agentchord.solvers.handoff import TAKER_MARGIN, handoff_spot
@@ -126,17 +126,18 @@ class Place(ArmAction):
         rotation = yield from self._upright_in_hand(robot, rotation)
         obj = robot.frame.objects[self.args.obj]
         tool = robot.commanded_pose(arm).pos
-        # A thin object held on its edge (a fork) is tipped flat once released: set down short of its spot.
+        # A flat object held on its edge (a fork) is tipped flat once released: set down short of its spot.
         tip = tip_push(robot.frame, self.args.obj, tool, rotation, self.args.z_offset)
         lowest = obj.bottom[2] if tip is None else obj.pos[2] - 0.5 * standing_height(obj)
         down = tool - np.array([0.0, 0.0, lowest - (self.args.z_offset + 0.004)])
         if tip is not None:
-            down -= tip[1] * tip[0]
+            push, short = tip
+            down -= short * push
         yield from move_to(robot, arm, pose_from_matrix(down, rotation), speed=0.12)
         yield from settle(robot, arm, max_ticks=10)
         yield from grip(robot, arm, self._release_grip(robot), ticks=8)
         if tip is not None:
-            down = yield from self._tip_over(robot, tip[0], rotation)
+            down = yield from self._tip_over(robot, push, rotation)
         # Back off along the approach (straight up after a top grasp).
         retreat = down - 0.08 * rotation[:, 0] + np.array([0.0, 0.0, 0.04 if rotation[2, 0] > -0.7 else 0.0])
         yield from move_to(robot, arm, pose_from_matrix(retreat, rotation))
@@ -197,7 +198,7 @@ class Place(ArmAction):
         so it falls on its face (:mod:`~agentchord.actions.tip_flat`). Returns where the tool ends."""
         tool = robot.commanded_pose(self.arm).pos
         feats = robot.frame.objects[self.args.obj]
-        if not thin_on_edge(feats):
+        if not on_its_edge(feats):
             return tool  # it fell flat as it was let go
         start = tip_start(tool, feats, self.args.z_offset)
         yield from move_to(robot, self.arm, pose_from_matrix(start, rotation), speed=0.1)

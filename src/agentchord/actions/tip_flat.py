@@ -37,12 +37,6 @@ SHORT_SHARES = (1.0, 0.5, 0.0)
 TOP_DOWN_COS = 0.9
 
 
-def thin_on_edge(feats: ObjectFeatures) -> bool:
-    """Whether a flat object (:data:`~agentchord.actions.top_grasp.FLAT_SHARE`) stands on its edge,
-    its face upright; a cloth's corner (a point) never does."""
-    return not feats.is_point and on_its_edge(feats)
-
-
 def standing_height(feats: ObjectFeatures) -> float:
     """How high (m) a thin object stands on its edge on the table: its width (the shorter side of
     its face), whatever its pitch in the fingers now.
@@ -84,8 +78,8 @@ def tip_push(
     Across the fingers, one way or the other, set down short by :func:`fall_shift` (so it falls onto
     its spot), by half that, or on its spot (where a neighbour is too near: rearrange, a fork beside
     the plate): the first whose fingers, pushing from there, sweep through no neighbour. None when
-    the object is not thin and held on its edge, the tool is not top-down, or every push is blocked:
-    the object is then put down as it is held.
+    the object is not flat and on its edge (:func:`~agentchord.actions.top_grasp.on_its_edge`), the
+    tool is not top-down, or every push is blocked: the object is then put down as it is held.
 
     Args:
         frame: The latest features, the object held.
@@ -99,16 +93,16 @@ def tip_push(
         object is set down.
     """
     feats = frame.objects[obj]
-    if not thin_on_edge(feats) or -float(rotation[2, 0]) < TOP_DOWN_COS:
+    if not on_its_edge(feats) or -float(rotation[2, 0]) < TOP_DOWN_COS:
         return None
     across = np.array([rotation[0, 1], rotation[1, 1], 0.0])
     across /= max(float(np.linalg.norm(across)), 1e-9)
+    fall = fall_shift(feats)
     for share in SHORT_SHARES:
         for push in (across, -across):
-            short = share * fall_shift(feats)
-            start = tip_start(tool - short * push, feats, surface_z)
+            start = tip_start(tool - share * fall * push, feats, surface_z)
             length = push_length(tool, feats, push)  # held, the object keeps its place relative to the tool
             poses = [(start + s * push, rotation) for s in np.linspace(0.0, length, PUSH_SAMPLES)]
             if not swept_hits(frame, obj, poses):
-                return push, short
+                return push, share * fall
     return None
