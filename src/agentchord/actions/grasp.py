@@ -41,7 +41,7 @@ from agentchord.actions.side_plan import SidePlanner, side_point, strikes_top
 from agentchord.actions.top_grasp import plain_top_grasp
 from agentchord.actions.wrist_branch import is_wound, move_above, plan_unflipped_fallen_grasp, turn_unflipped
 from agentchord.features.frame import ObjectFeatures, tilt_deg
-from agentchord.solvers.ik import ARM_CLEARANCE, PoseTarget
+from agentchord.solvers.ik import ARM_CLEARANCE, PoseTarget, solve_from_scratch
 from agentchord.solvers.poses import top_down_rotation
 from agentchord.robot.aloha import HOME_Q
 
@@ -122,14 +122,17 @@ class Grasp(ArmAction):
                 yield from grip(robot, self.arm, 0.0, ticks=8)
             return
         made_way = False
-        for attempt in range(self.ATTEMPTS):
+        # Tries are counted apart: an arm held back by the other one has not yet been at the object.
+        misses = held_back = 0
+        while True:
             try:
                 yield from self._let_go(robot)
                 yield from wait_for_rest(robot, self.args.obj)
                 yield from self._attempt(robot)
                 return
             except HeldBackByOtherArm:
-                if attempt == self.ATTEMPTS - 1:
+                held_back += 1
+                if held_back == self.ATTEMPTS:
                     raise
                 # Once per grasp: the other arm, if its part of the step is done, steps back.
                 if not made_way:
@@ -138,7 +141,8 @@ class Grasp(ArmAction):
                     made_way = yield from make_way(robot, self.arm, back_off=above)
             except GraspMissed:
                 # The object moved as the fingers closed (a nudge, a roll): look again and retry.
-                if attempt == self.ATTEMPTS - 1:
+                misses += 1
+                if misses == self.ATTEMPTS:
                     raise
 
     def _held_as_asked(self, robot: RobotController) -> bool:
@@ -318,6 +322,24 @@ class Grasp(ArmAction):
         if off > OFF_CENTRE_TOLERANCE:
             raise GraspMissed(f"{self.args.obj} is held {100 * off:.1f} cm off the grasp point")
 
+    def _reach_above(self, robot: RobotController) -> Iterator[None]:
+        """Wait for the tool to reach the pose above the grasp.
+
+        Raises:
+            HeldBackByOtherArm: The tool stopped short with the other arm's proxies at the collision
+                limit (the retry may move that arm aside).
+            ActionFailed: It stopped short on its own (a joint limit).
+        """
+        try:
+            yield from settle(robot, self.arm, tolerance=0.003, max_ticks=60, required=0.015)
+        except ActionFailed as error:
+            if robot.ik.arms_close() and robot.ik.arm_clearance() < BLOCKED_CLEARANCE:
+                # Held back only where the arm alone reaches the pose: else it is beyond this arm.
+                alone = robot.scratch_ik(avoid_other_arm=False)
+                if solve_from_scratch(alone, robot.ik.configuration.q.copy(), self.arm, [robot.commanded_pose(self.arm)]) is not None:
+                    raise HeldBackByOtherArm(f"the other arm was in the way of the grasp of {self.args.obj}") from error
+            raise
+
     def _still_standing(self, robot: RobotController, when: str) -> None:
         """A side grasp is for an object standing or leaning a little: knocked over meanwhile (by this
         arm's own fingers, or a push), it is taken again the way a fallen one is.
@@ -407,7 +429,7 @@ class Grasp(ArmAction):
         yield from self._clear_from_below(robot, above[2])
         yield from approach(robot, arm, pose_from_matrix(above, rotation), then=pose_from_matrix(point, rotation), clear=self._fingers_clear(robot))
         # A top-down tool often flips the forearm roll: let the IK converge before descending.
-        yield from settle(robot, arm, tolerance=0.003, max_ticks=60, required=0.015)
+        yield from self._reach_above(robot)
         rotation, point = self._top_frame(robot, keep_choice=True)
         yield from move_to(robot, arm, pose_from_matrix(point, rotation), speed=0.08)
         yield from self._close_and_check(robot)
@@ -452,7 +474,7 @@ class Grasp(ArmAction):
             yield from self._cross_over(robot, pre)
         yield from approach(robot, arm, pre, then=pose_from_matrix(point, rotation), clear=self._fingers_clear(robot))
         # A top-down tool often flips the forearm roll: let the IK converge before descending.
-        yield from settle(robot, arm, tolerance=0.003, max_ticks=60, required=0.015)
+        yield from self._reach_above(robot)
         feats = robot.frame.objects[self.args.obj]
         point[:2] = feats.pos[:2] + self._fallen_slide * rotation[:2, 2]  # the slide kept: the fingers' axis
         yield from move_to(robot, arm, pose_from_matrix(point, rotation), speed=0.08)
