@@ -79,6 +79,18 @@ def test_only_a_regrasp_before_a_place_at_a_target_may_skip_as_placed():
     assert all("skip_if_placed" not in call.args for edge_id, call in regrasps.items() if edge_id != "e5_r_bottle_dropped")
 
 
+def test_a_recovery_that_redoes_a_carry_watches_the_slip_its_edge_watches():
+    out = Arranger(scene_of("dual_arm_pour_water")).arrange(nominal_only("dual_arm_pour_water"))
+    slip = next(f for f in out.edge("e3").failures if f.name == "bottle_slipped")
+    # The cup regrasped while the bottle is brought to it again: the right arm only redoes e3's carry.
+    again = next(f for f in out.edge("e3_r_cup_dropped").failures if f.name == "bottle_slipped")
+    assert (again.monitor, again.recovery) == (slip.monitor, slip.recovery)
+    # The slip's own recovery sets the bottle down on purpose: no slip monitor there.
+    assert not any(f.intent == "reseat" for f in out.edge(slip.recovery).failures)
+    # An object the recovery grasps again is not watched for a slip in it (it is taken askew on purpose).
+    assert not any(f.name == "bottle_slipped" for f in out.edge("e3_r_bottle_dropped").failures)
+
+
 def test_a_capsule_carried_in_the_tray_is_watched():
     out = Arranger(scene_of("setup_coffee_tray")).arrange(nominal_only("setup_coffee_tray"))
     carry = out.edge("e4")

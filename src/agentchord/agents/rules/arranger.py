@@ -21,7 +21,8 @@ what, which motions since the last grasp, what each arm's pose is relative to). 
 
 Every recovery edge leaves the failure context ``s`` and merges at ``t`` (or, for a broken
 relation, at ``s``): nothing regresses, and the forward-moving filter (Eq. 8) checks it.
-Recovery edges carry drop monitors of their own; recovery grasps skip an object still held
+Recovery edges carry drop monitors of their own, and a recovery that redoes an edge's carry the
+slipped-grasp monitor of that edge; recovery grasps skip an object still held
 and recovery places skip an object already placed (an interrupted two-arm step).
 """
 
@@ -57,6 +58,8 @@ MISPLACED_WINDOW = 10
 PLACED_TILT_DEG = 10.0
 #: An upright path constraint, ``tilt(obj) - X`` (X in degrees), matched with its spaces removed.
 _UPRIGHT_PATH = re.compile(r"tilt\((\w+)\)-(\d+(?:\.\d+)?)")
+#: A slipped-grasp monitor, ``holding(arm, obj) * tipped(obj, X)``, matched with its spaces removed.
+_SLIP_MONITOR = re.compile(r"holding\((left|right),(\w+)\)\*tipped\(\2,(\d+(?:\.\d+)?)\)")
 
 
 def _with_skips(call: ActionCall) -> ActionCall:
@@ -105,6 +108,29 @@ def _replay_then_edge(account: Account, edge: Edge, arms: Iterable[str]) -> list
         if kept:
             steps.append(kept)
     return steps
+
+
+def _redone_slips(graph: TaskGraph, recovery: Edge) -> list[FailureMode]:
+    """The slipped-grasp modes of the nominal edge a recovery redoes the carry of.
+
+    A recovery from the same source to the same target whose holding arm makes only that edge's own
+    calls (a re-approach to a shifted host) carries the object the same way, under the same upright
+    bound: a slip then is the same failure (Table I, dual-arm pour, stress seed 89: the bottle
+    turned 24 deg in the hand while it was brought to the cup again, and was poured from there).
+    """
+    out = []
+    for nominal in graph.nominal_edges():
+        if (nominal.source, nominal.target) != (recovery.source, recovery.target):
+            continue
+        for mode in nominal.failures:
+            match = _SLIP_MONITOR.fullmatch("".join(mode.monitor.split()))
+            if mode.intent != "reseat" or match is None:
+                continue
+            arm = match.group(1)
+            redone = calls_of(recovery, arm)
+            if redone and all(call in calls_of(nominal, arm) for call in redone):
+                out.append(mode.model_copy())
+    return out
 
 
 @dataclass
@@ -362,6 +388,7 @@ class Arranger:
 
     def _monitor_recoveries(self, graph: TaskGraph) -> None:
         """Drop monitors on recovery edges: a second drop re-enters that object's recovery from the same context.
+        A recovery that redoes a nominal edge's carry also watches that edge's slips (:func:`_redone_slips`).
 
         Watched: what the arms hold at the recovery's source and what the recovery grasps. The
         grasp-done signal gates every such monitor: a recovery grasps and places on purpose.
@@ -388,6 +415,7 @@ class Arranger:
                 terms = [f"{arm}.closed * (0.5 - holding({arm}, {obj}))" for arm in arms]
                 monitor = terms[0] if len(terms) == 1 else f"max({', '.join(terms)})"
                 edge.failures.append(FailureMode(name=name, monitor=monitor, window=kb.WINDOW, intent="regrasp", recovery=recovery))
+            edge.failures += _redone_slips(graph, edge)
 
     # --- online repair -----------------------------------------------------------------
 
