@@ -292,27 +292,7 @@ class Executor(RecoverySwitching):
         if self.program is not None:
             status = self.program.update(self.robot)
             if status == Status.FAILURE:
-                program = self.program
-                if program.kind == "recovery" and program.attempt == 1 and program.scene_changed:
-                    # What it had found done was undone under it (a cup found placed, then knocked over
-                    # before its place step): bound once more from where things are, then the rest.
-                    again = EdgeProgram.from_edge(program.edge or self.graph.edge(program.edge_id))
-                    again.attempt = 2
-                    self._fallbacks.insert(0, again)
-                detection = None if self._fallbacks else self.strategy.on_program_failure(self, self.program)
-                if detection is not None:
-                    # The skill reported failure: a strategy that re-plans takes it as a detected failure.
-                    self.trace.add(self.world.tick, "action_failed", edge=self.program.edge_id, reason=self.program.failure_reason)
-                    self.program = None
-                    return self._on_failure(detection)
-                if self._fallbacks:
-                    # The bound recovery could not be carried out (a grasp out of reach after all):
-                    # the next candidate is bound from where the robot is now.
-                    self.trace.add(self.world.tick, "recovery_failed", edge=self.program.edge_id, reason=self.program.failure_reason)
-                    fallbacks, self._fallbacks = self._fallbacks, []
-                    self.program = None
-                    return self._begin_recovery(fallbacks)
-                return False, f"{self._where()}: {self.program.failure_reason}"
+                return self._on_program_failed()
             if status == Status.SUCCESS:
                 outcome = self._on_program_done()
                 if outcome is not None:
@@ -430,22 +410,6 @@ class Executor(RecoverySwitching):
             if outcome is not None:
                 return outcome
         self._start(program)
-        return None
-
-    def _watched_violation(self, node_id: str, edge_id: str) -> Detection | None:
-        """A recovery merged at ``node_id`` with one of its constraints violated (a second disturbance
-        cut the first recovery short before it restored what it was for): the failure mode of the
-        next edge whose monitor watches that constraint, fired now, so its recovery runs rather than
-        an edge that cannot start (its monitor may be gated by a signal the cut-short recovery reset).
-        """
-        violated = {" ".join(c.source.split()): c.scalar(self.frame) for c in self.constraints[node_id]
-                     if c.scalar(self.frame) > 0.0}
-        for failure in self.graph.edge(edge_id).failures:
-            monitor = " ".join(failure.monitor.split())
-            watched = [value for source, value in violated.items() if source in monitor]
-            if watched:
-                self.trace.add(self.world.tick, "violation_at_merge", node=node_id, edge=edge_id, failure=failure.name)
-                return Detection(edge_id, failure, self.world.tick, self.world.tick, float(watched[0]))
         return None
 
     def _start(self, program: EdgeProgram) -> None:

@@ -1,7 +1,9 @@
 """From a detection to the recovery program running: the executor's failure switching.
 
 On a detection the strategy names its recovery programs; :meth:`_on_failure` switches to them at
-once. A recovery that grasps first waits (binds) until what fell is at rest, then starts the first
+once. A skill's reported failure (:meth:`_on_program_failed`) is the strategy's detection, or the
+next candidate bound, and a recovery merged with a constraint still violated fires the next edge's
+mode that watches it (:meth:`_watched_violation`). A recovery that grasps first waits (binds) until what fell is at rest, then starts the first
 candidate its arms can make (:mod:`agentchord.execution.feasibility`); while it waits, a lost hold
 that comes back as it was resumes the interrupted edge (:mod:`agentchord.execution.binding`), and a
 recovery whose merge sub-goal already holds is skipped (:mod:`agentchord.execution.shortcuts`). An
@@ -16,6 +18,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import replace
+from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from agentchord.actions.base import Status
@@ -66,6 +69,8 @@ class RecoverySwitching:
     _skipped: tuple[str, str] | None
     nominal_next: dict[str, str]
     frame: FeatureFrame
+    constraints: dict[str, list[Any]]  # node -> its compiled constraints
+    _where: Callable[[], str]
 
     def _beyond_every_arm(self, obj: str, confirm_ik: bool) -> tuple[bool, str] | None:
         """The unrecoverable outcome when no arm can take ``obj`` where it is (else None)."""
@@ -208,6 +213,47 @@ class RecoverySwitching:
             self.binding.failure, self.binding.recovering_from = detection.failure.name, previous_context
             self.binding.window = detection.failure.window
         return outcome
+
+    def _on_program_failed(self) -> tuple[bool, str] | None:
+        """The running program reported a skill's failure: bind it once more (what it found done was
+        undone under it), take it as the strategy's detection, bind the next candidate, or end."""
+        program = self.program
+        if program.kind == "recovery" and program.attempt == 1 and program.scene_changed:
+            # What it had found done was undone under it (a cup found placed, then knocked over
+            # before its place step): bound once more from where things are, then the rest.
+            again = EdgeProgram.from_edge(program.edge or self.graph.edge(program.edge_id))
+            again.attempt = 2
+            self._fallbacks.insert(0, again)
+        detection = None if self._fallbacks else self.strategy.on_program_failure(self, self.program)
+        if detection is not None:
+            # The skill reported failure: a strategy that re-plans takes it as a detected failure.
+            self.trace.add(self.world.tick, "action_failed", edge=self.program.edge_id, reason=self.program.failure_reason)
+            self.program = None
+            return self._on_failure(detection)
+        if self._fallbacks:
+            # The bound recovery could not be carried out (a grasp out of reach after all):
+            # the next candidate is bound from where the robot is now.
+            self.trace.add(self.world.tick, "recovery_failed", edge=self.program.edge_id, reason=self.program.failure_reason)
+            fallbacks, self._fallbacks = self._fallbacks, []
+            self.program = None
+            return self._begin_recovery(fallbacks)
+        return False, f"{self._where()}: {self.program.failure_reason}"
+
+    def _watched_violation(self, node_id: str, edge_id: str) -> Detection | None:
+        """A recovery merged at ``node_id`` with one of its constraints violated (a second disturbance
+        cut the first recovery short before it restored what it was for): the failure mode of the
+        next edge whose monitor watches that constraint, fired now, so its recovery runs rather than
+        an edge that cannot start (its monitor may be gated by a signal the cut-short recovery reset).
+        """
+        violated = {" ".join(c.source.split()): c.scalar(self.frame) for c in self.constraints[node_id]
+                     if c.scalar(self.frame) > 0.0}
+        for failure in self.graph.edge(edge_id).failures:
+            monitor = " ".join(failure.monitor.split())
+            watched = [value for source, value in violated.items() if source in monitor]
+            if watched:
+                self.trace.add(self.world.tick, "violation_at_merge", node=node_id, edge=edge_id, failure=failure.name)
+                return Detection(edge_id, failure, self.world.tick, self.world.tick, float(watched[0]))
+        return None
 
     def _repair(self, program: EdgeProgram) -> Detection | None:
         """Online repair of an unanticipated failure at the end of ``program``.
