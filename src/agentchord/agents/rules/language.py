@@ -1,6 +1,6 @@
 """The offline composer's grammar of instructions: English -> clauses, before any scene.
 
-A `lark <https://github.com/lark-parser/lark>`_ Earley grammar over lower-cased words.
+A `lark <https://github.com/lark-parser/lark>`_ Earley grammar over lower-cased words (``instructions.lark``).
 An instruction is a sequence of steps (joined by ``then``, ``and``, ``after that``,
 ``next``, ``finally``, ``;``, ``,`` or numbered ``1.`` ``2.``); a step is one verb phrase:
 
@@ -28,119 +28,13 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 from functools import lru_cache
+from pathlib import Path
 
 from lark import Lark, Transformer
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
-GRAMMAR = r"""
-start: _sep? step (_sep step | "," placement)* _sep?
-// A later step after a comma may leave the verb out: "put the fork left of the plate, the spoon
-// right of it" (after "and", "the fork and the spoon beside the plate" is one list).
-
-_sep: ","? "and"? "then" ","?
-    | ","? "and"? "after" "that" ","?
-    | ","? "and"? ("next" | "finally" | "afterwards" | "lastly") ","?
-    | ","? "and"
-    | ","? "which" | ","? "and" "it" | ","? "while"
-    | ";" | "," | "." | ":"
-
-step: _first? core
-    | _first? "use" arm_np "to" core                       -> step_arm
-    | _first? arm_np ("should" | "must" | "will")? core   -> step_arm
-    | _first? arm ","? core                               -> step_arm
-    | _first? ("have" | "let") arm_np core                -> step_arm
-_first: "first" ","?
-
-?core: pour | fill | pick | place | handover | fold | move | stack | arrange
-
-// --- verbs -------------------------------------------------------------------------
-pour: _pour (np | _liquid)? _pour_part+
-_pour_part: src | dst | arm | "out"
-src: "from" np | "out"? "of" np
-dst: _into np
-_pour: "pour" | "empty" | "tip"
-fill: "fill" "up"? np "up"? ("with" ("water" | "it" | "some" "water"))? _pour_part*
-_liquid: "water" | "the" "water" | "some" "water" | "its" "contents" | "the" "contents" | "it" "out"
-_into: "into" | "in" | "in" "to" | "inside"
-
-pick: _pick "up"? held ("and" held)*
-    | "pick" np "up" arm?                                   -> pick_up
-held: np arm?
-_pick: "pick" | "grasp" | "grab" | "take" | "hold" | "lift" | "seize" | "get"
-
-place: _put placement ("and" placement)+                  -> place_each
-     | _put "down"? np_list _place_part*
-     | "return" np_list _place_part*                        -> place_return
-_place_part: where | arm | back | "down"
-_put: "put" | "place" | "set" | "lay" | "stand" | "leave" | "drop" | "insert" | "deposit"
-back: "back"
-placement: np_list where arm?
-
-handover: _hand "over"? np _hand_part*
-        | "handover" "of"? np _hand_part*
-        | "do" "a" "handover" "of" np _hand_part*
-_hand_part: "over" | from_arm | to_arm | arm
-_hand: "hand" | "pass" | "transfer" | "give" | "switch"
-
-fold: "fold" np (_fold_how | arm)*
-_fold_how: "in" ("half" | "two") | "over" | "in" "half" "lengthwise" | "from" word "to" word
-
-move: _move placement ("and" placement)+                    -> place_each
-    | _move np_list (direction | where | arm)*
-_move: "move" | "push" | "slide" | "shift" | "carry" | "bring" | "transport" | "nudge" | "drag"
-direction: "forward" -> forward | "forwards" -> forward | "ahead" -> forward | "away" -> forward | "further" -> forward
-         | "backward" -> backward | "backwards" -> backward | "closer" -> backward | "back" -> backward
-         | "to"? "the" side                    -> to_side
-         | "towards"? "the"? "front"           -> backward
-         | "to" "the" "front"                  -> backward
-         | "to" "the" "back"                   -> forward
-         | side
-
-stack: "stack" np ("on" | "onto" | "on" "top" "of" | "upon") np arm?
-
-arrange: ("arrange" | "rearrange" | "lay" "out" | "set" "out") np_list where arm?
-
-// --- arms --------------------------------------------------------------------------
-arm: ("with" | "using" | "by") arm_np
-arm_np: ("the" | "your" | "its")? side _limb             -> one_arm
-      | ("the" | "your")? "other" _limb                   -> other_arm
-      | ("both" | "two" | "both" "the" | "both" "of" "the" | "both" "of" "your" | "both" "your") (_limbs | _limb)  -> both_arms
-      | "bimanually"                                      -> both_arms
-from_arm: "from" arm_np
-to_arm: ("to" | "into" | "over" "to") arm_np
-_limb: "arm" | "hand" | "gripper"
-_limbs: "arms" | "hands" | "grippers"
-side: "left" -> left | "right" -> right
-
-// --- places ------------------------------------------------------------------------
-where: prep np                                         -> at
-     | "on" "top" "of" np                              -> on_top
-     | "in" "front" "of" np                            -> front_of
-     | ("to" | "on" | "at")? "the"? side ("of" | "side" "of") np -> side_of
-     | ("next" "to" | "beside" | "by" | "near" | "around" | "alongside") np -> next_to
-     | ("behind" | "in" "back" "of") np                -> behind
-     | "between" np "and" np                           -> between
-     | "where" pronoun ("was" | "were") "before"?      -> back_where
-     | "in" "its" "place" | "in" "place"               -> back_where
-     | "to" "its" "original" (word | "place")             -> back_where
-prep: "on" -> p_on | "onto" -> p_on | "upon" -> p_on | "over" -> p_on
-    | "in" -> p_in | "into" -> p_in | "inside" -> p_in
-    | "at" -> p_at | "to" -> p_at | "toward" -> p_at | "towards" -> p_at
-
-// --- noun phrases ------------------------------------------------------------------
-np_list: np ("," np)* (","? "and" np)?
-np: pronoun                                            -> it
-  | ("both" ("of" "them")? | "them" "both" | "all" ("of" "them")? | "everything")  -> all
-  | _det? word+ ("of" np)?                              -> noun
-  | _det? word+ "one"                                   -> one_of_kind
-!pronoun: "it" | "them" | "one" | "they"
-_det: "the" | "a" | "an" | "its" | "their" | "this" | "that" | "your"
-!word: WORD | side | "front" | "back" | "top" | "side" | "half" | "water" | "other" | "forward"
-
-WORD: /[a-z][a-z0-9_'-]*/
-
-%ignore " "
-"""
+#: The grammar (``instructions.lark`` beside this module).
+GRAMMAR = (Path(__file__).parent / "instructions.lark").read_text(encoding="utf-8")
 
 
 @dataclass(frozen=True)
