@@ -2,7 +2,7 @@
 
 import pytest
 
-from agentchord.agents.rules.arranger import _redone_slips
+from agentchord.agents.rules.arranger import redone_slips
 from agentchord.graph.progress import forward_filter, nominal_path
 from agentchord.graph.validation import check_graph
 from agentchord.tasks import library_tasks, load_task_graph
@@ -31,7 +31,7 @@ def test_a_recovery_that_redoes_a_carry_watches_its_slip_as_the_arranger_would(t
     graph = load_task_graph(task)
     for edge in graph.recovery_edges():
         have = {(f.name, f.monitor, f.recovery) for f in edge.failures}
-        for mode in _redone_slips(graph, edge):
+        for mode in redone_slips(graph, edge):
             assert (mode.name, mode.monitor, mode.recovery) in have, f"{task}: {edge.id} does not watch {mode.name}"
 
 

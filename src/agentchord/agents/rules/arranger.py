@@ -110,12 +110,12 @@ def _replay_then_edge(account: Account, edge: Edge, arms: Iterable[str]) -> list
     return steps
 
 
-def _redone_slips(graph: TaskGraph, recovery: Edge) -> list[FailureMode]:
+def redone_slips(graph: TaskGraph, recovery: Edge) -> list[FailureMode]:
     """The slipped-grasp modes of the nominal edge a recovery redoes the carry of.
 
     A recovery from the same source to the same target whose holding arm makes only that edge's own
     calls (a re-approach to a shifted host) carries the object the same way, under the same upright
-    bound: a slip then is the same failure (Table I, dual-arm pour, stress seed 89: the bottle
+    bound: a slip then is the same failure (dual-arm pour, stress protocol, seed 89: the bottle
     turned 24 deg in the hand while it was brought to the cup again, and was poured from there).
     """
     out = []
@@ -388,7 +388,7 @@ class Arranger:
 
     def _monitor_recoveries(self, graph: TaskGraph) -> None:
         """Drop monitors on recovery edges: a second drop re-enters that object's recovery from the same context.
-        A recovery that redoes a nominal edge's carry also watches that edge's slips (:func:`_redone_slips`).
+        A recovery that redoes a nominal edge's carry also watches that edge's slips (:func:`redone_slips`).
 
         Watched: what the arms hold at the recovery's source and what the recovery grasps. The
         grasp-done signal gates every such monitor: a recovery grasps and places on purpose.
@@ -415,7 +415,7 @@ class Arranger:
                 terms = [f"{arm}.closed * (0.5 - holding({arm}, {obj}))" for arm in arms]
                 monitor = terms[0] if len(terms) == 1 else f"max({', '.join(terms)})"
                 edge.failures.append(FailureMode(name=name, monitor=monitor, window=kb.WINDOW, intent="regrasp", recovery=recovery))
-            edge.failures += _redone_slips(graph, edge)
+            edge.failures += redone_slips(graph, edge)
 
     # --- online repair -----------------------------------------------------------------
 
