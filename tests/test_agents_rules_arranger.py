@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from agentchord.agents.checks import check_reply
-from agentchord.agents.reasoner import ArrangeRequest, UnanticipatedFailure
+from agentchord.agents.reasoner import ArrangeRequest, ComposeRequest, UnanticipatedFailure
 from agentchord.agents.scene import ArmState, Scene
 from agentchord.agents.rules import RulesReasoner
 from agentchord.agents.rules.arranger import Arranger
@@ -118,6 +118,48 @@ def test_online_repair_reads_a_dropped_object_from_the_observation():
     assert len(added) == 1 and added[0].intent == "regrasp"
     branch = repaired.edge(added[0].recovery)
     assert branch.source == "v1" and branch.target == "v2" and branch.steps[0]["right"].fn == "grasp"
+
+
+def _planned_dual_pour():
+    scene = scene_of("dual_arm_pour_water")
+    graph = RulesReasoner().compose(ComposeRequest(instruction=load_task_graph("dual_arm_pour_water").instruction, scene=scene))
+    return RulesReasoner().arrange(ArrangeRequest(graph=graph, scene=scene)), scene
+
+
+def _bottle_tilted_in_hand(scene, tilt_deg):
+    """The scene with the bottle tilted ``tilt_deg`` about x, held by the right hand, the cup by the left."""
+    import numpy as np
+
+    tilt = np.radians(tilt_deg)
+    objects = [o.model_copy(update={"axis": (0.0, -float(np.sin(tilt)), float(np.cos(tilt)))}) if o.name == "bottle" else o
+               for o in scene.objects]
+    arms = [ArmState(name="right", ee=(0.05, 0.5, 0.25), holding="bottle"), ArmState(name="left", ee=(0.0, 0.6, 0.15), holding="cup")]
+    return Scene(objects=objects, arms=arms)
+
+
+def test_online_repair_takes_no_pour_for_a_slipped_grasp():
+    # Planned dual-arm pour, real protocol, seed 5: the other arm's way back into the pour ended with
+    # the left tool 3.9 cm from its receiving pose (3 cm allowed). The bottle, tilted 79 deg by the
+    # pour itself, was read as slipped in the hand: set down, taken again, poured again, the same
+    # 0.9 cm short, until the ticks ran out.
+    from agentchord.agents.exceptions import ReasonerError
+
+    graph, scene = _planned_dual_pour()
+    now = _bottle_tilted_in_hand(scene, 79.0)
+    for edge in ("e4", "e4_r_bottle_dropped_via_left"):
+        failure = UnanticipatedFailure(edge=edge, context="v3", observation="at v4: dist(left.ee, [0.0, 0.62, 0.15]) - 0.03 = 0.009")
+        # Nor is the bottle the other arm set down for the right hand, held again, a leaning one to place again.
+        with pytest.raises(ReasonerError, match="no rule explains"):
+            RulesReasoner().arrange(ArrangeRequest(graph=graph, scene=now, failure=failure))
+    # The same tilt on the way to the cup, which carries it upright, is a slip (unanticipated once
+    # the arranger's own slip branch is taken out).
+    graph = graph.model_copy(deep=True)
+    graph.edges = [e for e in graph.edges if e.id != "e3_r_bottle_slipped"]
+    for edge in graph.edges:
+        edge.failures = [f for f in edge.failures if f.recovery != "e3_r_bottle_slipped"]
+    failure = UnanticipatedFailure(edge="e3", context="v2", observation="at v3: tilt(bottle) - 15 = 64")
+    repaired = RulesReasoner().arrange(ArrangeRequest(graph=graph, scene=now, failure=failure))
+    assert [f.intent for f in repaired.edge("e3").failures if f.name not in {g.name for g in graph.edge("e3").failures}] == ["reseat"]
 
 
 def test_online_repair_with_nothing_to_explain_is_a_reasoner_error():

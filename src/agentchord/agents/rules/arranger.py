@@ -110,6 +110,12 @@ def _replay_then_edge(account: Account, edge: Edge, arms: Iterable[str]) -> list
     return steps
 
 
+def _tilted_on_purpose(account: ArmAccount) -> bool:
+    """Whether the arm's held object is tilted by its own motions since the grasp (a pour not yet
+    undone): tilted in the hand then is no slip."""
+    return any(call.fn == "rotate_eef" for call in account.since_grasp)
+
+
 def redone_slips(graph: TaskGraph, recovery: Edge) -> list[FailureMode]:
     """The slipped-grasp modes of the nominal edge a recovery redoes the carry of.
 
@@ -425,7 +431,8 @@ class Arranger:
             for call in calls_of(edge, arm):
                 obj = call.args.get("obj")
                 info = self.objects.get(obj or "")
-                if call.fn != "place" or info is None or obj not in current or (arm, obj) in holding:
+                # Held again (by either arm: a hand-off set down for the other arm to take), it is not put down.
+                if call.fn != "place" or info is None or obj not in current or any(held == obj for _, held in holding):
                     continue
                 if not kb.keeps_upright(info) or tilt_deg(current[obj].axis) <= PLACED_TILT_DEG:
                     continue
@@ -440,8 +447,9 @@ class Arranger:
         """One new branch for an unanticipated failure at the end of a nominal edge, or ``None``.
 
         Reads the current observation ``now`` against the nominal account at the edge's source: a held
-        object no longer held is a drop; a held object tilted in the hand is a slipped grasp
-        (set it down upright, take it again); an upright object lying on its side is a tip.
+        object no longer held is a drop; a held object tilted in the hand, which the edge does not
+        tilt on purpose (a pour), is a slipped grasp (set it down upright, take it again); an
+        upright object lying on its side is a tip.
         """
         accounts = self.accounts(graph)
         edge = graph.edge(failure.edge)
@@ -467,7 +475,8 @@ class Arranger:
                 mode, recovery = self._drop(edge, before, after, obj)
                 entry = f"{edge.id}_r_{obj}_lost_unforeseen"
                 branch = (mode.model_copy(update={"name": f"{obj}_lost_unforeseen", "recovery": entry}), recovery.model_copy(update={"id": entry}))
-            elif info is not None and kb.is_tall(info) and tilt_deg(current[obj].axis) > 15.0 and before[arm].holding == obj:
+            elif (info is not None and kb.is_tall(info) and tilt_deg(current[obj].axis) > 15.0 and before[arm].holding == obj
+                  and not _tilted_on_purpose(after[arm])):
                 branch = self._slipped(edge, before, arm, obj, 15.0)
             if branch:
                 break
