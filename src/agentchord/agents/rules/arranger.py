@@ -110,10 +110,9 @@ def _replay_then_edge(account: Account, edge: Edge, arms: Iterable[str]) -> list
     return steps
 
 
-def _tilted_on_purpose(account: ArmAccount) -> bool:
-    """Whether the arm's held object is tilted by its own motions since the grasp (a pour not yet
-    undone): tilted in the hand then is no slip."""
-    return any(call.fn == "rotate_eef" for call in account.since_grasp)
+def _mentions(observation: str, name: str) -> bool:
+    """Whether the violated constraints of an observation name an object (``bottle.top``, ``tilt(bottle)``)."""
+    return re.search(rf"(?<![\w.]){re.escape(name)}(?!\w)", observation) is not None
 
 
 def redone_slips(graph: TaskGraph, recovery: Edge) -> list[FailureMode]:
@@ -447,9 +446,11 @@ class Arranger:
         """One new branch for an unanticipated failure at the end of a nominal edge, or ``None``.
 
         Reads the current observation ``now`` against the nominal account at the edge's source: a held
-        object no longer held is a drop; a held object tilted in the hand, which the edge does not
-        tilt on purpose (a pour), is a slipped grasp (set it down upright, take it again); an
-        upright object lying on its side is a tip.
+        object no longer held is a drop; a held object tilted in the hand, where a violated
+        constraint names it, is a slipped grasp (set it down upright, take it again, redo the edge:
+        a pour whose mouth ended off the cup is poured again; a bottle tilted by the pour while
+        another arm's pose is what is violated is left alone); an upright object lying on its side
+        is a tip.
         """
         accounts = self.accounts(graph)
         edge = graph.edge(failure.edge)
@@ -476,7 +477,7 @@ class Arranger:
                 entry = f"{edge.id}_r_{obj}_lost_unforeseen"
                 branch = (mode.model_copy(update={"name": f"{obj}_lost_unforeseen", "recovery": entry}), recovery.model_copy(update={"id": entry}))
             elif (info is not None and kb.is_tall(info) and tilt_deg(current[obj].axis) > 15.0 and before[arm].holding == obj
-                  and not _tilted_on_purpose(after[arm])):
+                  and _mentions(failure.observation, obj)):
                 branch = self._slipped(edge, before, arm, obj, 15.0)
             if branch:
                 break
