@@ -126,6 +126,34 @@ def _cylinder_residuals(points, centre, axis, radius, half, jac: bool, toward=No
     return sdf, (j, e1, e2)
 
 
+def _normal_equations(sdf: np.ndarray, j: np.ndarray, point_w: float) -> tuple[np.ndarray, np.ndarray]:
+    """The Huber-weighted Gauss-Newton system of the point residuals: (J^T W J, J^T W r)."""
+    w = _huber_weights(sdf) * point_w**2
+    jw = j * w[:, None]
+    return j.T @ jw, jw.T @ sdf
+
+
+def _damped_step(a: np.ndarray, g: np.ndarray, lam: float, cost: float, candidate):
+    """One Levenberg-Marquardt step: the damping raised until a step lowers the cost (six tries).
+
+    Args:
+        a, g: The system with its priors.
+        lam: The damping to start from.
+        cost: The cost now.
+        candidate: step -> (the state it leads to, that state's cost).
+
+    Returns:
+        (step, state, its cost, the damping for the next step), or None where no try lowered the cost.
+    """
+    for _ in range(6):
+        step = np.linalg.solve(a + lam * np.diag(np.diag(a) + 1e-9), -g)
+        state, new_cost = candidate(step)
+        if new_cost < cost:
+            return step, state, new_cost, max(lam / 3, 1e-7)
+        lam *= 4
+    return None
+
+
 def _robust_cost(sdf: np.ndarray, prior: np.ndarray) -> float:
     a = np.abs(sdf)
     huber = np.where(a <= HUBER_M, 0.5 * a**2, HUBER_M * (a - 0.5 * HUBER_M))
@@ -212,30 +240,24 @@ def _lm_cylinder(points, state, radius0, half0, iterations, toward=None):
     sdf, (j, e1, e2) = _cylinder_residuals(points, centre, axis, r, h, jac=True, toward=toward)
     cost = _robust_cost(sdf, prior(r, h))
     for _ in range(iterations):
-        w = _huber_weights(sdf) * point_w**2
-        jw = j * w[:, None]
-        a = j.T @ jw
-        g = jw.T @ sdf
+        a, g = _normal_equations(sdf, j, point_w)
         pr = prior(r, h)
         a[5, 5] += prior_w**2
         a[6, 6] += prior_w**2
         g[5] += prior_w * pr[0]
         g[6] += prior_w * pr[1]
-        improved = False
-        for _ in range(6):
-            step = np.linalg.solve(a + lam * np.diag(np.diag(a) + 1e-9), -g)
+
+        def candidate(step, centre=centre, axis=axis, r=r, h=h, e1=e1, e2=e2):
             new_axis = axis + step[3] * e1 + step[4] * e2
             new_axis /= np.linalg.norm(new_axis)
             cand = (centre + step[:3], new_axis, max(r + step[5], 1e-3), max(h + step[6], 1e-3))
             sdf_new, _ = _cylinder_residuals(points, *cand, jac=False, toward=toward)
-            new_cost = _robust_cost(sdf_new, prior(cand[2], cand[3]))
-            if new_cost < cost:
-                lam = max(lam / 3, 1e-7)
-                improved = True
-                break
-            lam *= 4
-        if not improved:
+            return cand, _robust_cost(sdf_new, prior(cand[2], cand[3]))
+
+        found = _damped_step(a, g, lam, cost, candidate)
+        if found is None:
             break
+        step, cand, new_cost, lam = found
         converged = cost - new_cost < 1e-5 * cost
         centre, axis, r, h = cand
         cost = new_cost
@@ -361,25 +383,19 @@ def _lm_box(points, state, half0, iterations, toward=None):
     sdf, j = _box_residuals(points, centre, rot, half, jac=True, toward=toward)
     cost = _robust_cost(sdf, (half - half0) * prior_w)
     for _ in range(iterations):
-        w = _huber_weights(sdf) * point_w**2
-        jw = j * w[:, None]
-        a = j.T @ jw
-        g = jw.T @ sdf
+        a, g = _normal_equations(sdf, j, point_w)
         a[6:, 6:] += np.eye(3) * prior_w**2
         g[6:] += prior_w**2 * (half - half0)
-        improved = False
-        for _ in range(6):
-            step = np.linalg.solve(a + lam * np.diag(np.diag(a) + 1e-9), -g)
+
+        def candidate(step, centre=centre, rot=rot, half=half):
             cand = (centre + step[:3], rot @ _rodrigues(step[3:6]), np.maximum(half + step[6:], 1e-3))
             sdf_new, _ = _box_residuals(points, *cand, jac=False, toward=toward)
-            new_cost = _robust_cost(sdf_new, (cand[2] - half0) * prior_w)
-            if new_cost < cost:
-                lam = max(lam / 3, 1e-7)
-                improved = True
-                break
-            lam *= 4
-        if not improved:
+            return cand, _robust_cost(sdf_new, (cand[2] - half0) * prior_w)
+
+        found = _damped_step(a, g, lam, cost, candidate)
+        if found is None:
             break
+        step, cand, new_cost, lam = found
         converged = cost - new_cost < 1e-5 * cost
         centre, rot, half = cand
         cost = new_cost
