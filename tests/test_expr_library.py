@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
 from agentchord.expr import FUNCTIONS, ArgKind, ExprTypeError, Vocabulary, compile_expr
 from agentchord.expr.library import LIBRARY, angle, cross, xy
@@ -65,6 +66,8 @@ VALUE_CASES = [
     ("norm(xy([3, 4, 5]))", 5.0),
     ("xy(bottle.pos)[2]", 0.0),
     ("xy(bottle.pos)[0]", 0.3),
+    ("local(cup, bottle.pos)[0]", -0.1),
+    ("local(cup, cup.pos)[2]", 0.0),
 ]
 
 
@@ -123,6 +126,27 @@ def test_vector_results_are_numpy_when_allowed() -> None:
     np.testing.assert_allclose(out, [0.45, -0.2, 0.2])
     np.testing.assert_allclose(evaluate("ref(bottle)", allow_vector=True), [0.3, 0.1, 0.1])
     np.testing.assert_allclose(evaluate("at(bottle, 0.25)", allow_vector=True), [0.3, 0.1, 0.05])
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_local_is_the_point_in_the_objects_own_frame(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    quat = rng.normal(size=4)
+    quat /= np.linalg.norm(quat)
+    point = rng.normal(size=3)
+    frame = make_static_frame(objects={"bottle": {"pos": (0.3, 0.1, 0.1), "quat": tuple(quat)}, "cup": {"pos": tuple(point)}})
+    rotation = Rotation.from_quat(quat, scalar_first=True)
+    expected = rotation.inv().apply(point - np.array([0.3, 0.1, 0.1]))
+    got = compile_expr("local(bottle, cup.pos)", VOCAB, allow_vector=True)(frame)
+    np.testing.assert_allclose(got, expected, atol=1e-12)
+
+
+def test_local_reads_a_yawed_tray_along_its_length() -> None:
+    # Turned 90 deg about z: a point 10 cm along world +x lies 10 cm along the object's -y.
+    yaw = (math.cos(math.pi / 4), 0.0, 0.0, math.sin(math.pi / 4))
+    frame = make_static_frame(objects={"bottle": {"pos": (0.0, 0.5, 0.0), "quat": yaw}, "cup": {"pos": (0.1, 0.5, 0.0)}})
+    got = compile_expr("local(bottle, cup.pos)", VOCAB, allow_vector=True)(frame)
+    np.testing.assert_allclose(got, [0.0, -0.1, 0.0], atol=1e-12)
 
 
 def test_xy_does_not_alter_the_frame() -> None:

@@ -201,6 +201,22 @@ def at(frame: FeatureFrame, obj: str, fraction: float) -> np.ndarray:
     return frame.objects[obj].at(fraction)
 
 
+def local(frame: FeatureFrame, obj: str, p: np.ndarray) -> np.ndarray:
+    """``p`` (world frame) in the object's own frame: ``R(obj.quat)^T (p - obj.pos)``.
+
+    Along the object's axes its extents are measured, so a footprint reads as two bounds
+    (a capsule inside a long tray: ``abs(local(tray, capsule.pos)[0]) - 0.11``).
+    """
+    o = frame.objects[obj]
+    w, x, y, z = o.quat.tolist()
+    d0, d1, d2 = (p - o.pos).tolist()
+    return np.array([
+        (1.0 - 2.0 * (y * y + z * z)) * d0 + 2.0 * (x * y + w * z) * d1 + 2.0 * (x * z - w * y) * d2,
+        2.0 * (x * y - w * z) * d0 + (1.0 - 2.0 * (x * x + z * z)) * d1 + 2.0 * (y * z + w * x) * d2,
+        2.0 * (x * z + w * y) * d0 + 2.0 * (y * z - w * x) * d1 + (1.0 - 2.0 * (x * x + y * y)) * d2,
+    ])
+
+
 _S, _V, _O, _A = ArgKind.SCALAR, ArgKind.VECTOR, ArgKind.OBJECT, ArgKind.ARM
 
 #: The library, by name, in the order listed to users.
@@ -255,6 +271,15 @@ LIBRARY: dict[str, Function] = {
             (Param("obj", _O), Param("f", _S)),
             at,
             "point at fraction f along the object's axis (0 = bottom, 1 = top).",
+            returns=_V,
+            returns_size=3,
+            reads_frame=True,
+        ),
+        Function(
+            "local",
+            (Param("obj", _O), Param("p", _V, 3)),
+            local,
+            "point p (world frame) in the object's own frame, along the axes its extents are measured on.",
             returns=_V,
             returns_size=3,
             reads_frame=True,
