@@ -47,6 +47,7 @@ from agentchord.agents.rules.accounts import (
     side_by_side,
 )
 from agentchord.agents.rules.arm_switch import add_arm_switch_alternatives
+from agentchord.agents.rules.constraints import over_footprint
 from agentchord.agents.rules.left_behind import left_behind_branches
 from agentchord.features.frame import tilt_deg
 from agentchord.graph.models import ActionCall, Edge, FailureMode, Step, TaskGraph
@@ -58,6 +59,8 @@ MISPLACED_WINDOW = 10
 PLACED_TILT_DEG = 10.0
 #: An upright path constraint, ``tilt(obj) - X`` (X in degrees), matched with its spaces removed.
 _UPRIGHT_PATH = re.compile(r"tilt\((\w+)\)-(\d+(?:\.\d+)?)")
+#: Calls that bring the arm to a pose of their own, whatever it held before.
+POSING = frozenset({"move_to_target", "move_to_obj", "place", "back"})
 #: A slipped-grasp monitor, ``holding(arm, obj) * tipped(obj, X)``, matched with its spaces removed.
 _SLIP_MONITOR = re.compile(r"holding\((left|right),(\w+)\)\*tipped\(\2,(\d+(?:\.\d+)?)\)")
 
@@ -88,14 +91,22 @@ def _regrasp(account: Account, arm: str, obj: str, tall: bool = False, skip_if_h
     return ActionCall(fn="grasp", args={**args, "skip_if_held": skip_if_held})
 
 
-def _replay_then_edge(account: Account, edge: Edge, arms: Iterable[str]) -> list[Step]:
-    """Restore each arm's relative motions since its grasp where ``edge`` continues them, then ``edge`` again."""
+def _replay_then_edge(account: Account, edge: Edge, arms: Iterable[str], regrasped: bool = False) -> list[Step]:
+    """Restore each arm's motions since its grasp where ``edge`` relies on them, then ``edge`` again.
+
+    An edge that continues them (its first call for the arm is relative) relies on them. So does,
+    after a regrasp, one that does not move the arm to a pose of its own first: the object is then
+    held where it was taken again, not where the edge expects it (a hand-over whose giving arm only
+    opens, a cup held still while the other arm pours into it).
+    """
     prefix: dict[str, list[ActionCall]] = {}
     stripped: set[str] = set()
     for arm in arms:
         mine = calls_of(edge, arm)
         history = account[arm].since_grasp
-        if not mine or mine[0].fn not in RELATIVE or not history:
+        continues = bool(mine) and mine[0].fn in RELATIVE
+        relies = continues or (regrasped and not (mine and mine[0].fn in POSING))
+        if not relies or not history:
             continue
         remaining = cancel_undone([*history, *mine])
         if len(remaining) < len(history):  # the edge undoes earlier motions: replay what is left, skip the edge's part
@@ -293,7 +304,7 @@ class Arranger:
                                          skip_if_placed=_places_at_target(edge, a, obj)) for a in at_s}
             # An arm of this edge with empty hands gets out of the way while the object is taken again.
             regrasp.update({a: ActionCall(fn="back") for a in busy if a not in at_s and before[a].holding is None})
-            steps = [regrasp, *_replay_then_edge(before, edge, at_s or busy)]
+            steps = [regrasp, *_replay_then_edge(before, edge, at_s or busy, regrasped=True)]
         recovery = Edge(id=f"{edge.id}_r_{obj}_dropped", source=edge.source, target=edge.target, kind="recovery", actions=steps)
         mode = FailureMode(name=f"{obj}_dropped", monitor=monitor, window=kb.WINDOW, intent="regrasp", recovery=recovery.id)
         return mode, recovery
@@ -303,7 +314,7 @@ class Arranger:
         down, take it again with the nominal hold, redo the edge. A pour or an upright place from
         an askew hold fails however the rest of the task goes."""
         steps: list[Step] = [{arm: ActionCall(fn="place", args={"obj": obj})}, {arm: _regrasp(before, arm, obj)}]
-        steps += _replay_then_edge(before, edge, {arm})
+        steps += _replay_then_edge(before, edge, {arm}, regrasped=True)
         recovery = Edge(id=f"{edge.id}_r_{obj}_slipped", source=edge.source, target=edge.target, kind="recovery", actions=steps)
         mode = FailureMode(name=f"{obj}_slipped", monitor=f"holding({arm}, {obj}) * tipped({obj}, {limit_deg:g})",
                            window=kb.WINDOW, intent="reseat", recovery=recovery.id)
@@ -381,15 +392,22 @@ class Arranger:
             if host not in carried or host not in self.objects:
                 continue
             holders = holders_of(before, host)
-            tol = round(0.5 * min(self.objects[host].extent[0], self.objects[host].extent[1]), 3)
             steps: list[Step] = [{a: ActionCall(fn="place", args={"obj": host, "skip_if_placed": True}) for a in holders}]
             steps += [{arm: _with_skips(grasp)}, {arm: place}]
             steps.append({a: _regrasp(before, a, host) for a in holders})
             steps += side_by_side({a: before[a].since_grasp for a in holders if before[a].since_grasp})
             recovery = Edge(id=f"{edge.id}_r_{obj}_out", source=edge.source, target=edge.source, kind="recovery", actions=steps)
-            mode = FailureMode(name=f"{obj}_out", monitor=f"misaligned({obj}.pos, {host}.pos, {tol:g})", window=kb.WINDOW, intent="re-place", recovery=recovery.id)
+            mode = FailureMode(name=f"{obj}_out", monitor=self._out_of(obj, host), window=kb.WINDOW, intent="re-place", recovery=recovery.id)
             out.append((mode, recovery))
         return out
+
+    def _out_of(self, obj: str, host: str) -> str:
+        """Monitor of ``obj`` fallen out of (or off) the carried ``host``: beyond its footprint."""
+        info = self.objects[host]
+        if kb.is_wide(info):
+            return over_footprint(obj, info)
+        # Eq. 19's relational template over the disc the host's shorter side spans.
+        return f"misaligned({obj}.pos, {host}.pos, {round(0.5 * min(info.extent[0], info.extent[1]), 3):g})"
 
     def _monitor_recoveries(self, graph: TaskGraph) -> None:
         """Drop monitors on recovery edges: a second drop re-enters that object's recovery from the same context.

@@ -81,7 +81,21 @@ def _at_constraints(name: str, key: str, objects: dict[str, SceneObject], scene:
         anchor, dx, dy = parts[0], parts[1], parts[2]
         return released + [f"norm(xy({name}.pos - {anchor}.pos) - [{dx}, {dy}, 0.0]) - 0.03"] + ([f"tilt({name}) - 15"] if obj is not None and kb.is_flat(obj) else upright)
     if kind in ("in", "on"):
-        host = objects[parts[0]]
-        radius = round(0.5 * min(host.extent[0], host.extent[1]), 4)
-        return released + [f"norm(xy({name}.pos - {parts[0]}.pos)) - {radius:g}"]
+        return released + [over_footprint(name, objects[parts[0]])]
     return released
+
+
+def over_footprint(name: str, host: SceneObject) -> str:
+    """<= 0 while ``name``'s centre lies over ``host``'s footprint (released in it or on it).
+
+    A round or small host's footprint is the disc its shorter side spans. A wide one (carried by
+    both arms by its ends) is long: its footprint is a rectangle in its own frame, less the
+    handles at its ends. The disc would read a capsule slid along a tray, still inside it, as out
+    (planned coffee tray, real protocol, seed 2: 6.7 cm from the centre of a tray 23 cm long inside).
+    """
+    half = [0.5 * host.extent[0], 0.5 * host.extent[1]]
+    if not kb.is_wide(host):
+        return f"norm(xy({name}.pos - {host.name}.pos)) - {round(min(half), 4):g}"
+    half[0 if half[0] >= half[1] else 1] -= 2 * kb.HANDLE_INSET
+    x, y = rounded(half)
+    return f"max(abs(local({host.name}, {name}.pos)[0]) - {x:g}, abs(local({host.name}, {name}.pos)[1]) - {y:g})"
