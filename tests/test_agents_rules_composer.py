@@ -9,6 +9,7 @@ from agentchord.agents.observe import observe, task_regions
 from agentchord.agents.checks import check_reply
 from agentchord.agents.reasoner import ComposeRequest
 from agentchord.agents.rules import RulesReasoner
+from agentchord.agents.rules.constraints import over_footprint
 from agentchord.tasks import load_task_graph
 from agentchord.worlds.sim.tasks import SIM_TASKS
 from agentchord.worlds.sim.world import SimWorld
@@ -49,6 +50,13 @@ def test_the_two_arms_work_at_once_where_they_are_independent():
     assert [("left", "place"), ("right", "place")] in fns(graph)
 
 
+def test_a_held_cup_is_put_down_only_once_the_bottle_over_it_is_upright_again():
+    graph = RulesReasoner().compose(ComposeRequest(instruction=load_task_graph("dual_arm_pour_water").instruction, scene=scene_of("dual_arm_pour_water")))
+    steps = fns(graph)
+    untilt = max(i for i, step in enumerate(steps) if ("right", "rotate_eef") in step)
+    assert steps.index([("left", "place"), ("right", "place")]) > untilt
+
+
 def test_handover_takes_before_it_lets_go():
     graph = RulesReasoner().compose(ComposeRequest(instruction=load_task_graph("handover_block").instruction, scene=scene_of("handover_block")))
     handover = next(e for e in graph.edges if len(e.steps) == 3)
@@ -67,3 +75,13 @@ def test_a_goal_spec_replaces_the_instruction():
     scene = scene_of("blocks_and_cup")
     graph = RulesReasoner(GoalSpec(goals=[Inside(obj="red_block", container="cup")])).compose(ComposeRequest(instruction="", scene=scene))
     assert any(c.fn == "place" and c.args.get("relative_to") == "cup" for _, c in graph.edges[1].calls)
+
+
+def test_in_a_wide_host_is_its_footprint_in_its_own_frame_and_in_a_cup_a_disc():
+    graph = RulesReasoner().compose(ComposeRequest(instruction="Place the coffee capsule into the tray and move the tray forward.",
+                                                   scene=scene_of("setup_coffee_tray")))
+    relation = [c for c in graph.node("v3").constraints if "capsule" in c and "tray" in c]
+    assert relation and relation[0].startswith("max(abs(local(tray, capsule.pos)[0])")
+    tray = next(o for o in scene_of("setup_coffee_tray").objects if o.name == "tray")
+    cup = tray.model_copy(update={"name": "cup", "extent": (0.08, 0.08, 0.1)})
+    assert over_footprint("block", cup) == "norm(xy(block.pos - cup.pos)) - 0.04"

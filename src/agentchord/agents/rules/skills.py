@@ -121,7 +121,8 @@ def _one_arm_ops(
         ops.append(
             Operator(
                 name=f"place({arm}, {name}, {key})", arms=(arm,), objects=(name,),
-                pre=frozenset(pre), pre_not=frozenset({("tilted", arm)}),
+                # A container is not moved from under a vessel still tilted over it.
+                pre=frozenset(pre), pre_not=frozenset({("tilted", arm), ("under_pour", name)}),
                 add=frozenset({("free", arm), ("on_table", name), ("at", name, key)}),
                 delete=_released(arm, name), cost=170 + reach,
                 steps=({arm: _call("place", **args)},), semantic=f"The {name} released {_where(key)}.", skill="place",
@@ -234,7 +235,7 @@ def _pour_ops(goal: Poured) -> list[Operator]:
             ops.append(
                 Operator(
                     name=f"tilt({arm}, {s}, {c}, {mode})", arms=(arm,), objects=(s, c),
-                    pre=frozenset({("pour_ready", arm, s, c)} | support), add=frozenset({("tilted", arm), ("poured", s, c, mode)}),
+                    pre=frozenset({("pour_ready", arm, s, c)} | support), add=frozenset({("tilted", arm), ("poured", s, c, mode), ("under_pour", c)}),
                     delete=frozenset({("pour_ready", arm, s, c)}), cost=80,
                     steps=({arm: _call("rotate_eef", angle=kb.POUR_TILT)},),
                     semantic=f"The {s} tilted, its mouth above the {c}.", skill="pour",
@@ -243,7 +244,7 @@ def _pour_ops(goal: Poured) -> list[Operator]:
         ops.append(
             Operator(
                 name=f"untilt({arm})", arms=(arm,), objects=(s, c), pre=frozenset({("tilted", arm)}),
-                add=frozenset(), delete=frozenset({("tilted", arm)}), cost=80,
+                add=frozenset(), delete=frozenset({("tilted", arm), ("under_pour", c)}), cost=80,
                 steps=({arm: _call("rotate_eef", angle=-kb.POUR_TILT)},), semantic=f"The {s} upright again.", skill="pour",
             )
         )
