@@ -25,7 +25,10 @@ def test_a_bottle_stood_on_the_table_is_watched_for_a_knock_as_the_arm_goes_home
     out = _arranged("single_arm_pour_water")
     last = out.edge("e6")
     assert is_retreat(last)
-    assert _modes(out, "e6")["bottle_knocked"] == ("tipped(bottle, 30)", "e6_r_bottle_put_back")
+    # Past the goal's own bound (tilt(bottle) - 10), not only knocked flat: left leaning 17 deg against
+    # the cup, the goal failed with nothing left to run (planned single-arm pour, stress seed 7).
+    assert "tilt(bottle) - 10" in out.node(last.target).constraints
+    assert _modes(out, "e6")["bottle_knocked"] == ("tipped(bottle, 12)", "e6_r_bottle_put_back")
     put_back = out.edge("e6_r_bottle_put_back")
     # Taken again with the nominal grasp, put down as the nominal place did; then home again from v5.
     assert (put_back.source, put_back.target) == ("v5", "v5")

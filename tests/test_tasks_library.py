@@ -2,7 +2,7 @@
 
 import pytest
 
-from agentchord.agents.rules.arranger import redone_slips
+from agentchord.agents.rules.in_hand import redone_slips
 from agentchord.graph.progress import forward_filter, nominal_path
 from agentchord.graph.validation import check_graph
 from agentchord.tasks import library_tasks, load_task_graph

@@ -7,8 +7,9 @@ what, which motions since the last grasp, what each arm's pose is relative to). 
 
 - a held object can drop or slip (Eq. 16-17): ``regrasp`` where it fell, restore the arm's
   relative motions since the grasp, then finish ``e``;
-- a tall object carried under an upright path constraint can tilt in the hand (taken askew):
-  ``reseat``: set it down, take it again with the nominal hold, then ``e`` again;
+- a tall object carried under an upright path constraint can tilt in the hand (taken askew),
+  and a hand-over's giver can hold the bar low (:mod:`.in_hand`): ``reseat`` or ``regrip high``:
+  set it down, take it again with the nominal hold, then ``e`` again;
 - an object the edge aims at (or places relative to) can drift (Eq. 14): ``re-approach``,
   run ``e`` again on its new pose; if it must stand upright it can tip (Eq. 15): ``set upright``
   with a free arm while the busy arm parks, then ``e`` again;
@@ -29,26 +30,17 @@ and recovery places skip an object already placed (an interrupted two-arm step).
 from __future__ import annotations
 
 import re
-from collections.abc import Iterable
 from dataclasses import dataclass
 
 from agentchord.agents.reasoner import UnanticipatedFailure
 from agentchord.agents.scene import Scene, SceneObject
 from agentchord.agents.rules import knowledge as kb
-from agentchord.agents.rules.accounts import (
-    ARMS,
-    RELATIVE,
-    Account,
-    ArmAccount,
-    apply_step,
-    calls_of,
-    cancel_undone,
-    holders_of,
-    side_by_side,
-)
+from agentchord.agents.rules.accounts import ARMS, RELATIVE, Account, ArmAccount, apply_step, calls_of, holders_of, side_by_side
 from agentchord.agents.rules.arm_switch import add_arm_switch_alternatives
 from agentchord.agents.rules.constraints import over_footprint
+from agentchord.agents.rules.in_hand import gripped_low, redone_slips, slipped, upright_in_hand
 from agentchord.agents.rules.left_behind import left_behind_branches
+from agentchord.agents.rules.recovery_steps import after_park, places_at_target, regrasp, replay_then_edge, with_skips
 from agentchord.features.frame import tilt_deg
 from agentchord.graph.models import ActionCall, Edge, FailureMode, Step, TaskGraph
 from agentchord.graph.progress import forward_filter, nominal_path
@@ -57,96 +49,12 @@ from agentchord.graph.progress import forward_filter, nominal_path
 MISPLACED_WINDOW = 10
 #: Tilt (deg) of a placed upright object beyond which it leans (the placed constraints allow 10).
 PLACED_TILT_DEG = 10.0
-#: An upright path constraint, ``tilt(obj) - X`` (X in degrees), matched with its spaces removed.
-_UPRIGHT_PATH = re.compile(r"tilt\((\w+)\)-(\d+(?:\.\d+)?)")
-#: Calls that bring the arm to a pose of their own, whatever it held before.
-POSING = frozenset({"move_to_target", "move_to_obj", "place", "back"})
-#: A slipped-grasp monitor, ``holding(arm, obj) * tipped(obj, X)``, matched with its spaces removed.
-_SLIP_MONITOR = re.compile(r"holding\((left|right),(\w+)\)\*tipped\(\2,(\d+(?:\.\d+)?)\)")
 
-
-def _with_skips(call: ActionCall) -> ActionCall:
-    if call.fn == "grasp":
-        return ActionCall(fn="grasp", args={**call.args, "skip_if_held": True})
-    if call.fn == "place":
-        return ActionCall(fn="place", args={**call.args, "skip_if_placed": True})
-    return call
-
-
-def _places_at_target(edge: Edge, arm: str, obj: str) -> bool:
-    """Whether ``edge`` has ``arm`` put ``obj`` down at a target (a drop there may finish the place)."""
-    return any(c.fn == "place" and c.args.get("obj") == obj and c.args.get("target") is not None for c in calls_of(edge, arm))
-
-
-def _regrasp(account: Account, arm: str, obj: str, tall: bool = False, skip_if_held: bool = True,
-             skip_if_placed: bool = False) -> ActionCall:
-    grasp = account[arm].grasp
-    args = dict(grasp.args) if grasp is not None and grasp.args.get("obj") == obj else {"obj": obj}
-    if tall and args.get("mode", "auto") != "top":
-        # A tall object that fell is taken again from its side once upright: the nominal hold,
-        # not the off-centre fallen-object hold (a pour or an upright place needs it).
-        args["reseat"] = True
-    if skip_if_placed:  # fallen where the edge was putting it: only let go (the replayed place does)
-        args["skip_if_placed"] = True
-    return ActionCall(fn="grasp", args={**args, "skip_if_held": skip_if_held})
-
-
-def _replay_then_edge(account: Account, edge: Edge, arms: Iterable[str], regrasped: bool = False) -> list[Step]:
-    """Restore each arm's motions since its grasp where ``edge`` relies on them, then ``edge`` again.
-
-    An edge that continues them (its first call for the arm is relative) relies on them. So does,
-    after a regrasp, one that does not move the arm to a pose of its own first: the object is then
-    held where it was taken again, not where the edge expects it (a hand-over whose giving arm only
-    opens, a cup held still while the other arm pours into it).
-    """
-    prefix: dict[str, list[ActionCall]] = {}
-    stripped: set[str] = set()
-    for arm in arms:
-        mine = calls_of(edge, arm)
-        history = account[arm].since_grasp
-        continues = bool(mine) and mine[0].fn in RELATIVE
-        relies = continues or (regrasped and not (mine and mine[0].fn in POSING))
-        if not relies or not history:
-            continue
-        remaining = cancel_undone([*history, *mine])
-        if len(remaining) < len(history):  # the edge undoes earlier motions: replay what is left, skip the edge's part
-            prefix[arm], _ = remaining, stripped.add(arm)
-        else:
-            prefix[arm] = history
-    steps = side_by_side(prefix)
-    for step in edge.steps:
-        kept = {a: _with_skips(c) for a, c in step.items() if c is not None and a not in stripped}
-        if kept:
-            steps.append(kept)
-    return steps
 
 
 def _mentions(observation: str, name: str) -> bool:
     """Whether the violated constraints of an observation name an object (``bottle.top``, ``tilt(bottle)``)."""
     return re.search(rf"(?<![\w.]){re.escape(name)}(?!\w)", observation) is not None
-
-
-def redone_slips(graph: TaskGraph, recovery: Edge) -> list[FailureMode]:
-    """The slipped-grasp modes of the nominal edge a recovery redoes the carry of.
-
-    A recovery from the same source to the same target whose holding arm makes only that edge's own
-    calls (a re-approach to a shifted host) carries the object the same way, under the same upright
-    bound: a slip then is the same failure (dual-arm pour, stress protocol, seed 89: the bottle
-    turned 24 deg in the hand while it was brought to the cup again, and was poured from there).
-    """
-    out = []
-    for nominal in graph.nominal_edges():
-        if (nominal.source, nominal.target) != (recovery.source, recovery.target):
-            continue
-        for mode in nominal.failures:
-            match = _SLIP_MONITOR.fullmatch("".join(mode.monitor.split()))
-            if mode.intent != "reseat" or match is None:
-                continue
-            arm = match.group(1)
-            redone = calls_of(recovery, arm)
-            if redone and all(call in calls_of(nominal, arm) for call in redone):
-                out.append(mode.model_copy())
-    return out
 
 
 @dataclass
@@ -216,7 +124,7 @@ class Arranger:
                 continue
             replay = Edge(
                 id=f"{edge.id}_r_{obj}_moved", source=edge.source, target=edge.target, kind="recovery",
-                actions=_replay_then_edge(account, edge, busy),
+                actions=replay_then_edge(account, edge, busy),
             )
             if kb.keeps_upright(obj_info):
                 tipped = self._set_upright(edge, account, obj, busy)
@@ -225,7 +133,8 @@ class Arranger:
             out.append((FailureMode(name=f"{obj}_shifted", monitor=f"drift({obj}, {kb.drift_tolerance(obj_info):g})", window=kb.WINDOW, intent="re-approach", recovery=replay.id), replay))
             if self.watch_visibility:
                 out.append((FailureMode(name=f"{obj}_lost", monitor=f"lost_view({obj}, {kb.MIN_POINTS})", window=kb.WINDOW, intent="re-observe", recovery=replay.id), None))
-        out += self._upright_in_hand(edge, account, after)
+        out += upright_in_hand(edge, account, after, self.objects)
+        out += gripped_low(graph, edge, account)
         out += self._relations(graph, edge, account, after)
         out += self._misplaced(graph, edge, account)
         out += left_behind_branches(graph, edge, self.objects)
@@ -294,50 +203,20 @@ class Arranger:
             terms = [f"{a}.closed * (0.5 - holding({a}, {obj}))" if deliberate else f"0.5 - holding({a}, {obj})" for a in arms]
             monitor = terms[0] if len(terms) == 1 else f"max({', '.join(terms)})"
         if not at_s:  # grasped during the edge: finish the grasp
-            steps = [{a: _with_skips(c) for a, c in step.items() if c is not None} for step in edge.steps]
+            steps = [{a: with_skips(c) for a, c in step.items() if c is not None} for step in edge.steps]
         else:
             busy = {arm for step in edge.steps for arm, call in step.items() if call is not None}
             tall = obj in self.objects and kb.is_tall(self.objects[obj])
             # Carried by two arms and lost by one, it hangs from the other: both let go (a grasp opens
             # first), so it lands flat, and both take it again.
-            regrasp: Step = {a: _regrasp(before, a, obj, tall, skip_if_held=len(at_s) < 2,
-                                         skip_if_placed=_places_at_target(edge, a, obj)) for a in at_s}
+            retake: Step = {a: regrasp(before, a, obj, tall, skip_if_held=len(at_s) < 2,
+                                         skip_if_placed=places_at_target(edge, a, obj)) for a in at_s}
             # An arm of this edge with empty hands gets out of the way while the object is taken again.
-            regrasp.update({a: ActionCall(fn="back") for a in busy if a not in at_s and before[a].holding is None})
-            steps = [regrasp, *_replay_then_edge(before, edge, at_s or busy, regrasped=True)]
+            retake.update({a: ActionCall(fn="back") for a in busy if a not in at_s and before[a].holding is None})
+            steps = [retake, *replay_then_edge(before, edge, at_s or busy, regrasped=True)]
         recovery = Edge(id=f"{edge.id}_r_{obj}_dropped", source=edge.source, target=edge.target, kind="recovery", actions=steps)
         mode = FailureMode(name=f"{obj}_dropped", monitor=monitor, window=kb.WINDOW, intent="regrasp", recovery=recovery.id)
         return mode, recovery
-
-    def _slipped(self, edge: Edge, before: Account, arm: str, obj: str, limit_deg: float) -> tuple[FailureMode, Edge]:
-        """A tall object tilted in the hand (pushed while it was taken, knocked in the hand): set it
-        down, take it again with the nominal hold, redo the edge. A pour or an upright place from
-        an askew hold fails however the rest of the task goes."""
-        steps: list[Step] = [{arm: ActionCall(fn="place", args={"obj": obj})}, {arm: _regrasp(before, arm, obj)}]
-        steps += _replay_then_edge(before, edge, {arm}, regrasped=True)
-        recovery = Edge(id=f"{edge.id}_r_{obj}_slipped", source=edge.source, target=edge.target, kind="recovery", actions=steps)
-        mode = FailureMode(name=f"{obj}_slipped", monitor=f"holding({arm}, {obj}) * tipped({obj}, {limit_deg:g})",
-                           window=kb.WINDOW, intent="reseat", recovery=recovery.id)
-        return mode, recovery
-
-    def _upright_in_hand(self, edge: Edge, before: Account, after: Account) -> list[tuple[FailureMode, Edge]]:
-        """Slipped-grasp branches for the tall objects an edge carries under an upright path constraint.
-
-        The path constraint ``tilt(obj) - X`` says the object must stay within X degrees of upright
-        while the edge runs; held throughout by one arm, leaving that bound means the hold slipped.
-        """
-        out = []
-        for constraint in edge.path_constraints:
-            match = _UPRIGHT_PATH.fullmatch("".join(constraint.split()))
-            if match is None:
-                continue
-            obj, limit = match.group(1), float(match.group(2))
-            info = self.objects.get(obj)
-            holders = holders_of(before, obj)
-            if info is None or not kb.is_tall(info) or len(holders) != 1 or holders_of(after, obj) != holders:
-                continue
-            out.append(self._slipped(edge, before, holders[0], obj, limit))
-        return out
 
     def _aimed_at(self, graph: TaskGraph, edge: Edge, account: Account, held: list[str]) -> list[str]:
         """Objects the edge aims at (or keeps a pose relative to) whose pose its target constrains."""
@@ -366,21 +245,10 @@ class Arranger:
         parked = {a: ActionCall(fn="move_to_target", args={"pos": list(kb.PARK_POSE[a][0]), "yaw": kb.PARK_POSE[a][1]}) for a in busy if account[a].holding}
         steps: list[Step] = [parked] if parked else []
         steps += [{helper: ActionCall(fn="grasp", args={"obj": obj})}, {helper: ActionCall(fn="place", args={"obj": obj})}, {helper: ActionCall(fn="back")}]
-        steps += _replay_then_edge(account, edge, busy) if not parked else self._after_park(account, edge, busy)
+        steps += replay_then_edge(account, edge, busy) if not parked else after_park(account, edge, busy)
         recovery = Edge(id=f"{edge.id}_r_{obj}_tipped", source=edge.source, target=edge.target, kind="recovery", actions=steps)
         mode = FailureMode(name=f"{obj}_tipped", monitor=f"tipped({obj}, {kb.TIP_DEG:g})", window=kb.WINDOW, intent="set upright", recovery=recovery.id)
         return mode, recovery
-
-    @staticmethod
-    def _after_park(account: Account, edge: Edge, busy: set[str]) -> list[Step]:
-        # Parking is an absolute move: restore the whole pose since the grasp, then the edge.
-        history = {a: account[a].since_grasp for a in busy if account[a].since_grasp}
-        steps = side_by_side(history)
-        for step in edge.steps:
-            kept = {a: _with_skips(c) for a, c in step.items() if c is not None}
-            if kept:
-                steps.append(kept)
-        return steps
 
     def _relations(self, graph: TaskGraph, edge: Edge, before: Account, after: Account) -> list[tuple[FailureMode, Edge]]:
         """Objects released in or on one that this edge carries (Eq. 19): put them back, take the carrier again."""
@@ -393,8 +261,8 @@ class Arranger:
                 continue
             holders = holders_of(before, host)
             steps: list[Step] = [{a: ActionCall(fn="place", args={"obj": host, "skip_if_placed": True}) for a in holders}]
-            steps += [{arm: _with_skips(grasp)}, {arm: place}]
-            steps.append({a: _regrasp(before, a, host) for a in holders})
+            steps += [{arm: with_skips(grasp)}, {arm: place}]
+            steps.append({a: regrasp(before, a, host) for a in holders})
             steps += side_by_side({a: before[a].since_grasp for a in holders if before[a].since_grasp})
             recovery = Edge(id=f"{edge.id}_r_{obj}_out", source=edge.source, target=edge.source, kind="recovery", actions=steps)
             mode = FailureMode(name=f"{obj}_out", monitor=self._out_of(obj, host), window=kb.WINDOW, intent="re-place", recovery=recovery.id)
@@ -453,7 +321,7 @@ class Arranger:
                     continue
                 if not kb.keeps_upright(info) or tilt_deg(current[obj].axis) <= PLACED_TILT_DEG:
                     continue
-                steps: list[Step] = [{arm: _regrasp(before, arm, obj, kb.is_tall(info))}, {arm: call}]
+                steps: list[Step] = [{arm: regrasp(before, arm, obj, kb.is_tall(info))}, {arm: call}]
                 recovery = Edge(id=f"{edge.id}_r_{obj}_leaning", source=edge.source, target=edge.target, kind="recovery", actions=steps)
                 monitor = f"(1 - {arm}.closed) * tipped({obj}, {PLACED_TILT_DEG + 2:g})"
                 mode = FailureMode(name=f"{obj}_leaning", monitor=monitor, window=kb.WINDOW, intent="re-place", recovery=recovery.id)
@@ -496,7 +364,7 @@ class Arranger:
                 branch = (mode.model_copy(update={"name": f"{obj}_lost_unforeseen", "recovery": entry}), recovery.model_copy(update={"id": entry}))
             elif (info is not None and kb.is_tall(info) and tilt_deg(current[obj].axis) > 15.0 and before[arm].holding == obj
                   and _mentions(failure.observation, obj)):
-                branch = self._slipped(edge, before, arm, obj, 15.0)
+                branch = slipped(edge, before, arm, obj, 15.0)
             if branch:
                 break
         if branch is None:

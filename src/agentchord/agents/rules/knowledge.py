@@ -46,6 +46,8 @@ HANDOVER_POSE = (0.0, 0.50, 0.25)
 #: handover: two grippers on one bar need ~11 cm between their tool centres.
 HANDOVER_GIVER_HEIGHT = 0.85
 HANDOVER_RECEIVER_HEIGHT = 0.2
+#: A giver's grip below this fraction of the bar's height leaves the receiver's fingers no room.
+HANDOVER_GRIP_LOW = 0.75
 #: The giver's retreat after opening (m, along its own side of the table).
 HANDOVER_RETREAT = 0.10
 #: Clearance lift of a flat object before it is carried (m), and of a tray held by both arms.
