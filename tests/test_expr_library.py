@@ -193,6 +193,9 @@ def test_pure_helpers_match_numpy() -> None:
         ("ref(bottle.pos)", "bottle.pos"),
         ("at(bottle, cup.pos)", "cup.pos"),
         ("dist(bottle, cup)", "bottle"),
+        ("local(cup.pos, bottle.pos)", "cup.pos"),
+        ("local(cup, 1)", "1"),
+        ("local(cup, [1, 2])", "[1, 2]"),
     ],
 )
 def test_wrong_calls_are_type_errors(source: str, part: str) -> None:
