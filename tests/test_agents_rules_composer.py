@@ -9,7 +9,10 @@ from agentchord.agents.observe import observe, task_regions
 from agentchord.agents.checks import check_reply
 from agentchord.agents.reasoner import ComposeRequest
 from agentchord.agents.rules import RulesReasoner
+from agentchord.agents.rules.composer import compose
 from agentchord.agents.rules.constraints import over_footprint
+from agentchord.agents.rules.facts import poured_into
+from agentchord.agents.rules.goals import GoalSpec
 from agentchord.tasks import load_task_graph
 from agentchord.worlds.sim.tasks import SIM_TASKS
 from agentchord.worlds.sim.world import SimWorld
@@ -85,3 +88,20 @@ def test_in_a_wide_host_is_its_footprint_in_its_own_frame_and_in_a_cup_a_disc():
     tray = next(o for o in scene_of("setup_coffee_tray").objects if o.name == "tray")
     cup = tray.model_copy(update={"name": "cup", "extent": (0.08, 0.08, 0.1)})
     assert over_footprint("block", cup) == "norm(xy(block.pos - cup.pos)) - 0.04"
+
+
+def test_a_re_plan_in_the_middle_of_a_pour_untilts_before_the_cup_under_the_bottle_moves():
+    scene = scene_of("dual_arm_pour_water")
+    objects = {o.name: o for o in scene.objects}
+    tipped = objects["bottle"].model_copy(update={"axis": (0.0, 0.996, -0.087), "pos": (0.0, 0.55, 0.25)})
+    held_up = objects["cup"].model_copy(update={"pos": (0.0, 0.62, 0.15)})
+    holding = {"left": "cup", "right": "bottle"}
+    mid_pour = scene.model_copy(update={
+        "objects": [{"bottle": tipped, "cup": held_up}.get(o.name, o) for o in scene.objects],
+        "arms": [a.model_copy(update={"holding": holding[a.name], "home": False, "closed": True}) for a in scene.arms],
+    })
+    assert poured_into(mid_pour) == {"right": ["cup"]}
+    goal = GoalSpec.model_validate({"goals": [{"kind": "placed", "obj": "cup"}, {"kind": "placed", "obj": "bottle"}]})
+    steps = fns(compose(goal, mid_pour).graph)
+    # Untilted alone first: not while the cup moves from under it in the same step.
+    assert steps[0] == [("right", "rotate_eef")] and [("left", "place"), ("right", "place")] in steps[1:]

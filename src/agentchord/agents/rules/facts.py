@@ -9,6 +9,7 @@ Facts (tuples of strings):
   ``region:NAME``, ``rel:ANCHOR:DX:DY:YAW``, ``in:C``, ``on:S``, ``fold:FAR``;
 - ``presented a c``: a container held up to be poured into;
 - ``pour_ready a s c`` / ``tilted a``; ``poured s c MODE`` (``table`` or ``held``);
+  ``under_pour c``: a vessel is tilted over container ``c`` (it is not moved until upright again);
 - ``handover_ready a o``; ``handed o GIVER RECEIVER``; ``over a corner``.
 
 The skills that make them true or false are in :mod:`~agentchord.agents.rules.skills`; the
@@ -16,6 +17,8 @@ node constraints each fact stands for, in :mod:`~agentchord.agents.rules.constra
 """
 
 from __future__ import annotations
+
+import math
 
 from agentchord.agents.scene import Scene, SceneObject
 from agentchord.agents.rules import knowledge as kb
@@ -48,6 +51,7 @@ def initial_state(scene: Scene, goal: GoalSpec | None = None) -> frozenset[Fact]
                 facts.add(("upright", obj.name))
                 if obj.axis[2] < HELD_TILTED_Z:
                     facts.add(("tilted", arm))
+                    facts |= {("under_pour", c) for c in poured_into(scene).get(arm, [])}
         else:
             facts.add(("free", arm))
             if holder is None or holder.home:
@@ -67,6 +71,27 @@ def initial_state(scene: Scene, goal: GoalSpec | None = None) -> frozenset[Fact]
 
 #: Axis height (cos 45 deg) under which a held upright object counts as tipped in the hand.
 HELD_TILTED_Z = 0.707
+#: How far (m) beyond a container's rim a tipped vessel's mouth may be and still pour into it.
+POUR_REACH = 0.05
+
+
+def poured_into(scene: Scene) -> dict[str, list[str]]:
+    """Arm -> the containers under the mouth of the vessel it holds tipped (a re-plan mid-pour).
+
+    Such a container is not moved before the vessel is upright again (``under_pour``).
+    """
+    objects = {o.name: o for o in scene.objects}
+    out: dict[str, list[str]] = {}
+    for holder in scene.arms:
+        vessel = objects.get(holder.holding or "")
+        if vessel is None or not kb.keeps_upright(vessel) or vessel.axis[2] >= HELD_TILTED_Z:
+            continue
+        mouth = [p + 0.5 * vessel.extent[2] * a for p, a in zip(vessel.pos, vessel.axis, strict=True)]
+        for c in scene.objects:
+            rim = 0.5 * max(c.extent[0], c.extent[1]) + POUR_REACH
+            if c.name != vessel.name and kb.is_container(c) and math.dist(mouth[:2], c.pos[:2]) <= rim:
+                out.setdefault(holder.name, []).append(c.name)
+    return out
 
 
 def _destinations(goal: GoalSpec) -> list[tuple[str, str]]:

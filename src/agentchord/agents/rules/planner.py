@@ -177,7 +177,8 @@ def schedule(plan_: Plan, initial: State) -> tuple[list[Round], list[State]]:
     """Rounds of independent operators of different arms, and the state after each round.
 
     Operator ``j`` depends on an earlier ``i`` when they share an arm or a moved object,
-    ``i`` adds a fact ``j`` needs, or either deletes a fact the other needs. Each operator goes to the round after its latest
+    ``i`` adds a fact ``j`` needs or deletes one that must not hold for ``j``, or either
+    deletes a fact the other needs. Each operator goes to the round after its latest
     dependency (as soon as possible); two operators share a round only when they have the
     same number of steps, so that their steps pair up. The rounds' order applied to the
     initial state is checked against the operators' preconditions.
@@ -188,6 +189,7 @@ def schedule(plan_: Plan, initial: State) -> tuple[list[Round], list[State]]:
             level[i]
             for i, other in enumerate(plan_.operators[:j])
             if set(op.arms) & set(other.arms) or set(op.objects) & set(other.objects) or other.add & op.pre or _interfere(other, op)
+            or _unblocks(other, op)
         ]
         level.append(max(deps) + 1 if deps else 0)
     rounds: list[Round] = []
@@ -212,6 +214,11 @@ def schedule(plan_: Plan, initial: State) -> tuple[list[Round], list[State]]:
             state = op.apply(state)
         states.append(state)
     return rounds, states
+
+
+def _unblocks(a: Operator, b: Operator) -> bool:
+    """Whether ``a`` deletes a fact that must not hold for ``b`` (the bottle untilted before the cup under it moves)."""
+    return any(_matches(p, f) for p in a.delete for f in b.pre_not)
 
 
 def _interfere(a: Operator, b: Operator) -> bool:

@@ -12,7 +12,7 @@ from __future__ import annotations
 from agentchord.agents.scene import Scene, SceneObject
 from agentchord.agents.rules import knowledge as kb
 from agentchord.agents.rules.constraints import rounded
-from agentchord.agents.rules.facts import ARMS, placed_key
+from agentchord.agents.rules.facts import ARMS, placed_key, poured_into
 from agentchord.agents.rules.goals import GoalSpec, HandedOver, Inside, On, Placed, Poured
 from agentchord.agents.rules.planner import Fact, Operator
 from agentchord.robot.aloha import other_arm
@@ -59,12 +59,13 @@ def ground(scene: Scene, goal: GoalSpec) -> list[Operator]:
         if isinstance(g, HandedOver):
             ops += _handover_ops(g)
     levelled = {op.arms[0] for op in ops if op.name.startswith("untilt(")}
+    under = poured_into(scene)
     for arm in sorted(set(ARMS) - levelled):
         # An object seen tipped in the hand (a re-plan in the middle of a pour) is levelled first.
         ops.append(
             Operator(
                 name=f"untilt({arm})", arms=(arm,), objects=(), pre=frozenset({("tilted", arm)}),
-                add=frozenset(), delete=frozenset({("tilted", arm)}), cost=80,
+                add=frozenset(), delete=frozenset({("tilted", arm)} | {("under_pour", c) for c in under.get(arm, [])}), cost=80,
                 steps=({arm: _call("rotate_eef", angle=-kb.POUR_TILT)},), semantic="The held object upright again.", skill="pour",
             )
         )
