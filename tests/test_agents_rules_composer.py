@@ -105,3 +105,30 @@ def test_a_re_plan_in_the_middle_of_a_pour_untilts_before_the_cup_under_the_bott
     steps = fns(compose(goal, mid_pour).graph)
     # Untilted alone first: not while the cup moves from under it in the same step.
     assert steps[0] == [("right", "rotate_eef")] and [("left", "place"), ("right", "place")] in steps[1:]
+
+
+def _mid_handover(grip_height: float, holder: str = "left"):
+    scene = scene_of("handover_block")
+    block = next(o for o in scene.objects if o.name == "block")
+    up = block.model_copy(update={"pos": (0.0, 0.5, 0.3), "axis": (0.0, 0.0, 1.0)})
+    bottom = 0.3 - 0.5 * block.extent[2]
+    ee = (0.0, 0.5, bottom + grip_height * block.extent[2])
+    arms = [a.model_copy(update={"holding": "block", "home": False, "closed": True, "ee": ee}) if a.name == holder else a
+            for a in scene.arms]
+    return scene.model_copy(update={"objects": [up if o.name == "block" else o for o in scene.objects], "arms": arms})
+
+
+def test_a_re_plan_with_the_givers_grip_low_takes_the_bar_high_before_it_is_offered():
+    goal = GoalSpec.model_validate({"goals": [{"kind": "handed_over", "obj": "block", "giver": "left", "receiver": "right"},
+                                              {"kind": "placed", "obj": "block", "region": "target", "arm": "right"}]})
+    low = fns(compose(goal, _mid_handover(0.5)).graph)
+    assert low[:2] == [[("left", "place")], [("left", "grasp")]]
+    assert fns(compose(goal, _mid_handover(0.85)).graph)[0] == [("left", "move_to_target")]
+
+
+def test_a_re_plan_hands_over_what_the_other_arm_is_to_put_down():
+    # The handover done, the bar back in the giver's hand (taken again after a drop): only the place is left.
+    goal = GoalSpec.model_validate({"goals": [{"kind": "placed", "obj": "block", "region": "target", "arm": "right"}]})
+    steps = fns(compose(goal, _mid_handover(0.85)).graph)
+    grasp = next(i for i, step in enumerate(steps) if ("right", "grasp") in step)
+    assert grasp < next(i for i, step in enumerate(steps) if ("right", "place") in step)

@@ -10,6 +10,7 @@ Facts (tuples of strings):
 - ``presented a c``: a container held up to be poured into;
 - ``pour_ready a s c`` / ``tilted a``; ``poured s c MODE`` (``table`` or ``held``);
   ``under_pour c``: a vessel is tilted over container ``c`` (it is not moved until upright again);
+- ``grip_low a``: arm ``a``, still to hand its object over, holds it standing but low;
 - ``handover_ready a o``; ``handed o GIVER RECEIVER``; ``over a corner``.
 
 The skills that make them true or false are in :mod:`~agentchord.agents.rules.skills`; the
@@ -20,7 +21,7 @@ from __future__ import annotations
 
 import math
 
-from agentchord.agents.scene import Scene, SceneObject
+from agentchord.agents.scene import ArmState, Scene, SceneObject
 from agentchord.agents.rules import knowledge as kb
 from agentchord.agents.rules.goals import Folded, GoalSpec, HandedOver, Inside, On, Placed, Poured
 from agentchord.agents.rules.planner import Fact
@@ -52,6 +53,8 @@ def initial_state(scene: Scene, goal: GoalSpec | None = None) -> frozenset[Fact]
                 if obj.axis[2] < HELD_TILTED_Z:
                     facts.add(("tilted", arm))
                     facts |= {("under_pour", c) for c in poured_into(scene).get(arm, [])}
+            if goal is not None and obj is not None and _gives_low(holder, obj, goal):
+                facts.add(("grip_low", arm))
         else:
             facts.add(("free", arm))
             if holder is None or holder.home:
@@ -73,6 +76,15 @@ def initial_state(scene: Scene, goal: GoalSpec | None = None) -> frozenset[Fact]
 HELD_TILTED_Z = 0.707
 #: How far (m) beyond a container's rim a tipped vessel's mouth may be and still pour into it.
 POUR_REACH = 0.05
+
+
+def _gives_low(holder: ArmState, obj: SceneObject, goal: GoalSpec) -> bool:
+    """Whether ``holder`` is still to hand ``obj`` over and holds it standing but low: the
+    receiver's fingers, taken low too, would find no room (a fallen bar taken by its middle)."""
+    gives = any(isinstance(g, HandedOver) and g.obj == obj.name and g.giver == holder.name for g in goal.goals)
+    standing = obj.axis[2] > math.cos(math.radians(30.0))
+    bottom = obj.pos[2] - 0.5 * obj.extent[2] * obj.axis[2]
+    return gives and standing and holder.ee[2] - bottom < kb.HANDOVER_GRIP_LOW * obj.extent[2]
 
 
 def poured_into(scene: Scene) -> dict[str, list[str]]:

@@ -53,11 +53,18 @@ def ground(scene: Scene, goal: GoalSpec) -> list[Operator]:
             ops += _one_arm_ops(arm, obj, scene, destinations.get(name, []), may_grasp, name in givers)
     for cloth in cloths:
         ops += _fold_ops(cloth, objects)
+    handed = set(givers)
+    held_by = {arm.holding: arm.name for arm in scene.arms if arm.holding}
     for g in goal.goals:
         if isinstance(g, Poured):
             ops += _pour_ops(g)
         if isinstance(g, HandedOver):
-            ops += _handover_ops(g)
+            ops += _handover_ops(g, objects.get(g.obj))
+        elif isinstance(g, (Placed, Inside, On)) and g.arm and held_by.get(g.obj, g.arm) != g.arm and g.obj not in handed:
+            # To be put down by the arm that does not hold it (a re-plan after the other arm took it
+            # back): it is handed over first.
+            handed.add(g.obj)
+            ops += _handover_ops(HandedOver(obj=g.obj, giver=held_by[g.obj], receiver=g.arm), objects.get(g.obj))
     levelled = {op.arms[0] for op in ops if op.name.startswith("untilt(")}
     under = poured_into(scene)
     for arm in sorted(set(ARMS) - levelled):
@@ -265,14 +272,22 @@ def _pour_ops(goal: Poured) -> list[Operator]:
     return ops
 
 
-def _handover_ops(goal: HandedOver) -> list[Operator]:
+def _handover_ops(goal: HandedOver, obj: SceneObject | None) -> list[Operator]:
     g, r, o = goal.giver, goal.receiver, goal.obj
     yaw_g, yaw_r = (0.0, 180.0) if g == "left" else (180.0, 0.0)
     retreat = [-kb.HANDOVER_RETREAT if g == "left" else kb.HANDOVER_RETREAT, 0.0, 0.03]
+    high = {**(_grasp_args(obj) if obj is not None else {"obj": o}), "height": kb.HANDOVER_GIVER_HEIGHT}
     return [
         Operator(
+            # Held low (a fallen bar taken by its middle, seen in a re-plan): set it down standing, take it high.
+            name=f"regrip({g}, {o})", arms=(g,), objects=(o,), pre=frozenset({("holding", g, o), ("grip_low", g)}),
+            add=frozenset(), delete=frozenset({("grip_low", g)}), cost=360,
+            steps=({g: _call("place", obj=o)}, {g: _call("grasp", **high)}),
+            semantic=f"The {o} held high by the {g} arm.", skill="regrip",
+        ),
+        Operator(
             name=f"offer({g}, {o})", arms=(g,), objects=(o,), pre=frozenset({("holding", g, o)}),
-            pre_not=frozenset({("handover_ready", g, o)}), add=frozenset({("handover_ready", g, o)}), cost=110,
+            pre_not=frozenset({("handover_ready", g, o), ("grip_low", g)}), add=frozenset({("handover_ready", g, o)}), cost=110,
             steps=({g: _call("move_to_target", pos=list(kb.HANDOVER_POSE), yaw=yaw_g)},),
             semantic=f"The {o} held up by the {g} arm at the handover pose.", skill="offer",
         ),
