@@ -87,7 +87,7 @@ def test_in_a_wide_host_is_its_footprint_in_its_own_frame_and_in_a_cup_a_disc():
     assert relation and relation[0].startswith("max(abs(local(tray, capsule.pos)[0])")
     tray = next(o for o in scene_of("setup_coffee_tray").objects if o.name == "tray")
     cup = tray.model_copy(update={"name": "cup", "extent": (0.08, 0.08, 0.1)})
-    assert over_footprint("block", cup) == "norm(xy(block.pos - cup.pos)) - 0.04"
+    assert over_footprint("block", cup) == "misaligned(block.pos, cup.pos, 0.04)"
 
 
 def test_a_re_plan_in_the_middle_of_a_pour_untilts_before_the_cup_under_the_bottle_moves():

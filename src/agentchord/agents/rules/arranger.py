@@ -51,7 +51,6 @@ MISPLACED_WINDOW = 10
 PLACED_TILT_DEG = 10.0
 
 
-
 def _mentions(observation: str, name: str) -> bool:
     """Whether the violated constraints of an observation name an object (``bottle.top``, ``tilt(bottle)``)."""
     return re.search(rf"(?<![\w.]){re.escape(name)}(?!\w)", observation) is not None
@@ -210,7 +209,7 @@ class Arranger:
             # Carried by two arms and lost by one, it hangs from the other: both let go (a grasp opens
             # first), so it lands flat, and both take it again.
             retake: Step = {a: regrasp(before, a, obj, tall, skip_if_held=len(at_s) < 2,
-                                         skip_if_placed=places_at_target(edge, a, obj)) for a in at_s}
+                                       skip_if_placed=places_at_target(edge, a, obj)) for a in at_s}
             # An arm of this edge with empty hands gets out of the way while the object is taken again.
             retake.update({a: ActionCall(fn="back") for a in busy if a not in at_s and before[a].holding is None})
             steps = [retake, *replay_then_edge(before, edge, at_s or busy, regrasped=True)]
@@ -265,17 +264,9 @@ class Arranger:
             steps.append({a: regrasp(before, a, host) for a in holders})
             steps += side_by_side({a: before[a].since_grasp for a in holders if before[a].since_grasp})
             recovery = Edge(id=f"{edge.id}_r_{obj}_out", source=edge.source, target=edge.source, kind="recovery", actions=steps)
-            mode = FailureMode(name=f"{obj}_out", monitor=self._out_of(obj, host), window=kb.WINDOW, intent="re-place", recovery=recovery.id)
+            mode = FailureMode(name=f"{obj}_out", monitor=over_footprint(obj, self.objects[host]), window=kb.WINDOW, intent="re-place", recovery=recovery.id)
             out.append((mode, recovery))
         return out
-
-    def _out_of(self, obj: str, host: str) -> str:
-        """Monitor of ``obj`` fallen out of (or off) the carried ``host``: beyond its footprint."""
-        info = self.objects[host]
-        if kb.is_wide(info):
-            return over_footprint(obj, info)
-        # Eq. 19's relational template over the disc the host's shorter side spans.
-        return f"misaligned({obj}.pos, {host}.pos, {round(0.5 * min(info.extent[0], info.extent[1]), 3):g})"
 
     def _monitor_recoveries(self, graph: TaskGraph) -> None:
         """Drop monitors on recovery edges: a second drop re-enters that object's recovery from the same context.

@@ -6,11 +6,22 @@ The composer writes, at each node, the constraints of the facts that hold there
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterable
 
 from agentchord.agents.scene import Scene, SceneObject
 from agentchord.agents.rules import knowledge as kb
 from agentchord.agents.rules.planner import Fact
+
+
+#: An upright bound, ``tilt(obj) - X`` (X in degrees), matched with its spaces removed.
+_UPRIGHT = re.compile(r"tilt\((\w+)\)-(\d+(?:\.\d+)?)")
+
+
+def upright_bound(constraint: str) -> tuple[str, float] | None:
+    """``(obj, X)`` of an upright bound ``tilt(obj) - X`` (X in degrees), else ``None``."""
+    match = _UPRIGHT.fullmatch("".join(constraint.split()))
+    return (match.group(1), float(match.group(2))) if match else None
 
 
 def rounded(values: Iterable[float]) -> list[float]:
@@ -88,14 +99,15 @@ def _at_constraints(name: str, key: str, objects: dict[str, SceneObject], scene:
 def over_footprint(name: str, host: SceneObject) -> str:
     """<= 0 while ``name``'s centre lies over ``host``'s footprint (released in it or on it).
 
-    A round or small host's footprint is the disc its shorter side spans. A wide one (carried by
+    A round or small host's footprint is the disc its shorter side spans (Eq. 19's relational
+    misalignment). A wide one (carried by
     both arms by its ends) is long: its footprint is a rectangle in its own frame, less the
     handles at its ends. The disc would read a capsule slid along a tray, still inside it, as out
     (planned coffee tray, real protocol, seed 2: 6.7 cm from the centre of a tray 23 cm long inside).
     """
     half = [0.5 * host.extent[0], 0.5 * host.extent[1]]
     if not kb.is_wide(host):
-        return f"norm(xy({name}.pos - {host.name}.pos)) - {round(min(half), 4):g}"
+        return f"misaligned({name}.pos, {host.name}.pos, {round(min(half), 4):g})"  # Eq. 19's template
     half[0 if half[0] >= half[1] else 1] -= 2 * kb.HANDLE_INSET
     x, y = rounded(half)
     return f"max(abs(local({host.name}, {name}.pos)[0]) - {x:g}, abs(local({host.name}, {name}.pos)[1]) - {y:g})"

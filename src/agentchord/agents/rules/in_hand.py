@@ -10,14 +10,12 @@ import re
 
 from agentchord.agents.rules import knowledge as kb
 from agentchord.agents.rules.accounts import ARMS, Account, calls_of, holders_of
+from agentchord.agents.rules.constraints import upright_bound
 from agentchord.agents.rules.recovery_steps import regrasp, replay_then_edge
 from agentchord.agents.scene import SceneObject
 from agentchord.graph.models import ActionCall, Edge, FailureMode, Step, TaskGraph
 from agentchord.graph.progress import nominal_path
 from agentchord.robot.aloha import other_arm
-
-#: An upright path constraint, ``tilt(obj) - X`` (X in degrees), matched with its spaces removed.
-_UPRIGHT_PATH = re.compile(r"tilt\((\w+)\)-(\d+(?:\.\d+)?)")
 
 #: A slipped-grasp monitor, ``holding(arm, obj) * tipped(obj, X)``, matched with its spaces removed.
 _SLIP_MONITOR = re.compile(r"holding\((left|right),(\w+)\)\*tipped\(\2,(\d+(?:\.\d+)?)\)")
@@ -87,10 +85,10 @@ def upright_in_hand(edge: Edge, before: Account, after: Account, objects: dict[s
     """
     out = []
     for constraint in edge.path_constraints:
-        match = _UPRIGHT_PATH.fullmatch("".join(constraint.split()))
-        if match is None:
+        bound = upright_bound(constraint)
+        if bound is None:
             continue
-        obj, limit = match.group(1), float(match.group(2))
+        obj, limit = bound
         info = objects.get(obj)
         holders = holders_of(before, obj)
         if info is None or not kb.is_tall(info) or len(holders) != 1 or holders_of(after, obj) != holders:

@@ -18,11 +18,11 @@ so starts that recovery again.
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 
 from agentchord.agents.rules import knowledge as kb
 from agentchord.agents.rules.accounts import ARMS, RELATIVE, Account, ArmAccount, apply_step, side_by_side
+from agentchord.agents.rules.constraints import upright_bound
 from agentchord.agents.scene import SceneObject
 from agentchord.graph.models import ActionCall, Edge, FailureMode, Step, TaskGraph
 from agentchord.graph.progress import nominal_path
@@ -79,6 +79,7 @@ def left_behind_branches(graph: TaskGraph, edge: Edge, objects: dict[str, SceneO
     if not is_retreat(edge):
         return []
     target = graph.node(edge.target).constraints
+    upright_bounds = dict(b for b in map(upright_bound, target) if b is not None)
     out: list[tuple[FailureMode, Edge | None]] = []
     for obj, by_arm in put_down_before(graph, edge).items():
         info = objects.get(obj)
@@ -86,7 +87,7 @@ def left_behind_branches(graph: TaskGraph, edge: Edge, objects: dict[str, SceneO
             continue
         modes: list[FailureMode] = []
         recovery = f"{edge.id}_r_{obj}_put_back"
-        bound = _upright_bound(target, obj)
+        bound = upright_bounds.get(obj)
         if kb.is_tall(info) and bound is not None:
             # Past the target's own bound, not only knocked flat: a bottle pushed against the cup as the
             # arm left leaned 17 deg there, and the goal failed with nothing left to run (planned
@@ -109,15 +110,6 @@ def left_behind_branches(graph: TaskGraph, edge: Edge, objects: dict[str, SceneO
         # One recovery edge for both modes: the arranger adds an edge once, with the first mode.
         out += [(mode, put_back if k == 0 else None) for k, mode in enumerate(modes)]
     return out
-
-
-def _upright_bound(constraints: list[str], obj: str) -> float | None:
-    """The bound X (deg) of the constraint ``tilt(obj) - X``, if one is there."""
-    for constraint in constraints:
-        match = re.fullmatch(rf"tilt\({re.escape(obj)}\)-(\d+(?:\.\d+)?)", "".join(constraint.split()))
-        if match:
-            return float(match.group(1))
-    return None
 
 
 def _names_another(constraint: str, obj: str, objects: dict[str, SceneObject]) -> bool:
