@@ -82,7 +82,7 @@ def _gives_low(holder: ArmState, obj: SceneObject, goal: GoalSpec) -> bool:
     """Whether ``holder`` is still to hand ``obj`` over and holds it standing but low: the
     receiver's fingers, taken low too, would find no room (a fallen bar taken by its middle)."""
     gives = any(isinstance(g, HandedOver) and g.obj == obj.name and g.giver == holder.name for g in goal.goals)
-    standing = obj.axis[2] > math.cos(math.radians(30.0))
+    standing = obj.axis[2] > math.cos(math.radians(kb.HANDOVER_STANDING_DEG))
     bottom = obj.pos[2] - 0.5 * obj.extent[2] * obj.axis[2]
     return gives and standing and holder.ee[2] - bottom < kb.HANDOVER_GRIP_LOW * obj.extent[2]
 

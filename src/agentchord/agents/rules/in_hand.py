@@ -71,8 +71,8 @@ def gripped_low(graph: TaskGraph, edge: Edge, before: Account) -> list[tuple[Fai
             continue
         if not any(c.fn == "grasp" and c.args.get("obj") == obj for e in later for c in calls_of(e, other_arm(arm))):
             continue  # not handed over from here on
-        # Only while the bar stands (within 30 deg): a bar lying in the hand has no high and low.
-        monitor = (f"holding({arm}, {obj}) * clip(30 - tilt({obj}), 0, 1) * "
+        # Only while the bar stands: a bar lying in the hand has no high and low.
+        monitor = (f"holding({arm}, {obj}) * clip({kb.HANDOVER_STANDING_DEG:g} - tilt({obj}), 0, 1) * "
                    f"({kb.HANDOVER_GRIP_LOW:g} * {obj}.extent[2] - ({arm}.ee[2] - {obj}.bottom[2]))")
         out.append(retaken(edge, before, arm, obj, f"{obj}_grip_low", monitor, "regrip high"))
     return out

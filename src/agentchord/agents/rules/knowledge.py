@@ -48,6 +48,8 @@ HANDOVER_GIVER_HEIGHT = 0.85
 HANDOVER_RECEIVER_HEIGHT = 0.2
 #: A giver's grip below this fraction of the bar's height leaves the receiver's fingers no room.
 HANDOVER_GRIP_LOW = 0.75
+#: ... judged only while the bar stands within this tilt (deg): lying in the hand it has no high and low.
+HANDOVER_STANDING_DEG = 30.0
 #: The giver's retreat after opening (m, along its own side of the table).
 HANDOVER_RETREAT = 0.10
 #: Clearance lift of a flat object before it is carried (m), and of a tray held by both arms.
