@@ -76,3 +76,43 @@ def test_a_scratch_solve_returns_the_joints_at_the_pose_asked_for():
         ik.reset(home)
         ik.set_arm_q("left", q)
         assert np.linalg.norm(ik.tcp_pose("left").pos - where) < 0.01
+
+
+def test_aimed_home_turns_only_the_waist_to_face_the_point():
+    from agentchord.robot.aloha import HOME_Q
+
+    ik = BimanualIK()
+    home = ik.configuration.q.copy()
+    # The left arm stands at x = -0.469 facing +x, the right one at x = +0.469 facing -x (both at y = 0.5).
+    cases = (("left", (0.0, 0.5), 0.0), ("left", (-0.469, 0.9), np.pi / 2), ("left", (-0.069, 0.1), -np.pi / 4),
+             ("right", (0.0, 0.5), 0.0), ("right", (0.469, 0.9), -np.pi / 2), ("right", (0.069, 0.9), -np.pi / 4))
+    for arm, (x, y), waist in cases:
+        point = np.array([x, y, 0.1])
+        q6 = ik.aimed_home(arm, point)
+        assert abs(q6[0] - waist) < 1e-3, (arm, x, y, q6[0])
+        assert np.allclose(q6[1:], HOME_Q[1:])
+        # The tool, seen from above, now lies on the line from the waist's axis to the point.
+        ik.reset(home)
+        ik.set_arm_q(arm, q6)
+        shoulder = np.array([-0.469 if arm == "left" else 0.469, 0.5])
+        to_tool, to_point = ik.tcp_pose(arm).pos[:2] - shoulder, point[:2] - shoulder
+        assert np.dot(to_tool, to_point) / np.linalg.norm(to_tool) / np.linalg.norm(to_point) > 0.9999
+
+
+def test_a_scratch_solve_aimed_at_the_pose_reaches_a_top_down_grasp_a_solve_from_home_stalls_on():
+    from agentchord.actions.controller import SCRATCH_IK_CONVERGED, SCRATCH_IK_ITERATIONS
+    from agentchord.actions.motion import pose_from_matrix
+    from agentchord.solvers.ik import solve_from_scratch
+    from agentchord.solvers.poses import top_down_rotation
+
+    ik = BimanualIK(iterations=SCRATCH_IK_ITERATIONS, converged_step=SCRATCH_IK_CONVERGED, avoid_arm_collisions=False)
+    home = ik.configuration.q.copy()
+    # 15 cm above the table, 37 cm from the left arm's waist: from home the solve swings the waist round.
+    pose = pose_from_matrix(np.array([-0.1, 0.7, 0.15]), top_down_rotation(np.array([1.0, 0.0, 0.0])))
+    ik.solve({"left": pose})
+    assert ik.residual("left", pose) > 0.1
+    q = solve_from_scratch(ik, home, "left", [pose])
+    assert q is not None
+    ik.reset(home)
+    ik.set_arm_q("left", q)
+    assert ik.residual("left", pose) < 0.01
