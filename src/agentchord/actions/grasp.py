@@ -18,6 +18,7 @@ import numpy as np
 from agentchord.actions import catalog
 from agentchord.actions.base import ActionFailed, ArmAction
 from agentchord.actions.controller import RobotController
+from agentchord.actions.drag_clear import drag_clear, plan_drag
 from agentchord.actions.finger_clearance import TopGraspChoice, clear_top_grasp, crossing_over, swept_hits
 from agentchord.actions.geometry import _matrix, _wrist_margin
 from agentchord.actions.in_hand import grasp_height_share
@@ -70,6 +71,18 @@ class HeldBackByOtherArm(GraspMissed):
     """The arm-arm collision limit held the arm back from the grasp: the other arm was in the way."""
 
 
+class FingersBlocked(ActionFailed):
+    """A top grasp's open fingers came down on a neighbour the object is pressed against.
+
+    Attributes:
+        blocked_by: The neighbours the fingers came down on.
+    """
+
+    def __init__(self, message: str, blocked_by: tuple[str, ...]) -> None:
+        super().__init__(message)
+        self.blocked_by = blocked_by
+
+
 class Grasp(ArmAction):
     """Grasp an object wherever it is, then lift it; a fallen object is set upright in hand.
 
@@ -89,6 +102,9 @@ class Grasp(ArmAction):
     LEANING_AS_FALLEN_DEG = 40.0
     #: Tries before a grasp that closes on nothing fails.
     ATTEMPTS = 3
+    #: Drags of an object pressed against a neighbour (:mod:`~agentchord.actions.drag_clear`) before
+    #: a grasp whose fingers still come down on it fails: the first may leave it short (slipping).
+    DRAGS = 2
     #: Objects shorter than this (m) are grasped from above in ``auto`` mode.
     SIDE_MIN_HEIGHT = 0.08
     #: The empty hand goes over a fallen object, on the unflipped wrist branch, this far (m) above the pre-grasp.
@@ -123,13 +139,20 @@ class Grasp(ArmAction):
             return
         made_way = False
         # Tries are counted apart: an arm held back by the other one has not yet been at the object.
-        misses = held_back = 0
+        misses = held_back = drags = 0
         while True:
             try:
                 yield from self._let_go(robot)
                 yield from wait_for_rest(robot, self.args.obj)
                 yield from self._attempt(robot)
                 return
+            except FingersBlocked as blocked:
+                # Pressed against a neighbour no slide or turn clears: drag it away and look again.
+                plan = plan_drag(robot.frame, self.args.obj, blocked.blocked_by) if drags < self.DRAGS else None
+                if plan is None:
+                    raise
+                drags += 1
+                yield from drag_clear(robot, self.arm, plan, self.args.obj)
             except HeldBackByOtherArm:
                 held_back += 1
                 if held_back == self.ATTEMPTS:
@@ -296,9 +319,9 @@ class Grasp(ArmAction):
                     ) from None
             if blocked:
                 short = float(np.linalg.norm(robot.frame.arms[self.arm].ee - robot.commanded_pose(self.arm).pos))
-                raise ActionFailed(
+                raise FingersBlocked(
                     f"the open fingers came down on {' and '.join(blocked)} beside {self.args.obj}: "
-                    f"the tool stopped {100 * short:.1f} cm short of the grasp"
+                    f"the tool stopped {100 * short:.1f} cm short of the grasp", blocked,
                 ) from None
             raise
         aimed = robot.commanded_pose(self.arm).pos.copy()
