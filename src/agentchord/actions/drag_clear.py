@@ -26,7 +26,7 @@ from agentchord.actions.finger_clearance import (
     FINGER_SPAN_DOWN,
     ROUND_SHARE,
     SHORT_RATIO,
-    _neighbours_hit,
+    neighbours_hit,
     clear_top_grasp,
     horizontal_sizes,
     open_finger_points,
@@ -169,11 +169,11 @@ def plan_drag(frame: FeatureFrame, obj: str, blockers: tuple[str, ...]) -> DragP
     press[2] = _top(feats) - PRESS_DEPTH + FINGER_SPAN_DOWN[1]  # the tips reach this far below the tool centre
     tip = feats.pos + tip_offset * away
     tip[2] = press[2] - FINGER_SPAN_DOWN[1]
-    if _neighbours_hit(frame, obj, _tip_points(tip, rotation), 0.0):
+    if neighbours_hit(frame, obj, _tip_points(tip, rotation), 0.0):
         return None  # the tip would come down on something else
     for length in DRAG_LENGTHS:
         sweep = [open_finger_points(press + s * length * away, rotation) for s in np.linspace(0.0, 1.0, DRAG_SAMPLES)]
-        if _neighbours_hit(frame, obj, np.vstack(sweep), 0.0).keys() - set(blockers):
+        if neighbours_hit(frame, obj, np.vstack(sweep), 0.0).keys() - set(blockers):
             return None  # the hand would drag into something on the way (it leaves the blockers)
         moved = _moved(frame, obj, length * away)
         long_dir, point = plain_top_grasp(moved.objects[obj])

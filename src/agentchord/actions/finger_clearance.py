@@ -119,7 +119,7 @@ def _inside(feats: ObjectFeatures, points: np.ndarray, clearance: float = CLEARA
 def blocking(frame: FeatureFrame, obj: str, point: np.ndarray, long_dir: np.ndarray) -> dict[str, int]:
     """The neighbours of ``obj`` that the open fingers of a top grasp at ``point`` come down on,
     with how many of the fingers' sample points lie in each."""
-    return _neighbours_hit(frame, obj, finger_points(point, long_dir), CLEARANCE)
+    return neighbours_hit(frame, obj, finger_points(point, long_dir), CLEARANCE)
 
 
 def side_approach_blocking(
@@ -134,7 +134,7 @@ def side_approach_blocking(
     """
     steps = max(2, int(np.ceil(float(np.linalg.norm(point - pre)) / SWEEP_STEP)) + 1)
     points = np.vstack([open_finger_points(pre + s * (point - pre), rotation) for s in np.linspace(0.0, 1.0, steps)])
-    return _neighbours_hit(frame, obj, points, 0.0)
+    return neighbours_hit(frame, obj, points, 0.0)
 
 
 def swept_hits(
@@ -147,9 +147,9 @@ def swept_hits(
     ``held_radius`` of those points)."""
     hits: dict[str, int] = {}
     for point, rotation in tool_poses:
-        found = [_neighbours_hit(frame, obj, open_finger_points(point, rotation), 0.0)]
+        found = [neighbours_hit(frame, obj, open_finger_points(point, rotation), 0.0)]
         if held is not None and len(held):
-            found.append(_neighbours_hit(frame, obj, point + held @ rotation.T, held_radius))
+            found.append(neighbours_hit(frame, obj, point + held @ rotation.T, held_radius))
         for part in found:
             for name, count in part.items():
                 hits[name] = hits.get(name, 0) + count
@@ -194,7 +194,7 @@ def crossing_over(frame: FeatureFrame, obj: str, start: PoseTarget, goal: PoseTa
     return None
 
 
-def _neighbours_hit(frame: FeatureFrame, obj: str | None, points: np.ndarray, clearance: float) -> dict[str, int]:
+def neighbours_hit(frame: FeatureFrame, obj: str | None, points: np.ndarray, clearance: float) -> dict[str, int]:
     """How many of ``points`` lie within ``clearance`` of each neighbour of ``obj`` (of every object
     where None).
 
