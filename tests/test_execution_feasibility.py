@@ -86,3 +86,29 @@ def test_a_hand_pinching_one_corner_of_the_cloth_is_free_for_another_and_a_rigid
     robot.frame.holding = {("left", "cup")}
     assert not FeasibilityChecker(robot).check_grasp(Grasp("left", GraspArgs(obj="cup"))).reason  # its own object: free
     assert "holds cup" in FeasibilityChecker(robot).check_grasp(Grasp("left", GraspArgs(obj="bottle"))).reason
+
+
+def test_an_arm_holding_the_object_does_not_make_way_for_its_grasp_unless_it_lets_go_first():
+    # Single-arm pour under drops, DoReMi's seed 6: the bottle rode home on the right arm's open
+    # fingers; a left-arm grasp of it there, beside the right hand, is checked clear of the right arm,
+    # even though the right arm moves in the same step (it takes the bottle along).
+    from types import SimpleNamespace
+
+    from agentchord.actions.library import make_action
+    from agentchord.execution.feasibility import releases_first
+
+    robot = _robot()
+    checker = FeasibilityChecker(robot)
+    grasp = make_action("grasp", "left", {"obj": "bottle"})
+    together = SimpleNamespace(steps=[[grasp, make_action("back", "right", {})]])
+    let_go = SimpleNamespace(steps=[[make_action("open_gripper", "right", {})], [grasp, make_action("back", "right", {})]])
+    alone = SimpleNamespace(steps=[[grasp]])
+    assert not releases_first(together, grasp, "right") and releases_first(let_go, grasp, "right")
+    robot.frame.holding = set()
+    assert not checker._other_arm_stays(together, grasp)  # the right arm, empty-handed, may move away
+    assert checker._other_arm_stays(alone, grasp)
+    robot.frame.holding = {("right", "bottle")}
+    assert checker._other_arm_stays(together, grasp)
+    assert not checker._other_arm_stays(let_go, grasp)
+    robot.frame.holding = {("right", "cup")}
+    assert not checker._other_arm_stays(together, grasp)  # it holds something else: it moves away with it
