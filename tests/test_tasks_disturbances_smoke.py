@@ -129,12 +129,20 @@ def test_an_arm_that_falls_short_of_a_pushed_object_is_not_blamed_on_the_other_a
 
 
 def test_fingers_that_come_down_on_a_neighbour_are_named_in_the_reason(monkeypatch):
-    # The same grasp, its fingers known to overlap the plate and no clear one chosen: the reason
-    # says what they came down on.
+    # The same grasp, its fingers known to overlap the plate and no clear one chosen, nor a drag of
+    # the fork away from the plate: the reason says what they came down on.
     _top_grasps_at_the_centre(monkeypatch, report_blocked=True)
+    monkeypatch.setattr("agentchord.actions.grasp.Grasp.DRAGS", 0)
     result = run_episode(EpisodeSpec("rearrange_table", seed=86, protocol=True, disturb=KINDS))
     assert not result.success
     assert "the open fingers came down on plate beside fork" in result.reason
+
+
+def test_a_fork_the_fingers_come_down_beside_is_dragged_off_the_plate_and_taken(monkeypatch):
+    # The same again with the drag (actions/drag_clear.py): the fork is dragged clear and taken.
+    _top_grasps_at_the_centre(monkeypatch, report_blocked=True)
+    result = run_episode(EpisodeSpec("rearrange_table", seed=86, protocol=True, disturb=KINDS))
+    assert result.success, result.reason
 
 
 class _Both:
