@@ -140,8 +140,9 @@ def plan_drag(frame: FeatureFrame, obj: str, blockers: tuple[str, ...]) -> DragP
         blockers: The neighbours its open fingers come down on.
 
     Returns:
-        The plan; None where no direction away is known, the pressing hand's fingers would land on
-        something, or no drag of :data:`DRAG_LENGTHS` clears the grasp.
+        The plan; None where no direction away is known, the pressing tip would come down on
+        something else, the hand would sweep into something on the way, or no drag of
+        :data:`DRAG_LENGTHS` clears the grasp.
     """
     feats = frame.objects[obj]
     directions = [d for d in (_away_from(feats, frame.objects[b]) for b in blockers if b in frame.objects) if d is not None]
