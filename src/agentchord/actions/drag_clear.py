@@ -24,11 +24,11 @@ from agentchord.actions.controller import RobotController
 from agentchord.actions.finger_clearance import (
     FINGER_ACROSS,
     FINGER_SPAN_DOWN,
-    ROUND_SHARE,
     SHORT_RATIO,
     neighbours_hit,
     clear_top_grasp,
     horizontal_sizes,
+    is_round,
     open_finger_points,
     swept_hits,
 )
@@ -89,11 +89,10 @@ def _away_from(feats: ObjectFeatures, neighbour: ObjectFeatures) -> np.ndarray |
     local = (feats.pos - neighbour.pos) @ _matrix(neighbour.quat)
     half = 0.5 * np.asarray(neighbour.extent, dtype=float)
     nearest = np.clip(local, -half, half)
-    ex, ey = float(neighbour.extent[0]), float(neighbour.extent[1])
-    if abs(ex - ey) <= ROUND_SHARE * max(ex, ey, 1e-9):  # round: the nearest point of its circle
+    if is_round(neighbour):  # the nearest point of its circle
         radial = np.hypot(local[0], local[1])
         if radial > 1e-9:
-            nearest[:2] = local[:2] * min(1.0, 0.5 * max(ex, ey) / radial)
+            nearest[:2] = local[:2] * min(1.0, 0.5 * float(max(neighbour.extent[:2])) / radial)
     direction = (_matrix(neighbour.quat) @ (local - nearest))[:2]
     norm = float(np.linalg.norm(direction))
     return None if norm < 1e-6 else np.r_[direction / norm, 0.0]
@@ -104,7 +103,7 @@ def _chord(feats: ObjectFeatures, direction: np.ndarray) -> float:
     sides (its oriented box, or its circle when round, seen from above)."""
     local = np.abs(direction @ _matrix(feats.quat))[:2]
     extent = np.asarray(feats.extent, dtype=float)[:2]
-    if abs(extent[0] - extent[1]) <= ROUND_SHARE * max(extent[0], extent[1], 1e-9):
+    if is_round(feats):
         return float(max(extent))
     return float(min(extent[i] / local[i] for i in (0, 1) if local[i] > 1e-9))
 
@@ -163,7 +162,7 @@ def plan_drag(frame: FeatureFrame, obj: str, blockers: tuple[str, ...]) -> DragP
     # The pressing finger's tip (its inner edge) near the object's edge on the neighbour's side: the
     # press then holds the object down against the drag's tipping moment. Pressed on its centre line,
     # a fork 1.6 cm wide and 1.1 cm thick rolled onto its edge instead of sliding (planned rearrange,
-    # stress seed 2: 2 mm from its edge it slid 4 cm; 3-5 mm from it, it rolled). Forks and spoons
+    # stress seed 2: pressed 2-3 mm from its edge it slid 4 cm; 4-5 mm from it, it rolled). Forks and spoons
     # pressed against the plate, 7 places x 4 scenes: all 28 taken after the drag, 26 still flat.
     tip_offset = min(0.0, -0.5 * _chord(feats, away) + EDGE_MARGIN + 0.5 * TIP_THICKNESS)
     press = feats.pos + (tip_offset + FINGER_ACROSS[0] + 0.5 * TIP_THICKNESS) * away

@@ -105,13 +105,19 @@ def finger_points(point: np.ndarray, long_dir: np.ndarray) -> np.ndarray:
     return open_finger_points(point, top_down_rotation(long_dir))
 
 
+def is_round(feats: ObjectFeatures) -> bool:
+    """Whether an object reads as round seen from above (a cylinder: its horizontal sides within
+    :data:`ROUND_SHARE` of each other)."""
+    ex, ey = float(feats.extent[0]), float(feats.extent[1])
+    return abs(ex - ey) <= ROUND_SHARE * max(ex, ey, 1e-9)
+
+
 def _inside(feats: ObjectFeatures, points: np.ndarray, clearance: float = CLEARANCE) -> np.ndarray:
     """Which points lie within ``clearance`` of an object: its oriented box, or its cylinder when round."""
     local = (points - feats.pos) @ _matrix(feats.quat)
     half = 0.5 * np.asarray(feats.extent, dtype=float) + clearance
-    ex, ey = float(feats.extent[0]), float(feats.extent[1])
-    if abs(ex - ey) <= ROUND_SHARE * max(ex, ey, 1e-9):
-        radius = 0.5 * max(ex, ey) + clearance
+    if is_round(feats):
+        radius = 0.5 * float(max(feats.extent[0], feats.extent[1])) + clearance
         return (np.hypot(local[:, 0], local[:, 1]) <= radius) & (np.abs(local[:, 2]) <= half[2])
     return np.all(np.abs(local) <= half, axis=1)
 

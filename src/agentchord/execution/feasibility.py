@@ -101,25 +101,25 @@ def first_grasps(program: EdgeProgram) -> list[Grasp]:
     return grasps
 
 
-def releases_first(program: EdgeProgram, grasp: Grasp, arm: str) -> bool:
-    """Whether ``arm`` lets go of what it holds (opens, sets it down, or goes home, which opens the
-    hand) in a step before ``grasp``'s."""
+def _acts_before(program: EdgeProgram, grasp: Grasp, arm: str, names: tuple[str, ...]) -> bool:
+    """Whether ``arm`` runs one of the actions ``names`` in a step before ``grasp``'s."""
     for step in program.steps:
         if grasp in step:
             return False
-        if any(action.arm == arm and action.name in FREEING_ACTIONS for action in step):
+        if any(action.arm == arm and action.name in names for action in step):
             return True
     return False
+
+
+def releases_first(program: EdgeProgram, grasp: Grasp, arm: str) -> bool:
+    """Whether ``arm`` lets go of what it holds (opens, sets it down, or goes home, which opens the
+    hand) in a step before ``grasp``'s."""
+    return _acts_before(program, grasp, arm, FREEING_ACTIONS)
 
 
 def places_first(program: EdgeProgram, grasp: Grasp) -> bool:
     """Whether ``grasp``'s arm sets an object down earlier in the program (its hand is freed for it)."""
-    for step in program.steps:
-        if grasp in step:
-            return False
-        if any(action.arm == grasp.arm and action.name == "place" for action in step):
-            return True
-    return False
+    return _acts_before(program, grasp, grasp.arm, ("place",))
 
 
 class FeasibilityChecker:
