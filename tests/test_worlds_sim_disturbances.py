@@ -1,5 +1,6 @@
 """Seeded disturbances: every kind happens, and schedules are the same for two strategies."""
 
+import numpy as np
 import pytest
 
 from agentchord.actions.library import make_action
@@ -178,3 +179,22 @@ def test_a_perturb_pushes_an_object_at_rest_or_in_the_other_hand_never_one_in_th
     frame = extractor.update()
     frame.holding = {("left", "bottle")}  # ... unless the other hand holds it (a hand-over)
     assert inject("perturb", world, frame, rng, "right", grasp) is not None
+
+
+def test_a_pulled_bottle_is_carried_over_the_cup_and_the_regrasp_reaches_over_it_too():
+    # Set down beyond the cup: a straight carry swept the bottle through the cup (stress, p = 0.3,
+    # single-arm pour seed 4), and the right hand's straight reach for it struck the cup's rim.
+    cup_moved = []
+
+    def watch(executor):
+        pos, rotation = executor.world.object_pose("cup")
+        if not cup_moved:
+            cup_moved.append(pos.copy())
+        elif rotation[2, 2] < 0.95 or np.linalg.norm(pos[:2] - cup_moved[0][:2]) > 0.01:
+            cup_moved.append(executor.world.tick)
+
+    pull = ScriptedDisturbance("move_to_obj", "pull", after=15, seed=1, spot=(-0.25, 0.7), lying=False)
+    result = run_episode(EpisodeSpec(TASK, seed=1, disturbance=pull), on_tick=watch)
+    assert result.trace.of("disturbance")[0]["kind"] == "pull"
+    assert result.success, result.reason
+    assert cup_moved[1:] == []  # the cup never moved or tipped

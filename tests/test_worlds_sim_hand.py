@@ -96,3 +96,21 @@ def test_a_gripper_that_never_stops_is_waited_for_at_most_the_stated_time():
         elapsed += dt
     assert hand.done
     assert abs(elapsed - (hand.duration + MAX_CLEAR_HOLD_S)) < 0.01
+
+
+def test_a_carry_with_something_in_the_way_lifts_over_it_and_one_without_goes_straight():
+    from agentchord.worlds.sim.hand import RISE_S
+
+    pos, start = np.array([0.1, 0.5, 0.1]), Rotation.identity()
+    args = (pos, start, np.array([0.0, 1.0, 0.0]), np.array([-0.2, 0.7]), 0.05, Rotation.identity())
+    straight = set_down_path(*args)
+    assert [w.seconds for w in straight] == [0.3, 0.9, 0.3, 0.3]
+    # Lower than both ends of the carry: nothing changes.
+    assert [tuple(w.pos) for w in set_down_path(*args, over=0.09)] == [tuple(w.pos) for w in straight]
+    lifted = set_down_path(*args, over=0.25)
+    assert len(lifted) == len(straight) + 2
+    up, across, down = lifted[1:4]
+    assert np.allclose(up.pos, [straight[0].pos[0], straight[0].pos[1], 0.25]) and up.seconds == RISE_S
+    assert np.allclose(across.pos, [-0.2, 0.7, 0.25])
+    assert np.allclose(down.pos, straight[1].pos)  # then down over the spot, as before
+    assert np.allclose(lifted[-1].pos, straight[-1].pos)

@@ -380,6 +380,8 @@ class Grasp(ArmAction):
         if np.linalg.norm(robot.commanded_pose(arm).pos[:2] - pre[:2]) > 0.05:
             yield from self._clear_from_below(robot, pre[2] + 0.08)
         yield from self._pass_over(robot, pre, rotation)
+        # Reaching across a cup for a bottle set down beyond it, the fingers struck the cup's rim.
+        yield from self._cross_over(robot, pose_from_matrix(pre, rotation))
         yield from approach(robot, arm, pose_from_matrix(pre, rotation), then=pose_from_matrix(point, rotation), clear=self._fingers_clear(robot))
         self._still_standing(robot, "during the approach")
         # Re-observe: the object may have moved while the arm approached.
@@ -450,6 +452,7 @@ class Grasp(ArmAction):
         rotation, point = self._top_frame(robot)
         above = point + np.array([0.0, 0.0, self.args.pre_grasp_dis])
         yield from self._clear_from_below(robot, above[2])
+        yield from self._cross_over(robot, pose_from_matrix(above, rotation))
         yield from approach(robot, arm, pose_from_matrix(above, rotation), then=pose_from_matrix(point, rotation), clear=self._fingers_clear(robot))
         # A top-down tool often flips the forearm roll: let the IK converge before descending.
         yield from self._reach_above(robot)

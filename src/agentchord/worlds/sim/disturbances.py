@@ -66,6 +66,8 @@ SET_DOWN_AREA = ((-0.32, 0.32), (0.28, 0.85))
 SET_DOWN_BASE_CLEARANCE = 0.30
 SET_DOWN_WORKSPACE = (0.36, 0.62)
 SET_DOWN_OBJECT_CLEARANCE = 0.03
+#: A person carries a pulled object this far (m) clear of what stands in its way, above and beside.
+CARRY_PASS_CLEARANCE = 0.02
 #: Share of tall objects (a bottle) a person sets down on their side rather than upright.
 LYING_SHARE = 0.3
 #: A perturbation pushes the object being grasped this far (m), a shift this far.
@@ -198,7 +200,37 @@ def _take_and_set_down(world: SimWorld, frame: FeatureFrame, obj: str, arm: str,
         rest, height = yaw, 0.5 * spec.height
     # Out of the fingers entirely: a fork taken out of a top grasp slides along its length.
     distance = max(PULL_OUT_DISTANCE, _half_extent_along(spec, matrix, out) + PULL_OUT_MARGIN)
-    world.hand_carry(obj, set_down_path(pos, Rotation.from_matrix(matrix), out, spot, height, rest, distance), out_of=arm)
+    over = _carry_height(world, frame, obj, pos[:2] + distance * out[:2], spot)
+    path = set_down_path(pos, Rotation.from_matrix(matrix), out, spot, height, rest, distance, over=over)
+    world.hand_carry(obj, path, out_of=arm)
+
+
+def _carry_height(world: SimWorld, frame: FeatureFrame, obj: str, start: np.ndarray, spot: np.ndarray) -> float | None:
+    """The height (m) ``obj``'s centre must keep to pass over what stands on the table between
+    ``start`` and ``spot`` (x, y), turning as it goes; None when nothing stands in the way.
+
+    Objects the robot holds are up in the air with it and are left out.
+    """
+    spec = world.object_spec(obj)
+    # Its half diagonal (a cylinder's: radius and half height), reached whichever way it turns.
+    reach = float(np.linalg.norm(spec.size[:2] if spec.shape == "cylinder" else spec.size[:3]))
+    held = {name for _, name in frame.holding}
+    tops = []
+    for name in world.object_names:
+        if name == obj or name in held:
+            continue
+        other = world.object_spec(name)
+        other_pos, other_matrix = world.object_pose(name)
+        if _distance_to_segment(other_pos[:2], start, spot) < _footprint(other) + reach + CARRY_PASS_CLEARANCE:
+            tops.append(other_pos[2] + _half_extent_along(other, other_matrix, np.array([0.0, 0.0, 1.0])))
+    return max(tops) + reach + CARRY_PASS_CLEARANCE if tops else None
+
+
+def _distance_to_segment(point: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
+    """Distance (m) from ``point`` to the segment ``a``-``b`` (all x, y)."""
+    ab = b - a
+    t = float(np.clip((point - a) @ ab / max(float(ab @ ab), 1e-12), 0.0, 1.0))
+    return float(np.linalg.norm(point - (a + t * ab)))
 
 
 def _half_extent_along(spec, matrix: np.ndarray, direction: np.ndarray) -> float:

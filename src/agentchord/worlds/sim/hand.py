@@ -29,6 +29,8 @@ MAX_ACCEL = 30.0
 MAX_ANGULAR_ACCEL = 150.0
 #: Seconds of each phase: out of the fingers, carried over the spot, lowered, held still before letting go.
 OUT_S, CARRY_S, LOWER_S, HOLD_S = 0.3, 0.9, 0.3, 0.3
+#: Seconds to lift the object over things in the way before the carry, and to bring it down after.
+RISE_S = 0.3
 #: Height (m) the object's resting pose is carried above before it is lowered, and released above.
 CARRY_CLEARANCE = 0.05
 RELEASE_CLEARANCE = 0.001
@@ -169,6 +171,7 @@ def set_down_path(
     rest_height: float,
     rest_rotation: Rotation,
     out_distance: float = 0.10,
+    over: float | None = None,
 ) -> list[Waypoint]:
     """Waypoints of a take-and-set-down: out of the fingers along ``out_dir``, over ``spot``, down.
 
@@ -181,13 +184,26 @@ def set_down_path(
         rest_rotation: Orientation it is set down in (upright or on its side).
         out_distance: How far (m) it slides out of the fingers (a long object, taken out along
             its length, needs more than its half length).
+        over: Height (m) the object's centre must keep while it crosses to the spot, where
+            something stands in the way (None: nothing does). Above both ends of the carry, the
+            hand lifts it first, carries it across at that height and brings it down over the spot.
     """
     out = pos + out_distance * out_dir + np.array([0.0, 0.0, 0.03])
     above = np.array([spot[0], spot[1], rest_height + CARRY_CLEARANCE])
     down = np.array([spot[0], spot[1], rest_height + RELEASE_CLEARANCE])
+    carry = [Waypoint(above, rest_rotation, CARRY_S)]
+    if over is not None and over > min(out[2], above[2]):
+        # A person lifts a bottle over the cup rather than sweeping it through (stress, p = 0.3,
+        # single-arm pour seed 4: the straight carry knocked the cup over).
+        lift = max(over, out[2], above[2])
+        carry = [
+            Waypoint(np.array([out[0], out[1], lift]), rotation, RISE_S),
+            Waypoint(np.array([spot[0], spot[1], lift]), rest_rotation, CARRY_S),
+            Waypoint(above, rest_rotation, RISE_S),
+        ]
     return [
         Waypoint(out, rotation, OUT_S),
-        Waypoint(above, rest_rotation, CARRY_S),
+        *carry,
         Waypoint(down, rest_rotation, LOWER_S),
         # A person lets go once it is still: a bottle laid on its side does not roll away.
         Waypoint(down, rest_rotation, HOLD_S),
