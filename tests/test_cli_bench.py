@@ -140,3 +140,8 @@ def test_the_report_of_several_methods_has_the_paired_table(tmp_path):
     written = write_report(records, tmp_path, SweepConfig(), None, trials=3, first_seed=0)
     assert tmp_path / "tables" / "paired.md" in written and tmp_path / "tables" / "paired.csv" in written
     assert "| ReKep | 3 |" in (tmp_path / "tables" / "paired.md").read_text()
+    # Modelled latencies: the same episodes priced at other latencies; measured LLM calls are not re-priced.
+    assert tmp_path / "tables" / "latency.md" in written
+    assert "AgentChord takes the same time as ReKep at every latency" in (tmp_path / "tables" / "latency.md").read_text()
+    measured = write_report(records, tmp_path / "llm", SweepConfig(reasoner="llm"), None, trials=3, first_seed=0)
+    assert not any(path.name.startswith("latency") for path in measured)

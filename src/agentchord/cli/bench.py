@@ -214,6 +214,16 @@ def write_report(records: list[dict], out: Path, config, console: Console | None
         write(out / "tables" / "paired.csv", paired_csv(records))
         if console is not None:
             console.print(paired, markup=False, highlight=False)
+    if config.reasoner == "rules" and len(methods) > 1:
+        # Modelled latencies only: a measured LLM call has no price to scale.
+        from agentchord.bench.latency import latency_csv, latency_markdown  # noqa: PLC0415
+
+        plan_s = config.reasoning.latency.plan
+        sensitivity = latency_markdown(records, plan_s, describe(config) + ".")
+        write(out / "tables" / "latency.md", sensitivity)
+        write(out / "tables" / "latency.csv", latency_csv(records, plan_s))
+        if console is not None:
+            console.print(sensitivity, markup=False, highlight=False)
     figure = stress_figure(records)
     if figure is not None:
         write(out / "figures" / "stress.png", figure)
