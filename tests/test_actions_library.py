@@ -130,7 +130,7 @@ def test_a_fallen_bottle_beside_the_arms_own_base_is_turned_upright_clear_of_the
 
 
 @pytest.mark.parametrize("crosses_over", [True, False])
-def test_a_fallen_grasp_goes_over_a_neighbour_its_straight_approach_would_strike(crosses_over, monkeypatch):
+def test_a_fallen_grasp_goes_over_a_neighbour_its_straight_approach_would_strike(crosses_over, monkeypatch, straight_carry):
     # Stress protocol, single-arm pour, seed 38: the bottle pulled out of the hand lies beyond the cup
     # from where the hand let it go. The straight move to the fallen grasp's pre-grasp crossed the cup's
     # rim; the fingers struck it and the cup went off the table. The hand now goes over it.
@@ -151,7 +151,7 @@ def test_a_fallen_grasp_goes_over_a_neighbour_its_straight_approach_would_strike
 
 
 @pytest.mark.parametrize("slides", [True, False])
-def test_a_fallen_grasp_slides_along_the_object_where_a_finger_would_come_down_on_a_neighbour(slides, monkeypatch):
+def test_a_fallen_grasp_slides_along_the_object_where_a_finger_would_come_down_on_a_neighbour(slides, monkeypatch, straight_carry):
     # Real-world protocol, single-arm pour, seed 58: the bottle pulled out of the hand lies against the
     # cup. At its centre a finger came down on the cup's rim and the tool stopped 6 cm above the grasp,
     # three times, for the right arm; the left arm's alternative could not reach past it. Slid 2.5 cm

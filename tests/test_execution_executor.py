@@ -288,7 +288,7 @@ def test_the_bottle_taken_again_is_not_carried_to_a_cup_still_lying_there():
     assert not blind.success
 
 
-def test_a_recovery_is_not_skipped_to_a_merge_node_the_next_edge_fails_at_once():
+def test_a_recovery_is_not_skipped_to_a_merge_node_the_next_edge_fails_at_once(straight_carry):
     # p = 0.3, every kind, seed 4: the cup is knocked over as the bottle is carried to it, and its
     # righting is cut short by a pull of the bottle. The bottle's regrasp merges at v2, whose
     # constraints do not read the cup, and e3's cup_tipped fires at once. v2 holds, but the cup still
@@ -302,7 +302,7 @@ def test_a_recovery_is_not_skipped_to_a_merge_node_the_next_edge_fails_at_once()
     assert "e3_r_cup_tipped" in [b["edge"] for b in result.trace.of("recovery_bound")]
 
 
-def test_a_recovery_is_skipped_to_its_merge_node_once_not_round_and_round(monkeypatch):
+def test_a_recovery_is_skipped_to_its_merge_node_once_not_round_and_round(monkeypatch, straight_carry):
     # The same episode with the merge judged by its node alone: e3_r_cup_tipped is skipped to v2, e3
     # fires again, and this time the recovery runs (skipping again and again went round node, edge,
     # failure until the failure budget ended the episode). The guard for monitors that fire later

@@ -171,19 +171,25 @@ class _Both:
         return None
 
 
-def test_an_arm_switch_whose_busy_hand_already_lost_its_object_goes_on():
+@pytest.mark.parametrize("crosses_over", [False, True])
+def test_an_arm_switch_whose_busy_hand_already_lost_its_object_goes_on(crosses_over, straight_carry, monkeypatch):
     # Both arms lose their objects: the right arm drops the bottle on its way to the cup, then, as the
     # recovery starts, a person takes the cup out of the left hand and sets it down far on the right,
-    # beyond the bottle lying there: the left arm's grasp, with no clear way in that it reaches,
-    # sweeps into the bottle and pushes the cup away. The cup's recovery passes to the right arm,
-    # whose bottle already fell: its hand is free already (place free_hand), it takes the cup over
-    # the lying bottle, and takes the fallen bottle again before the pour.
+    # beyond the bottle lying there. Reaching straight in, the left arm's grasp sweeps into the bottle
+    # and pushes the cup away. The cup's recovery passes to the right arm, whose bottle already fell:
+    # its hand is free already (place free_hand), it takes the cup over the lying bottle, and takes
+    # the fallen bottle again before the pour. A grasp that crosses over the bottle (as side grasps
+    # now do) takes the cup with the left arm itself.
+    from agentchord.actions import grasp as grasp_module
+
+    if not crosses_over:
+        monkeypatch.setattr(grasp_module, "crossing_over", lambda *args: None)
     both = _Both(ScriptedDisturbance("move_to_obj", "drop", nth=0, after=36),
                  ScriptedDisturbance("move_to_target", "pull", nth=1, after=1, seed=1, spot=(0.25, 0.35), lying=False))
     result = run_episode(EpisodeSpec("dual_arm_pour_water", seed=8, disturbance=both))
     assert [(e["kind"], e["obj"], e["arm"]) for e in result.trace.of("disturbance")] == [("drop", "bottle", "right"), ("pull", "cup", "left")]
     assert result.success, result.reason
-    assert "e3_r_cup_dropped_via_right" in result.path
+    assert ("e3_r_cup_dropped_via_right" in result.path) is not crosses_over
 
 
 def test_a_recovery_whose_scene_changed_under_it_is_bound_once_more():
