@@ -198,3 +198,30 @@ def test_a_pulled_bottle_is_carried_over_the_cup_and_the_regrasp_reaches_over_it
     assert result.trace.of("disturbance")[0]["kind"] == "pull"
     assert result.success, result.reason
     assert cup_moved[1:] == []  # the cup never moved or tipped
+
+
+def test_a_carry_lifts_over_what_stands_in_its_way_but_not_over_its_own_load():
+    # Lifted over the capsule in it, a tray pulled out of the hand threw the capsule off the table
+    # (planned coffee tray, real protocol, seed 2): what rests in or on the carried object goes with it.
+    from types import SimpleNamespace
+
+    from agentchord.worlds.sim.disturbances import _carry_height
+    from agentchord.worlds.sim.tasks import SIM_TASKS
+
+    specs = {o.name: o for o in SIM_TASKS["setup_coffee_tray"].sample_scene(np.random.default_rng(0)).objects}
+    on_table = 0.5 * specs["capsule"].height
+
+    def world(x, y, z=on_table):
+        poses = {"tray": np.array([0.0, 0.5, 0.5 * specs["tray"].height]), "capsule": np.array([x, y, z])}
+        return SimpleNamespace(object_names=["tray", "capsule"], object_spec=specs.__getitem__,
+                               object_pose=lambda name: (poses[name], np.eye(3)))
+
+    frame = SimpleNamespace(holding=[])
+    start, spot = np.array([0.0, 0.5]), np.array([0.35, 0.5])
+    assert _carry_height(world(0.03, 0.5, on_table + 0.005), frame, "tray", start, spot) is None  # on the tray's base
+    for x in (0.15, 0.26):  # on the table in the way, beside the tray's centre or beyond its end
+        over = _carry_height(world(x, 0.5), frame, "tray", start, spot)
+        assert over is not None and over > 2 * on_table
+    assert _carry_height(world(0.26, 0.75), frame, "tray", start, spot) is None  # well off the way
+    frame.holding = [("left", "capsule")]
+    assert _carry_height(world(0.26, 0.5), frame, "tray", start, spot) is None  # up in a hand

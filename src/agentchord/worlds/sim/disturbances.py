@@ -66,8 +66,11 @@ SET_DOWN_AREA = ((-0.32, 0.32), (0.28, 0.85))
 SET_DOWN_BASE_CLEARANCE = 0.30
 SET_DOWN_WORKSPACE = (0.36, 0.62)
 SET_DOWN_OBJECT_CLEARANCE = 0.03
-#: A person carries a pulled object this far (m) clear of what stands in its way, above and beside.
+#: A person carries a pulled object this far (m) clear of what stands in its way, above and beside ...
 CARRY_PASS_CLEARANCE = 0.02
+#: ... but not over what it carries: an object over its footprint whose bottom is this far (m) above
+#: its own (a capsule on a tray's 5 mm base), not one beside it on the table.
+LOAD_ABOVE = 0.003
 #: Share of tall objects (a bottle) a person sets down on their side rather than upright.
 LYING_SHARE = 0.3
 #: A perturbation pushes the object being grasped this far (m), a shift this far.
@@ -209,11 +212,15 @@ def _carry_height(world: SimWorld, frame: FeatureFrame, obj: str, start: np.ndar
     """The height (m) ``obj``'s centre must keep to pass over what stands on the table between
     ``start`` and ``spot`` (x, y), turning as it goes; None when nothing stands in the way.
 
-    Objects the robot holds are up in the air with it and are left out.
+    Objects the robot holds are up in the air with it, and objects in or on ``obj`` (a capsule in
+    a tray) travel with it: both are left out.
     """
     spec = world.object_spec(obj)
     # Its half diagonal (a cylinder's: radius and half height), reached whichever way it turns.
     reach = float(np.linalg.norm(spec.size[:2] if spec.shape == "cylinder" else spec.size[:3]))
+    up = np.array([0.0, 0.0, 1.0])
+    here, matrix = world.object_pose(obj)
+    bottom = here[2] - _half_extent_along(spec, matrix, up)
     held = {name for _, name in frame.holding}
     tops = []
     for name in world.object_names:
@@ -221,6 +228,11 @@ def _carry_height(world: SimWorld, frame: FeatureFrame, obj: str, start: np.ndar
             continue
         other = world.object_spec(name)
         other_pos, other_matrix = world.object_pose(name)
+        resting_on = other_pos[2] - _half_extent_along(other, other_matrix, up) > bottom + LOAD_ABOVE
+        if resting_on and np.linalg.norm(other_pos[:2] - here[:2]) < _footprint(spec):
+            # Lifted over its own load, a tray pulled with the capsule in it threw the capsule off the
+            # table (planned coffee tray, real protocol, seed 2).
+            continue
         if _distance_to_segment(other_pos[:2], start, spot) < _footprint(other) + reach + CARRY_PASS_CLEARANCE:
             tops.append(other_pos[2] + _half_extent_along(other, other_matrix, np.array([0.0, 0.0, 1.0])))
     return max(tops) + reach + CARRY_PASS_CLEARANCE if tops else None
