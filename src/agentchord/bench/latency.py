@@ -20,13 +20,12 @@ from collections import defaultdict
 from dataclasses import dataclass
 from statistics import mean
 
+from agentchord.bench.paired import REFERENCE
 from agentchord.bench.tables import markdown_table, ordered
 from agentchord.execution.methods import METHODS, SHORT
 
 #: Latency scales tabled (x the sweep's latency model): none, faster models, as run, slower ones.
 SCALES = (0.0, 0.1, 0.25, 0.5, 1.0, 2.0, 3.0)
-#: The method the others are compared with.
-REFERENCE = "agentchord"
 
 
 @dataclass(frozen=True)

@@ -234,7 +234,7 @@ def _carry_height(world: SimWorld, frame: FeatureFrame, obj: str, start: np.ndar
             # table (planned coffee tray, real protocol, seed 2).
             continue
         if _distance_to_segment(other_pos[:2], start, spot) < _footprint(other) + reach + CARRY_PASS_CLEARANCE:
-            tops.append(other_pos[2] + _half_extent_along(other, other_matrix, np.array([0.0, 0.0, 1.0])))
+            tops.append(other_pos[2] + _half_extent_along(other, other_matrix, up))
     return max(tops) + reach + CARRY_PASS_CLEARANCE if tops else None
 
 
