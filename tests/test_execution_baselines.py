@@ -51,15 +51,31 @@ def test_latency_model_parses_and_refuses():
         ReasoningConfig(vqa_miss=1.5)
 
 
-def test_agentchord_and_its_ablation_are_charged_the_three_agents():
-    ac = _run("agentchord", 0)
-    bt = _run("agentchord-bt", 0)
-    assert ac.reasoning_calls == {"plan": 3} and ac.reasoning_s == pytest.approx(21.0)
-    # The ablation's monitors are the arranger's failure modes: it is asked too (paper App. E-C).
-    assert bt.reasoning_calls == {"plan": 3} and bt.reasoning_s == pytest.approx(21.0)
-    assert ac.exec_time_s == pytest.approx(ac.time_s + ac.compute_s + 21.0)
+def test_sequential_agentchord_and_its_ablation_wait_for_the_three_agents():
+    flat = ReasoningConfig(latency=LatencyModel())
+    runs = {m: run_episode(EpisodeSpec(TASK, strategy=m, p=0.05, seed=0, reasoning=flat))
+            for m in ("agentchord-sequential", "agentchord-bt")}
+    for result in runs.values():
+        # The ablation's monitors are the arranger's failure modes: it is asked too (paper App. E-C).
+        assert result.reasoning_calls == {"plan": 3} and result.reasoning_s == pytest.approx(21.0)
+        assert result.first_motion_s == pytest.approx(21.0 + result.compute_s)
+    seq = runs["agentchord-sequential"]
+    assert seq.exec_time_s == pytest.approx(seq.time_s + seq.compute_s + 21.0)
     plain = run_episode(EpisodeSpec(TASK, seed=0))  # `run` and `demo`: robot time only
-    assert plain.reasoning_calls == {} and plain.steps == ac.steps
+    assert plain.reasoning_calls == {} and plain.steps == seq.steps
+
+
+def test_pipelined_agentchord_moves_once_the_first_edge_is_grounded():
+    from agentchord.execution.planning import pipelined_schedule
+    from agentchord.graph.progress import forward_filter
+    from agentchord.tasks import load_task_graph
+
+    result = _run("agentchord", 0)
+    schedule = pipelined_schedule(forward_filter(load_task_graph(TASK)).graph, ReasoningConfig().latency)
+    assert result.first_motion_s == pytest.approx(schedule.first_motion_s)
+    assert result.reasoning_s == pytest.approx(schedule.first_motion_s)  # the rest arrives while it moves
+    assert result.reasoning_calls == {"plan": len(schedule.calls)}
+    assert result.first_motion_s < _run("agentchord-sequential", 0).first_motion_s / 10
 
 
 def test_inner_monologue_queries_at_each_subgoal_and_replans_on_a_no():
@@ -84,6 +100,9 @@ def test_rekep_backtracks_and_never_reasons_again():
     assert result.success
     assert _events(result, "backtrack")
     assert result.reasoning_calls == {"plan": 1} and result.replans == 0
+    (call,) = _events(result, "reasoning")
+    # Priced by what it writes: every stage's constraints, fewer tokens than the composer's whole graph.
+    assert 100 < call["tokens"] < 400 and call["latency_s"] == pytest.approx(0.45 + call["tokens"] / 120, abs=1e-4)
 
 
 def test_code_as_monitor_replans_with_the_vlm_on_a_detection():

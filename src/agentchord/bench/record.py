@@ -76,6 +76,11 @@ class EpisodeRecord(_RecordKey):
     unrecoverable: StrictBool
     path: list[StrictStr]
     disturbances_injected: Count
+    # Pipelined planning (absent from records written before it: read as a robot that waited for every call).
+    first_motion_s: Seconds | None = None
+    critical_reasoning_s: Seconds | None = None
+    plan_wait_s: Seconds = 0.0
+    early_failures: list[dict[StrictStr, Any]] = Field(default_factory=list)
 
 
 class ErrorRecord(_RecordKey):

@@ -13,7 +13,7 @@ import traceback
 from dataclasses import dataclass, field
 
 from agentchord.execution.episode import EpisodeSpec, run_episode
-from agentchord.execution.reasoning import LatencyModel, ReasoningConfig
+from agentchord.execution.reasoning import ReasoningConfig
 
 #: Version of the record layout (a record names it; a reader refuses another).
 RECORD_VERSION = 1
@@ -83,9 +83,8 @@ class SweepConfig:
     @classmethod
     def from_dict(cls, data: dict) -> SweepConfig:
         """The config a manifest holds."""
-        reasoning = dict(data["reasoning"])
-        reasoning["latency"] = LatencyModel(**reasoning["latency"])
-        return cls(reasoning=ReasoningConfig(**reasoning), perception=data["perception"], reasoner=data.get("reasoner", "rules"))
+        return cls(reasoning=ReasoningConfig.from_dict(data["reasoning"]), perception=data["perception"],
+                   reasoner=data.get("reasoner", "rules"))
 
 
 def sweep_keys(tasks: list[str], methods: list[str], conditions: list[Condition], trials: int, first_seed: int = 0) -> list[EpisodeKey]:
@@ -147,7 +146,8 @@ def run_record(key: EpisodeKey, config: SweepConfig) -> dict:
         **{name: summary[name] for name in (
             "success", "reason", "steps", "exec_time_s", "robot_time_s", "compute_s", "reasoning_s", "reasoning_calls",
             "replans", "failures_detected", "recoveries", "drops_injected", "drops_detected", "drops_recovered",
-            "disturbances", "reaction_latency_ticks", "reaction_latency_s", "unrecoverable", "path")},
+            "disturbances", "reaction_latency_ticks", "reaction_latency_s", "unrecoverable", "path",
+            "first_motion_s", "critical_reasoning_s", "plan_wait_s", "early_failures")},
         "disturbances_injected": injected,
         "wall_s": round(time.perf_counter() - started, 3),
     }
@@ -179,8 +179,8 @@ def describe(config: SweepConfig) -> str:
     """One line for every table's caption: the latency model and the VQA's error rates."""
     reasoning = config.reasoning
     if config.reasoner == "llm":
-        latency = (f"planning calls measured (LLM reasoner), VQA {reasoning.latency.vqa:g} s and VLM "
-                   f"{reasoning.latency.vlm:g} s per call modelled (see docs/results.md)")
+        latency = (f"planning calls measured (LLM reasoner), VQA {reasoning.latency.of('vqa'):g} s and VLM "
+                   f"{reasoning.latency.of('vlm'):g} s per call modelled (see docs/results.md)")
     else:
         latency = f"reasoning latency per call: {reasoning.latency.describe()} (modelled; see docs/results.md)"
     return (f"{latency}; "

@@ -12,6 +12,7 @@ import numpy as np
 
 if TYPE_CHECKING:
     from agentchord.execution.edge_program import EdgeProgram
+    from agentchord.execution.planning import PlanSchedule
     from agentchord.execution.trace import Trace
     from agentchord.features.frame import FeatureFrame
     from agentchord.graph.models import TaskGraph
@@ -32,6 +33,7 @@ class ExecutionContext(Protocol):
         monitors: Edge id -> its compiled monitors.
         visited_nominal: Nominal nodes reached so far, in order.
         keyframes: Nominal node -> per arm (joint targets, grip) when it was reached.
+        compute_s: The planner's own work measured in this process so far (s).
     """
 
     graph: TaskGraph
@@ -44,6 +46,16 @@ class ExecutionContext(Protocol):
     monitors: dict[str, EdgeMonitors]
     visited_nominal: list[str]
     keyframes: dict[str, dict[str, tuple[np.ndarray, float]]]
+    compute_s: float
+
+    def charge(self, kind: str, agent: str, latency_s: float, measured: bool = False, compute_s: float = 0.0,
+               tokens: int | None = None) -> None:
+        """Charge one blocking reasoning call (the robot holds still while it answers)."""
+        ...
+
+    def follow_schedule(self, schedule: PlanSchedule) -> None:
+        """Plan with a pipelined schedule: the robot moves at its first motion, the rest arrives at its ticks."""
+        ...
 
     def constraints_hold(self, node_id: str) -> bool:
         """Whether a node's sub-goal constraints hold on the current frame."""

@@ -24,12 +24,14 @@ import numpy as np
 from agentchord.actions.base import ArmAction, Status
 from agentchord.actions.catalog import ACTIONS
 from agentchord.actions.controller import RobotController
+from agentchord.execution.arrivals import PlanArrivals, Waiting, derived_monitors
 from agentchord.execution.binding import Binding, HoldMemory
 from agentchord.execution.edge_program import EdgeProgram
 from agentchord.execution.feasibility import FeasibilityChecker, first_grasps, off_table
 from agentchord.execution.harness import Disturbance, SuccessTracker
 from agentchord.execution.ledger import DisturbanceLedger
 from agentchord.execution.motion_watch import MotionWatch
+from agentchord.execution.planning import PlanSchedule
 from agentchord.execution.repair import Repairer
 from agentchord.execution.result import UNRECOVERABLE, EpisodeResult
 from agentchord.execution.shortcuts import Shortcuts, attach_subgoal_checks
@@ -74,7 +76,7 @@ class ExecutorConfig:
     settle_ticks: int = 25
 
 
-class Executor(RecoverySwitching):
+class Executor(RecoverySwitching, PlanArrivals):
     """Runs one episode of a graph on a world with a recovery strategy.
 
     Args:
@@ -149,6 +151,14 @@ class Executor(RecoverySwitching):
         self.compute_s = 0.0
         self.reasoning_calls: dict[str, int] = {}
         self.replans = 0
+        # A pipelined plan's arrivals (None: the whole graph was there before the first tick).
+        self.schedule: PlanSchedule | None = None
+        self.waiting: Waiting | None = None
+        self.early_failures: list[dict] = []
+        self.plan_wait_ticks = 0
+        self._early_armed: str | None = None
+        self._rearm_tick = 0
+        self._arriving: Waiting | None = None
 
     def _compile(self, graph: TaskGraph) -> None:
         """Adopt a (filtered) graph: compile what the tick loop evaluates.
@@ -160,6 +170,7 @@ class Executor(RecoverySwitching):
         vocabulary = Vocabulary(frozenset(graph.objects))
         # Compile once, before execution: the tick loop only evaluates closures.
         self.monitors = {edge.id: EdgeMonitors.compile(edge, vocabulary) for edge in graph.edges}
+        self._derived = derived_monitors(graph, vocabulary)
         self.constraints = {node.id: [compile_expr(c, vocabulary) for c in node.constraints] for node in graph.nodes}
         self.recovery_map = RecoveryMap(graph)
         self.nominal_next = {graph.edge(e).source: e for e in nominal_path(graph)}
@@ -177,13 +188,14 @@ class Executor(RecoverySwitching):
         self.node = self.graph.start
         self.replans += 1
 
-    def charge(self, kind: str, agent: str, latency_s: float, measured: bool = False, compute_s: float = 0.0) -> None:
-        """Charge one reasoning call: its latency (modelled or measured) and any compute it measured here."""
+    def charge(self, kind: str, agent: str, latency_s: float, measured: bool = False, compute_s: float = 0.0,
+               tokens: int | None = None) -> None:
+        """Charge one blocking reasoning call: its latency (modelled or measured) and any compute it measured here."""
         self.reasoning_s += latency_s
         self.compute_s += compute_s
         self.reasoning_calls[kind] = self.reasoning_calls.get(kind, 0) + 1
         self.trace.add(self.world.tick, "reasoning", kind=kind, agent=agent, latency_s=round(latency_s, 4),
-                       measured=measured, compute_s=round(compute_s, 4))
+                       measured=measured, compute_s=round(compute_s, 4), tokens=tokens)
 
     # ------------------------------------------------------------- queries
     @property
@@ -211,6 +223,7 @@ class Executor(RecoverySwitching):
         wall0 = time.perf_counter()
         self.trace.add(self.world.tick, "episode_start", task=self.graph.task, strategy=self.strategy.name, start=self.graph.start)
         self.strategy.begin(self)
+        first_motion_s = self.reasoning_s + self.compute_s
         outcome = self._arrive(self.graph.start)
         while outcome is None:
             outcome = self._tick()
@@ -238,6 +251,9 @@ class Executor(RecoverySwitching):
             reasoning_calls=dict(sorted(self.reasoning_calls.items())),
             reaction_latency_s=self.disturbances.latency_s,
             replans=self.replans,
+            first_motion_s=first_motion_s,
+            plan_wait_s=self.plan_wait_ticks / CONTROL_HZ,
+            early_failures=self.early_failures,
         )
         self.trace.add(self.world.tick, "episode_end", success=success, reason=reason, steps=result.steps)
         close = getattr(self.extractor, "close", None)
@@ -269,6 +285,12 @@ class Executor(RecoverySwitching):
         lost = self._lost_objects(frame)
         if lost is not None:
             return False, lost
+        # A part of a pipelined plan the robot waits for; then a failure mode arriving as the edge runs.
+        waited = self._tick_waiting()
+        if waited is not False:
+            return waited
+        if self._arrivals_due():
+            self._arm_arrived()
         if self.binding is not None:
             outcome = self._bind(frame)
             if outcome is not None:
@@ -348,7 +370,9 @@ class Executor(RecoverySwitching):
         if not self.strategy.uses_monitors:
             return None
         into_goal = [e for e in nominal_path(self.graph) if self.graph.edge(e).target == self.graph.goal]
-        monitors = self.monitors.get(into_goal[-1]) if into_goal else None
+        if not into_goal or self.branch_pending(into_goal[-1]):
+            return None
+        monitors = self.monitors.get(into_goal[-1])
         return monitors.violated_now(self.frame) if monitors is not None else None
 
     def _where(self) -> str:
@@ -409,7 +433,8 @@ class Executor(RecoverySwitching):
             outcome = self._beyond_every_arm(grasp.args.obj, confirm_ik=False)
             if outcome is not None:
                 return outcome
-        self._start(program)
+        if not self._wait_for_grounding(program):
+            self._start(program)
         return None
 
     def _start(self, program: EdgeProgram) -> None:
@@ -432,6 +457,8 @@ class Executor(RecoverySwitching):
         Only the active edge's own monitors are armed. A failure during a recovery edge
         without monitors shows at its merge node: the next edge's monitors catch it.
         """
+        if self.strategy.uses_monitors and self._arm_early(program):
+            return  # its branches are still to come: the monitors derived from its own constraints
         edge_monitors = self.monitors.get(program.edge_id) if self.strategy.uses_monitors else None
         self.armed = edge_monitors if edge_monitors is not None and edge_monitors.monitors else None
         if self.armed is not None:

@@ -7,10 +7,13 @@ from agentchord.execution.baselines.strategies import BaselineContext
 from agentchord.execution.reasoning import ReasoningConfig
 from agentchord.execution.strategies import STRATEGIES, RecoveryStrategy
 
-#: The methods in the paper's column order (Table I): the baselines, then the ablation, then AgentChord.
-METHODS: tuple[str, ...] = ("inner-monologue", "doremi", "rekep", "code-as-monitor", "agentchord-bt", "agentchord")
+#: The methods in the paper's column order (Table I): the baselines, then the ablation, then AgentChord
+#: with the paper's sequential plan, then AgentChord (its plan pipelined: the robot moves while the agents think).
+METHODS: tuple[str, ...] = ("inner-monologue", "doremi", "rekep", "code-as-monitor", "agentchord-bt",
+                            "agentchord-sequential", "agentchord")
 #: Short column names, as the paper's tables write them.
-SHORT = {"inner-monologue": "IM", "doremi": "DRM", "rekep": "ReKep", "code-as-monitor": "CaM", "agentchord-bt": "AC-BT", "agentchord": "AgentChord"}
+SHORT = {"inner-monologue": "IM", "doremi": "DRM", "rekep": "ReKep", "code-as-monitor": "CaM", "agentchord-bt": "AC-BT",
+         "agentchord-sequential": "AC-seq", "agentchord": "AgentChord"}
 
 
 def is_baseline(name: str) -> bool:

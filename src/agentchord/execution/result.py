@@ -44,11 +44,22 @@ class EpisodeResult:
     reaction_latency_s: list[float] = field(default_factory=list)
     #: Re-plans made (the re-planning baselines).
     replans: int = 0
+    #: Seconds from receiving the task to the robot's first motion: the reasoning (and compute) it waited for.
+    first_motion_s: float = 0.0
+    #: Seconds the robot held still mid-episode for a part of a pipelined plan that had not arrived (in ``time_s``).
+    plan_wait_s: float = 0.0
+    #: Failures that fired before their recovery branch had arrived: edge, failure, tick, ticks waited, what came of it.
+    early_failures: list[dict] = field(default_factory=list)
 
     @property
     def exec_time_s(self) -> float:
         """Execution time: robot time + measured compute + reasoning latency (DESIGN section 6)."""
         return self.time_s + self.compute_s + self.reasoning_s
+
+    @property
+    def critical_reasoning_s(self) -> float:
+        """Reasoning on the critical path: what the robot held still for, before its first motion and after."""
+        return self.reasoning_s + self.plan_wait_s
 
     @property
     def unrecoverable(self) -> bool:
@@ -77,6 +88,10 @@ class EpisodeResult:
             "reasoning_s": round(self.reasoning_s, 3),
             "reasoning_calls": dict(self.reasoning_calls),
             "replans": self.replans,
+            "first_motion_s": round(self.first_motion_s, 3),
+            "critical_reasoning_s": round(self.critical_reasoning_s, 3),
+            "plan_wait_s": round(self.plan_wait_s, 3),
+            "early_failures": self.early_failures,
             "disturbances": self.disturbances,
             "unrecoverable": self.unrecoverable,
             "path": self.path,

@@ -12,12 +12,14 @@ from typing import TYPE_CHECKING
 
 from agentchord.execution.edge_program import EdgeProgram, ReturnToKeyframe
 from agentchord.execution.feasibility import first_grasps
-from agentchord.execution.reasoning import ReasoningConfig, charge_calls
+from agentchord.execution.planning import pipelined_schedule, sequential_calls
+from agentchord.execution.reasoning import ModelledCall, ReasoningConfig, charge_calls
 from agentchord.monitor import Detection
 
 if TYPE_CHECKING:
     from agentchord.execution.context import ExecutionContext as Executor  # the executor as a strategy sees it
     from agentchord.features.frame import FeatureFrame
+    from agentchord.graph.models import TaskGraph
 
 
 class RecoveryStrategy:
@@ -43,14 +45,16 @@ class RecoveryStrategy:
     reasoning: ReasoningConfig | None = None
     #: The reasoner calls that planned this episode's graph (none: a library graph, modelled).
     planned_calls: tuple = ()
-    #: Calls that made the graph before the first tick: agent -> call kind. AgentChord's three
-    #: agents each answer once (composer, arranger, conductor).
-    begin_roles: dict[str, str] = {"composer": "plan", "arranger": "plan", "conductor": "plan"}
+
+    def planning_calls(self, graph: TaskGraph) -> list[ModelledCall]:
+        """The calls that make ``graph`` before the first tick, each with what it writes: AgentChord's
+        three agents one after the other (composer, arranger, conductor: the paper's order)."""
+        return sequential_calls(graph)
 
     def begin(self, executor: Executor) -> None:
-        """Called once before the first tick: charge the reasoning that made the plan."""
+        """Called once before the first tick: charge the reasoning that made the plan (the robot waits for it)."""
         if self.reasoning is not None:
-            charge_calls(executor, self.reasoning, self.begin_roles, self.planned_calls)
+            charge_calls(executor, self.reasoning, self.planning_calls(executor.graph), self.planned_calls)
 
     def watch(self, executor: Executor, frame: FeatureFrame) -> Detection | None:
         """A failure this strategy detects at this tick of an edge program (None: nothing)."""
@@ -103,16 +107,35 @@ class AgentChordStrategy(RecoveryStrategy):
     """Switch to the pre-compiled forward-moving recovery edge (Eq. 13): no re-planning.
 
     The entry edge and its alternatives (another arm's way there) are all candidates;
-    the executor binds the first the arms can make.
+    the executor binds the first the arms can make. The plan is pipelined: the robot moves once
+    the first edge is grounded, and the rest of the plan arrives while it moves
+    (:mod:`agentchord.execution.planning`, :mod:`agentchord.execution.arrivals`).
     """
 
     name = "agentchord"
     resumes_cleared_failures = True
     merges_met_subgoals = True
 
+    def begin(self, executor: Executor) -> None:
+        if self.reasoning is None:
+            return
+        if any(call.reasoner != "rules" for call in self.planned_calls):
+            # An LLM planned this graph, its calls one after the other: charged what they measured.
+            super().begin(executor)
+            return
+        executor.compute_s += sum(call.latency_s for call in self.planned_calls)  # the offline agents' own work
+        executor.follow_schedule(pipelined_schedule(executor.graph, self.reasoning.latency))
+
     def recover(self, executor: Executor, detection: Detection) -> list[EdgeProgram]:
         candidates = executor.recovery_map.candidates(detection.edge_id, detection.failure.name)
         return [EdgeProgram.from_edge(edge) for edge in candidates]
+
+
+class SequentialAgentChordStrategy(AgentChordStrategy):
+    """AgentChord with the paper's sequential plan: the robot waits for all three agents before it moves."""
+
+    name = "agentchord-sequential"
+    begin = RecoveryStrategy.begin
 
 
 class BacktrackStrategy(RecoveryStrategy):
@@ -123,7 +146,7 @@ class BacktrackStrategy(RecoveryStrategy):
     """
 
     name = "agentchord-bt"
-    # The same three agents answer before the first tick (the default ``begin_roles``): the paper's
+    # The same three agents answer before the first tick, one after the other: the paper's
     # ablation keeps "the same task graph, feature extractors and compiled monitors", and the
     # monitors are the arranger's (its failure modes); only the recovery edges are not followed.
 
@@ -136,7 +159,9 @@ class BacktrackStrategy(RecoveryStrategy):
         return []
 
 
-STRATEGIES: dict[str, type[RecoveryStrategy]] = {s.name: s for s in (AgentChordStrategy, BacktrackStrategy)}
+STRATEGIES: dict[str, type[RecoveryStrategy]] = {
+    s.name: s for s in (AgentChordStrategy, SequentialAgentChordStrategy, BacktrackStrategy)
+}
 
 
 def make_strategy(name: str) -> RecoveryStrategy:

@@ -71,6 +71,10 @@ class RecoverySwitching:
     frame: FeatureFrame
     constraints: dict[str, list[Any]]  # node -> its compiled constraints
     _where: Callable[[], str]
+    _early_failure: Callable[[Detection], bool]
+    as_arranged: Callable[[Detection], Detection]
+    _early_program_failure: Callable[[], bool]
+    branch_pending: Callable[[str], bool]
 
     def _beyond_every_arm(self, obj: str, confirm_ik: bool) -> tuple[bool, str] | None:
         """The unrecoverable outcome when no arm can take ``obj`` where it is (else None)."""
@@ -156,7 +160,7 @@ class RecoverySwitching:
         """
         edge_id = self.nominal_next.get(node_id)
         monitors = self.monitors.get(edge_id) if edge_id is not None else None
-        if monitors is None:
+        if monitors is None or self.branch_pending(edge_id):
             return False
         frame = self.frame
         as_started = replace(frame, refs={name: feats.pos.copy() for name, feats in frame.objects.items()})
@@ -178,6 +182,9 @@ class RecoverySwitching:
                        objects=[h.obj for h in binding.lost])
 
     def _on_failure(self, detection: Detection) -> tuple[bool, str] | None:
+        if self._early_failure(detection):
+            return None  # its branch has not arrived: the arms hold still until it does
+        detection = self.as_arranged(detection)
         key = (detection.edge_id, detection.failure.name)
         self.fire_counts[key] = self.fire_counts.get(key, 0) + 1
         self.trace.add(detection.tick, "failure_detected", edge=detection.edge_id, failure=detection.failure.name,
@@ -217,6 +224,8 @@ class RecoverySwitching:
     def _on_program_failed(self) -> tuple[bool, str] | None:
         """The running program reported a skill's failure: bind it once more (what it found done was
         undone under it), take it as the strategy's detection, bind the next candidate, or end."""
+        if self._early_program_failure():
+            return None  # its branch has not arrived: the arms hold still until it does
         program = self.program
         if program.kind == "recovery" and program.attempt == 1 and program.scene_changed:
             # What it had found done was undone under it (a cup found placed, then knocked over
@@ -245,6 +254,8 @@ class RecoverySwitching:
         next edge whose monitor watches that constraint, fired now, so its recovery runs rather than
         an edge that cannot start (its monitor may be gated by a signal the cut-short recovery reset).
         """
+        if self.branch_pending(edge_id):
+            return None  # its failure modes have not arrived
         violated = {" ".join(c.source.split()): c.scalar(self.frame) for c in self.constraints[node_id]
                      if c.scalar(self.frame) > 0.0}
         for failure in self.graph.edge(edge_id).failures:

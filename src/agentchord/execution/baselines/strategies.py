@@ -19,9 +19,10 @@ from agentchord.agents.exceptions import ReasonerError
 from agentchord.agents.rules.arm_switch import arm_switch_alternative
 from agentchord.agents.rules.knowledge import is_cloth_corner
 from agentchord.execution.baselines.progress import GoalEvents
+from agentchord.execution.baselines.replies import composer_call, next_step_call, stages_call, subgoal_calls, vqa_call
 from agentchord.execution.baselines.vqa import SimulatedVqa
 from agentchord.execution.edge_program import EdgeProgram
-from agentchord.execution.reasoning import ReasoningConfig, charge_calls
+from agentchord.execution.reasoning import ModelledCall, ReasoningConfig, charge_calls
 from agentchord.execution.strategies import RecoveryStrategy
 from agentchord.expr import Vocabulary, compile_expr
 from agentchord.graph.models import FailureMode, TaskGraph
@@ -76,11 +77,6 @@ class BaselineStrategy(RecoveryStrategy):
         context: Per-episode re-planner, progress and seed.
     """
 
-    #: Calls made before the first tick: agent -> call kind.
-    begin_roles: dict[str, str] = {"composer": "plan"}
-    #: Calls of one re-plan: agent -> call kind.
-    replan_roles: dict[str, str] = {"composer": "plan"}
-
     def __init__(self, reasoning: ReasoningConfig | None = None, context: BaselineContext | None = None) -> None:
         self.reasoning = reasoning or ReasoningConfig()
         self.context = context or BaselineContext()
@@ -92,12 +88,21 @@ class BaselineStrategy(RecoveryStrategy):
         self._compiled: dict[str, list] = {}
 
     # -- charges ---------------------------------------------------------------------------
-    def _charge(self, executor: Executor, kind: str, agent: str) -> None:
-        executor.charge(kind, agent, self.reasoning.latency.of(kind))
+    def planning_calls(self, graph: TaskGraph) -> list[ModelledCall]:
+        """The calls before the first tick: a whole plan (the composer's nominal graph)."""
+        return [composer_call(graph)]
+
+    def replan_calls(self, graph: TaskGraph) -> list[ModelledCall]:
+        """The calls of one re-plan that wrote ``graph``: a whole plan again."""
+        return [composer_call(graph)]
+
+    def _charge(self, executor: Executor, calls: list[ModelledCall]) -> None:
+        for call in calls:
+            executor.charge(call.kind, call.agent, self.reasoning.latency.price(call), tokens=call.tokens)
 
     def ask_vqa(self, executor: Executor, constraints: list) -> bool:
         """One VQA query (charged): do ``constraints`` hold now?"""
-        self._charge(executor, "vqa", "vqa")
+        self._charge(executor, [vqa_call()])
         return self.vqa.holds(constraints, executor.frame)
 
     # -- the step's constraints ------------------------------------------------------------
@@ -155,11 +160,13 @@ class BaselineStrategy(RecoveryStrategy):
             planned = replanner(executor.frame, achieved, self.context.descriptions)
         except ReasonerError as error:
             wall = time.perf_counter() - started
-            charge_calls(executor, self.reasoning, self.replan_roles, getattr(error, "calls", []) or [], wall)
+            # A failed re-plan wrote about as much as a plan of what was there.
+            charge_calls(executor, self.reasoning, self.replan_calls(executor.graph), getattr(error, "calls", []) or [], wall)
             executor.trace.add(executor.world.tick, "replan", ok=False, reason=str(error), problems=list(getattr(error, "problems", []) or []))
             return []
         wall = time.perf_counter() - started
-        charge_calls(executor, self.reasoning, self.replan_roles, planned.calls if planned else [], wall)
+        written = self.replan_calls(planned.graph) if planned is not None else [ModelledCall("composer", "plan", 8, part="nothing left")]
+        charge_calls(executor, self.reasoning, written, planned.calls if planned else [], wall)
         goal = executor.graph.goal
         if planned is None:
             # Every goal is achieved: nothing to plan, the episode is judged now.
@@ -194,8 +201,9 @@ class _SubgoalVqa(BaselineStrategy):
         if program.target != executor.graph.goal:
             # The next step is asked of the planner with this feedback in its context: from a
             # state where the sub-goal holds its answer is the plan's next edge (charged, not re-run).
-            for agent, kind in self.replan_roles.items():
-                self._charge(executor, kind, agent)
+            following = executor.nominal_next.get(program.target)
+            if following is not None:
+                self._charge(executor, [next_step_call(executor.graph, following)])
         return None
 
 
@@ -242,6 +250,10 @@ class ReKepStrategy(BaselineStrategy):
     name = "rekep"
     uses_monitors = False
 
+    def planning_calls(self, graph: TaskGraph) -> list[ModelledCall]:
+        """ReKep's one call: every stage's constraints."""
+        return [stages_call(graph)]
+
     def _stage(self, executor: Executor, edge_id: str) -> tuple[list[str], int]:
         path = nominal_path(executor.graph)
         return path, path.index(edge_id) if edge_id in path else -1
@@ -287,8 +299,15 @@ class CodeAsMonitorStrategy(BaselineStrategy):
 
     name = "code-as-monitor"
     uses_monitors = True
-    begin_roles = {"composer": "vlm", "arranger": "vlm"}
-    replan_roles = {"composer": "vlm", "arranger": "vlm"}
+
+    def planning_calls(self, graph: TaskGraph) -> list[ModelledCall]:
+        """The first sub-goal's constraints and monitor code."""
+        path = nominal_path(graph)
+        return subgoal_calls(graph, path[0] if path else None)
+
+    def replan_calls(self, graph: TaskGraph) -> list[ModelledCall]:
+        """A re-plan is the next sub-goal written again: its constraints and monitor code."""
+        return self.planning_calls(graph)
 
     def at_subgoal(self, executor: Executor, program: EdgeProgram) -> Detection | None:
         if not self._known_edge(executor, program):
@@ -298,8 +317,7 @@ class CodeAsMonitorStrategy(BaselineStrategy):
             return Detection(program.edge_id, CONSTRAINT_VIOLATED, tick, tick, 1.0)
         if program.target != executor.graph.goal:
             # The next sub-goal: the generator and the monitor writer are called again.
-            for agent, kind in self.replan_roles.items():
-                self._charge(executor, kind, agent)
+            self._charge(executor, subgoal_calls(executor.graph, executor.nominal_next.get(program.target)))
         return None
 
 

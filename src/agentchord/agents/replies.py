@@ -1,0 +1,165 @@
+"""What each agent call writes, and how many tokens that is: the parts of a graph as replies.
+
+A token-priced latency model charges a call by its output (time to first token + output tokens /
+decode rate), so each call is priced by the reply it returns: the graph part it writes, serialised
+as compact JSON the way the LLM prompts ask for it (defaults left out). Tokens are counted as
+characters / 4, the usual approximation for English and JSON with GPT-4o-class tokenizers (no
+tokenizer is shipped for offline use; docs/results.md says how it compares).
+
+The pipelined plan splits the agents' work (:mod:`agentchord.execution.planning`): the composer's
+nominal graph is written edges first, so that the first edge can be read from the stream before the
+nodes arrive; the arranger writes each edge's failure modes, then each mode's branch; the conductor
+grounds each edge and each branch (:func:`branch_owners` says which mode's branch brings which
+recovery edge).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from typing import Any
+
+from agentchord.graph.models import Edge, TaskGraph
+from agentchord.graph.progress import nominal_path, recovery_reach, with_alternatives
+
+#: Characters per token of compact JSON (GPT-4o-class tokenizers: 3.5-4.5 on code and JSON).
+CHARS_PER_TOKEN = 4.0
+#: The order a streamed nominal graph is written in: the header, then the edges in execution order, then the nodes.
+STREAM_ORDER = ("task", "instruction", "objects", "start", "goal", "edges", "nodes")
+
+
+def count_tokens(value: Any) -> int:
+    """Output tokens of ``value`` written as compact JSON (a string is counted as it is)."""
+    text = value if isinstance(value, str) else json.dumps(value, separators=(",", ":"), ensure_ascii=False)
+    return math.ceil(len(text) / CHARS_PER_TOKEN)
+
+
+def _dump(model) -> dict[str, Any]:
+    return model.model_dump(mode="json", exclude_defaults=True)
+
+
+def nominal_reply(graph: TaskGraph) -> dict[str, Any]:
+    """The composer's reply: the nominal graph (no failure modes, no recovery), in :data:`STREAM_ORDER`."""
+    data = _dump(graph)
+    data["nodes"] = [_dump(n) for n in graph.nodes if not n.is_recovery]
+    data["edges"] = [_dump(e.model_copy(update={"failures": []})) for e in graph.edges if not e.is_recovery]
+    return {key: data[key] for key in STREAM_ORDER if key in data}
+
+
+def streamed_edge_tokens(graph: TaskGraph) -> dict[str, int]:
+    """Per nominal edge, the composer's output tokens up to the end of that edge in its streamed reply."""
+    reply = nominal_reply(graph)
+    text = json.dumps(reply, separators=(",", ":"), ensure_ascii=False)
+    ends: dict[str, int] = {}
+    cursor = text.index('"edges":')
+    for edge in reply.get("edges", []):
+        piece = json.dumps(edge, separators=(",", ":"), ensure_ascii=False)
+        cursor = text.index(piece, cursor) + len(piece)
+        ends[edge["id"]] = math.ceil(cursor / CHARS_PER_TOKEN)
+    return ends
+
+
+def edge_reply(edge: Edge) -> dict[str, Any]:
+    """One nominal edge as the composer writes it (actions and path constraints; no failure modes)."""
+    return _dump(edge.model_copy(update={"failures": []}))
+
+
+def grounding_patch(edges: list[Edge]) -> dict[str, Any]:
+    """What the conductor writes for ``edges``: the values it grounds, not the structure it keeps.
+
+    Per edge, every numeric action argument (offsets, heights, yaws, targets, angles: ``step.arm.arg``)
+    and every failure mode's trigger (margin, window); tolerances inside expressions are left out
+    (they are few, and a patch of them would name the expression). The structure -- ids, endpoints,
+    actions, monitors, the recovery map -- is fixed by the composer and the arranger and not repeated.
+    """
+    patch: dict[str, Any] = {}
+    for edge in edges:
+        values: dict[str, Any] = {}
+        for index, step in enumerate(edge.steps):
+            for arm, call in step.items():
+                if call is None:
+                    continue
+                for name, value in call.args.items():
+                    if isinstance(value, (int, float, list)) and not isinstance(value, bool):
+                        values[f"{index}.{arm}.{name}"] = value
+        for failure in edge.failures:
+            values[failure.name] = [failure.margin, failure.window]
+        if values:
+            patch[edge.id] = values
+    return patch
+
+
+def branch_owners(graph: TaskGraph) -> dict[str, tuple[str, str]]:
+    """Recovery edge or node id -> the (nominal edge, failure mode) whose branch first leads to it.
+
+    Nominal edges are taken in execution order and each one's failure modes in order; from a mode
+    the walk follows its entry edge, the entry's alternatives, what leaves the recovery nodes they
+    reach, and the failure modes of every recovery edge reached (a second failure while recovering),
+    until nothing new is found. What no nominal edge's mode leads to is owned by the last mode.
+    """
+    owners: dict[str, tuple[str, str]] = {}
+    last: tuple[str, str] | None = None
+    for edge_id, failure in nominal_failures(graph):
+        last = (edge_id, failure)
+        for item in branch_reach(graph, edge_id, failure):
+            owners.setdefault(item, last)
+    for item in [*graph.recovery_edges(), *graph.recovery_nodes()]:
+        if last is not None:
+            owners.setdefault(item.id, last)
+    return owners
+
+
+def nominal_failures(graph: TaskGraph) -> list[tuple[str, str]]:
+    """Every (nominal edge, failure mode name) pair, edges in execution order."""
+    return [(edge_id, f.name) for edge_id in nominal_path(graph) for f in graph.edge(edge_id).failures]
+
+
+def branch_reach(graph: TaskGraph, edge_id: str, failure: str) -> list[str]:
+    """Recovery edge and node ids the branch of one failure mode can pass through, in a stable order."""
+    known = {e.id: e for e in graph.edges}
+    frontier = [f.recovery for f in known[edge_id].failures if f.name == failure]
+    seen: list[str] = []
+    while frontier:
+        entries = [e for e in with_alternatives(graph, frontier) if e not in seen]
+        frontier = []
+        edges, nodes = recovery_reach(graph, entries)
+        for reached in sorted(edges - set(seen)):
+            seen.append(reached)
+            frontier += [f.recovery for f in known[reached].failures]
+        seen += [n for n in sorted(nodes) if n not in seen and graph.node(n).is_recovery]
+    return seen
+
+
+def modes_reply(edge: Edge) -> list[dict[str, Any]]:
+    """What the arranger first writes for one nominal edge: its failure modes (monitors, triggers, intents)."""
+    return [_dump(f.model_copy(update={"recovery": ""})) for f in edge.failures]
+
+
+def branch_reply(graph: TaskGraph, edge_id: str, failure: str, owners: dict[str, tuple[str, str]]) -> dict[str, Any]:
+    """What the arranger writes for one failure mode's branch: its entry, the recovery nodes and edges it brings."""
+    key = (edge_id, failure)
+    return {
+        "failure": failure,
+        "recovery": next(f.recovery for f in graph.edge(edge_id).failures if f.name == failure),
+        "nodes": [_dump(n) for n in graph.recovery_nodes() if owners.get(n.id) == key],
+        "edges": [_dump(e) for e in graph.recovery_edges() if owners.get(e.id) == key],
+    }
+
+
+def branch_edges(graph: TaskGraph, edge_id: str, failure: str, owners: dict[str, tuple[str, str]]) -> list[Edge]:
+    """The recovery edges one failure mode's branch brings (the conductor grounds them)."""
+    return [e for e in graph.recovery_edges() if owners.get(e.id) == (edge_id, failure)]
+
+
+def augmentation_reply(graph: TaskGraph) -> dict[str, Any]:
+    """What the arranger adds to the nominal graph, all edges at once (the paper's sequential order)."""
+    return {
+        "failures": {e.id: [_dump(f) for f in e.failures] for e in graph.nominal_edges() if e.failures},
+        "nodes": [_dump(n) for n in graph.recovery_nodes()],
+        "edges": [_dump(e) for e in graph.recovery_edges()],
+    }
+
+
+def grounded_reply(graph: TaskGraph) -> dict[str, Any]:
+    """What the conductor grounds, all at once: every edge's values (:func:`grounding_patch`)."""
+    return grounding_patch(graph.edges)

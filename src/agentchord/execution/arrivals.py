@@ -1,0 +1,296 @@
+"""A pipelined plan's parts arriving while the robot moves: the executor's side of it.
+
+The robot starts once the first edge is grounded (:mod:`agentchord.execution.planning`); the rest
+of the plan arrives at ticks of the episode. Until an edge's failure modes and branches have
+arrived, the edge runs with what needs no reasoner: **monitors derived from its own constraints**
+-- each constraint its source and target nodes share (what is held stays held; what stands stays
+standing) and each of its path constraints, as a monitor with the default persistence window.
+The arranger's other monitors (a cup drifting, a bottle slipping in the hand) are armed when they
+arrive; the persistence history starts then.
+
+A failure before its branch has arrived -- a derived monitor that fires, a skill that reports
+failure, a failure mode the strategy names -- **waits for the branch**: the arms hold still (the
+world keeps stepping, disturbances keep acting), and when the branch arrives the failure is taken
+again on what the scene is then: an arrived monitor that reads it violated switches to its
+recovery as if it had just fired; a skill's failure goes to the strategy as usual; a derived
+monitor that no arrived failure mode explains lets the edge go on. A nominal edge whose grounding
+has not arrived when the robot reaches its source waits the same way. Each case is in the trace
+(``failure_before_branch``, then ``branch_arrived`` with what came of it) and in the episode's
+result (:attr:`EpisodeResult.early_failures`).
+
+:class:`PlanArrivals` is a part of :class:`~agentchord.execution.executor.Executor` (a mixin), as
+:class:`~agentchord.execution.switching.RecoverySwitching` is.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+from agentchord.execution.edge_program import EdgeProgram
+from agentchord.execution.planning import PlanSchedule
+from agentchord.expr import Vocabulary
+from agentchord.graph.models import FailureMode, TaskGraph
+from agentchord.monitor import Detection, EdgeMonitors
+
+if TYPE_CHECKING:
+    from agentchord.execution.trace import Trace
+    from agentchord.worlds.protocol import World
+
+#: The intent of a derived monitor's failure: there is no recovery before the arranger's arrives.
+DERIVED_INTENT = "wait for the arranger's branch"
+
+
+def derived_monitors(graph: TaskGraph, vocabulary: Vocabulary) -> dict[str, EdgeMonitors]:
+    """Per nominal edge, monitors of the constraints it must keep, known before any arranger reply.
+
+    A constraint both ends of the edge share (the same text, spaces aside) must hold all along it;
+    a path constraint must too. Each is a failure mode named ``keeps: <constraint>``.
+    """
+    out = {}
+    for edge in graph.nominal_edges():
+        source = {" ".join(c.split()): c for c in graph.node(edge.source).constraints}
+        shared = [source[key] for key in (" ".join(c.split()) for c in graph.node(edge.target).constraints) if key in source]
+        kept = list(dict.fromkeys([*shared, *edge.path_constraints]))
+        failures = [FailureMode(name=f"keeps: {c}", monitor=c, intent=DERIVED_INTENT, recovery=edge.id) for c in kept]
+        out[edge.id] = EdgeMonitors.compile(edge.model_copy(update={"failures": failures}), vocabulary)
+    return out
+
+
+@dataclass
+class Waiting:
+    """The robot holding still for a part of the plan that has not arrived.
+
+    Attributes:
+        until: The tick it arrives.
+        since: The tick the wait began.
+        edge_id: The nominal edge whose part is awaited.
+        what: ``branch`` (its failure modes and recovery branches) or ``grounding`` (the edge itself).
+        failure: What fired before the branch (None when waiting for a grounding).
+        then: Called when it arrives: the episode's outcome, or None to go on.
+    """
+
+    until: int
+    since: int
+    edge_id: str
+    what: str
+    failure: str | None
+    then: Callable[[], tuple[bool, str] | None]
+
+
+class PlanArrivals:
+    """The executor's pipelined plan: parts armed at their ticks, failures that come first wait."""
+
+    world: World
+    trace: Trace
+    graph: TaskGraph
+    program: EdgeProgram | None
+    armed: EdgeMonitors | None
+    monitors: dict[str, EdgeMonitors]
+    reasoning_s: float
+    reasoning_calls: dict[str, int]
+    schedule: PlanSchedule | None
+    waiting: Waiting | None
+    early_failures: list[dict[str, Any]]
+    _early_armed: str | None
+    _rearm_tick: int
+    _arriving: Waiting | None
+    plan_wait_ticks: int
+    _derived: dict[str, EdgeMonitors]
+    frame: Any
+    _on_failure: Callable[[Detection], tuple[bool, str] | None]
+    _on_program_failed: Callable[[], tuple[bool, str] | None]
+    _start: Callable[[EdgeProgram], None]
+    _arm_monitors: Callable[[EdgeProgram], None]
+    _step: Callable[[], None]
+
+    def follow_schedule(self, schedule: PlanSchedule) -> None:
+        """Plan with ``schedule``: the robot waits for its first motion, the rest arrives at its ticks."""
+        self.schedule = schedule
+        self.reasoning_s += schedule.first_motion_s
+        for scheduled in schedule.calls:
+            call = scheduled.call
+            self.reasoning_calls[call.kind] = self.reasoning_calls.get(call.kind, 0) + 1
+            self.trace.add(self.world.tick, "reasoning", kind=call.kind, agent=call.agent, part=call.part, tokens=call.tokens,
+                           start_s=round(scheduled.start_s, 4), end_s=round(scheduled.end_s, 4),
+                           latency_s=round(scheduled.end_s - scheduled.start_s, 4), measured=False,
+                           arrives_tick=schedule.tick_of(scheduled.end_s), critical=scheduled.end_s <= schedule.first_motion_s)
+
+    # ------------------------------------------------------------ queries
+    def _tick_at(self, seconds: float | None) -> int | None:
+        """The tick a part arriving at ``seconds`` is armed, if that is still to come (None: it is here)."""
+        if seconds is None:
+            return None
+        tick = self.schedule.tick_of(seconds)
+        return tick if self.world.tick < tick else None
+
+    def _mode_tick(self, edge_id: str, failure: str) -> int | None:
+        """The tick a failure mode (its monitor and branch) arrives, if still to come."""
+        if self.schedule is None:
+            return None
+        return self._tick_at(self.schedule.mode_ready_s.get((edge_id, failure)))
+
+    def _pending_modes(self, edge_id: str) -> list[int]:
+        """The ticks still to come at which ``edge_id``'s failure modes (or their list) arrive."""
+        if self.schedule is None:
+            return []
+        ticks = [self._mode_tick(edge_id, f.name) for f in self.graph.edge(edge_id).failures] if edge_id in self.monitors else []
+        ticks.append(self._tick_at(self.schedule.modes_listed_s.get(edge_id)))
+        return sorted(t for t in ticks if t is not None)
+
+    def branch_pending(self, edge_id: str) -> bool:
+        """Whether some failure mode of ``edge_id`` (its monitor or branch) is still to come."""
+        return bool(self._pending_modes(edge_id))
+
+    # ------------------------------------------------------------ arming
+    def _arm_early(self, program: EdgeProgram) -> bool:
+        """Arm what of ``program``'s monitors has arrived, and the derived ones (True when some are still to come)."""
+        pending = self._pending_modes(program.edge_id) if program.kind in ("nominal", "recovery") else []
+        if not pending:
+            self._early_armed = None
+            return False
+        own = self.monitors.get(program.edge_id)
+        arrived = [m for m in own.monitors if self._mode_tick(program.edge_id, m.failure.name) is None] if own else []
+        derived = self._derived.get(program.edge_id) if program.kind == "nominal" else None
+        monitors = arrived + (derived.monitors if derived is not None else [])
+        self.armed = EdgeMonitors(monitors) if monitors else None
+        if self.armed is not None:
+            self.armed.reset()
+        self._early_armed = program.edge_id
+        self._rearm_tick = pending[0]
+        return True
+
+    def _arm_arrived(self) -> None:
+        """A failure mode of the running edge arrived: armed from now on (its persistence history starts)."""
+        edge_id, self._early_armed = self._early_armed, None
+        if self.program is None or self.program.edge_id != edge_id:
+            return
+        self._arm_monitors(self.program)
+        self.trace.add(self.world.tick, "monitors_armed", edge=edge_id,
+                       monitors=[m.failure.name for m in self.armed.monitors] if self.armed is not None else [])
+
+    def _arrivals_due(self) -> bool:
+        """Whether a failure mode of the running edge arrives at this tick."""
+        return self._early_armed is not None and self.world.tick >= self._rearm_tick
+
+    # ------------------------------------------------------------ waiting
+    def _wait_for(self, edge_id: str, until: int, failure: str | None, then: Callable[[], tuple[bool, str] | None]) -> None:
+        """Hold the arms still until tick ``until`` (a part of the plan for ``edge_id`` arrives), then call ``then``."""
+        self.program, self.armed = None, None
+        self.waiting = Waiting(until, self.world.tick, edge_id, "branch" if failure else "grounding", failure, then)
+        if failure is not None:
+            self.trace.add(self.world.tick, "failure_before_branch", edge=edge_id, failure=failure, arrives_tick=until)
+
+    def _early_failure(self, detection: Detection, suspended: EdgeProgram | None = None, since: int | None = None) -> bool:
+        """Wait for the branch of a failure that fired before it arrived (True when it waits).
+
+        A mode that fires before its branch (a strategy's detection) waits for its own branch. A derived
+        monitor (``keeps: ...``) is the mode of its edge that watches the same constraint, if the
+        arranger wrote one: it waits for that mode and switches to its recovery then, as if that mode
+        had fired (it would have, had it been there). Otherwise it waits for every mode of the edge and
+        asks them what the scene is: one that reads it violated switches to its recovery, else the
+        edge goes on.
+        """
+        derived = detection.failure.intent == DERIVED_INTENT
+        if derived:
+            watching = self.as_arranged(detection)
+            if watching is not detection:
+                return self._early_failure(watching, suspended, since)
+            pending = self._pending_modes(detection.edge_id)
+            until = pending[-1] if pending else self.world.tick
+        else:
+            until = self._mode_tick(detection.edge_id, detection.failure.name)
+            if until is None:
+                return False
+        suspended = self.program if suspended is None else suspended
+        since = self.world.tick if since is None else since
+
+        def arrived() -> tuple[bool, str] | None:
+            self.program = suspended
+            if not derived:
+                self._arrived(f"recovery for {detection.failure.name}", since)
+                return self._on_failure(detection)
+            monitors = self.monitors.get(detection.edge_id)
+            now = monitors.violated_now(self.frame) if monitors is not None else None
+            if now is not None:
+                self._arrived(f"recovery for {now.failure.name}", since)
+                return self._on_failure(Detection(now.edge_id, now.failure, self.world.tick, detection.onset_tick, now.value))
+            self._arrived("no failure mode of the edge is violated: the edge goes on", since)
+            if suspended is not None:
+                self._arm_monitors(suspended)
+            return None
+
+        if since == self.world.tick:
+            self.trace.add(self.world.tick, "failure_before_branch", edge=detection.edge_id, failure=detection.failure.name,
+                           arrives_tick=until)
+        self.program, self.armed = None, None
+        self.waiting = Waiting(until, since, detection.edge_id, "branch", detection.failure.name, arrived)
+        return True
+
+    def as_arranged(self, detection: Detection) -> Detection:
+        """A derived monitor's detection as the arranger's mode of its edge that reads the same constraint, if
+        there is one (the mode would have fired, had it been there); any other detection as it is."""
+        if detection.failure.intent != DERIVED_INTENT:
+            return detection
+        constraint = " ".join(detection.failure.monitor.split())
+        for failure in self.graph.edge(detection.edge_id).failures:
+            if constraint in " ".join(failure.monitor.split()):
+                return Detection(detection.edge_id, failure, detection.tick, detection.onset_tick, detection.value)
+        return detection
+
+    def _early_program_failure(self) -> bool:
+        """Wait for the failure modes of an edge whose skill failed before they arrived (True when it waits)."""
+        program = self.program
+        pending = self._pending_modes(program.edge_id) if program is not None and program.kind == "nominal" else []
+        if not pending:
+            return False
+        since = self.world.tick
+
+        def arrived() -> tuple[bool, str] | None:
+            self.program = program
+            self._arrived(f"the skill's failure taken as the strategy takes it ({program.failure_reason})", since)
+            return self._on_program_failed()
+
+        reason = f"skill failed: {program.failure_reason}"
+        self.trace.add(self.world.tick, "failure_before_branch", edge=program.edge_id, failure=reason, arrives_tick=pending[-1])
+        self._wait_for(program.edge_id, pending[-1], reason, arrived)
+        return True
+
+    def _wait_for_grounding(self, program: EdgeProgram) -> bool:
+        """Wait for a nominal edge's grounding if the robot reached its source first (True when it waits)."""
+        until = self._tick_at(self.schedule.edge_ready_s.get(program.edge_id)) if self.schedule is not None else None
+        if until is None:
+            return False
+        since = self.world.tick
+
+        def arrived() -> tuple[bool, str] | None:
+            self.trace.add(self.world.tick, "edge_grounded", edge=program.edge_id, waited_ticks=self.world.tick - since)
+            self._start(program)
+            return None
+
+        self._wait_for(program.edge_id, until, None, arrived)
+        return True
+
+    def _arrived(self, outcome: str, since: int) -> None:
+        """Record what came of a failure that waited for its branch since tick ``since``."""
+        waiting = self._arriving
+        waited = self.world.tick - since
+        self.early_failures.append({"edge": waiting.edge_id, "failure": waiting.failure, "tick": since,
+                                    "waited_ticks": waited, "then": outcome})
+        self.trace.add(self.world.tick, "branch_arrived", edge=waiting.edge_id, failure=waiting.failure,
+                       waited_ticks=waited, then=outcome)
+
+    def _tick_waiting(self) -> tuple[bool, str] | None | bool:
+        """One tick of a wait: the arms hold still until the part arrives (the world stepped, None), or what
+        came of it once it has (an outcome, or False: the tick goes on as usual, as when nothing waits)."""
+        waiting = self.waiting
+        if waiting is None:
+            return False
+        if self.world.tick < waiting.until:
+            self.plan_wait_ticks += 1
+            self._step()
+            return None
+        self.waiting, self._arriving = None, waiting
+        outcome = waiting.then()
+        return False if outcome is None else outcome

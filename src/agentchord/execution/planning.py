@@ -1,0 +1,182 @@
+"""When each agent's work arrives: the paper's sequential plan and AgentChord's pipelined one.
+
+Sequential (the paper's order, ``agentchord-sequential``): the composer writes the nominal graph,
+the arranger its failure modes and recovery branches, the conductor grounds all of it; the robot
+waits for all three before it moves.
+
+Pipelined (``agentchord``): a robot does not need the branches of its third edge before it starts
+its first. The composer's reply streams, edges first (:data:`~agentchord.agents.replies.STREAM_ORDER`);
+as soon as an edge has streamed, the conductor grounds it. Once the nominal graph is whole, the
+arranger is asked per edge for its failure modes, then per mode for its recovery branch, and the
+conductor grounds each branch as it comes. The calls are served as the model allows
+(``concurrency`` at once), in the order the robot needs them: edge k's grounding, its modes and
+their branches before edge k+1's. The robot moves once the first edge is grounded; every other part
+arrives while it moves, as an event on the episode's clock (:class:`PlanSchedule`). A failure mode
+is armed once its branch, and whatever the branch can reach (a second failure while recovering may
+enter another mode's branch), has arrived grounded.
+
+Pure functions of a graph and a latency model: the same graph and model give the same schedule.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from agentchord.agents.replies import (
+    augmentation_reply,
+    branch_edges,
+    branch_owners,
+    branch_reach,
+    branch_reply,
+    count_tokens,
+    grounded_reply,
+    grounding_patch,
+    modes_reply,
+    nominal_failures,
+    nominal_reply,
+    streamed_edge_tokens,
+)
+from agentchord.execution.reasoning import AnyLatencyModel, ModelledCall
+from agentchord.graph.models import TaskGraph
+from agentchord.graph.progress import nominal_path
+from agentchord.worlds.protocol import CONTROL_HZ
+
+
+def composer_call(graph: TaskGraph) -> ModelledCall:
+    """The composer's one call: the nominal graph."""
+    return ModelledCall("composer", "plan", count_tokens(nominal_reply(graph)), part="nominal graph")
+
+
+def sequential_calls(graph: TaskGraph) -> list[ModelledCall]:
+    """The paper's three calls, one after the other: nominal graph, branches, their grounding."""
+    return [
+        composer_call(graph),
+        ModelledCall("arranger", "plan", count_tokens(augmentation_reply(graph)), part="failure modes and branches"),
+        ModelledCall("conductor", "plan", count_tokens(grounded_reply(graph)), part="grounded edges and branches"),
+    ]
+
+
+@dataclass(frozen=True)
+class ScheduledCall:
+    """One call of a pipelined plan and when it ran (seconds from the start of planning)."""
+
+    call: ModelledCall
+    start_s: float
+    end_s: float
+
+
+@dataclass(frozen=True)
+class PlanSchedule:
+    """When each part of a pipelined plan arrives (seconds from the start of planning).
+
+    Attributes:
+        calls: Every call, in the order they started.
+        first_motion_s: When the first edge is grounded: the robot moves from then on.
+        edge_ready_s: Nominal edge id -> when its grounding has arrived.
+        mode_ready_s: (edge id, failure mode name) -> when the mode can fire and be recovered from:
+            its monitor, its branch and everything the branch can reach, grounded. A recovery edge's
+            modes come with the branch that brings the edge.
+        modes_listed_s: Nominal edge id -> when the arranger's list of its failure modes has arrived.
+        owners: Recovery edge or node id -> the (nominal edge, failure mode) whose branch brings it.
+    """
+
+    calls: tuple[ScheduledCall, ...]
+    first_motion_s: float
+    edge_ready_s: dict[str, float]
+    mode_ready_s: dict[tuple[str, str], float]
+    modes_listed_s: dict[str, float] = field(default_factory=dict)
+    owners: dict[str, tuple[str, str]] = field(default_factory=dict)
+
+    def tick_of(self, seconds: float) -> int:
+        """The control tick (counted from the first motion) at which a part arriving at ``seconds`` is armed."""
+        return max(0, math.ceil(round((seconds - self.first_motion_s) * CONTROL_HZ, 6)))
+
+    def branches_ready_s(self, edge_id: str) -> float:
+        """When every failure mode of ``edge_id`` has arrived (its list, if it has none)."""
+        modes = [s for (edge, _), s in self.mode_ready_s.items() if edge == edge_id]
+        return max([self.modes_listed_s.get(edge_id, 0.0), *modes])
+
+
+@dataclass
+class _Job:
+    call: ModelledCall
+    priority: tuple
+    key: str
+    after: str | None = None  # the job whose end releases this one (None: ``release_s``)
+    release_s: float | None = None
+    start_s: float = 0.0
+    end_s: float = 0.0
+
+
+def pipelined_schedule(graph: TaskGraph, latency: AnyLatencyModel) -> PlanSchedule:
+    """The pipelined plan of ``graph``: each call's start and end, and when each part is armed.
+
+    Calls, in the order the robot needs them (edge by edge): the edge's grounding, the list of its
+    failure modes, then per mode its branch and the branch's grounding. A call starts when what it
+    reads has arrived and the model has a free slot (``latency.concurrency`` at once; the composer
+    holds one while it streams); among the calls ready, the first in need goes first. A flat latency
+    model does not stream: every edge arrives with the whole nominal graph.
+    """
+    path = nominal_path(graph)
+    composer = composer_call(graph)
+    composer_end = latency.price(composer)
+    streamed = streamed_edge_tokens(graph)
+    owners = branch_owners(graph)
+    jobs: list[_Job] = []
+    for k, edge_id in enumerate(path):
+        at = (latency.first_token_s(composer) + latency.decode_s(streamed[edge_id])) if latency.streams else composer_end
+        edge = graph.edge(edge_id)
+        nominal = edge.model_copy(update={"failures": []})
+        jobs.append(_Job(ModelledCall("conductor", "plan", count_tokens(grounding_patch([nominal])), part=f"{edge_id} grounded"),
+                         (k, 0), f"edge:{edge_id}", release_s=min(at, composer_end)))
+        jobs.append(_Job(ModelledCall("arranger", "plan", count_tokens(modes_reply(edge)), part=f"{edge_id} failure modes"),
+                         (k, 1), f"modes:{edge_id}", release_s=composer_end))
+        for j, failure in enumerate(edge.failures):
+            mode = f"{edge_id}/{failure.name}"
+            jobs.append(_Job(ModelledCall("arranger", "plan", count_tokens(branch_reply(graph, edge_id, failure.name, owners)),
+                                          part=f"{mode} branch"), (k, 2, j), f"branch:{mode}", after=f"modes:{edge_id}"))
+            patch = grounding_patch([edge.model_copy(update={"failures": [failure]}),
+                                     *branch_edges(graph, edge_id, failure.name, owners)])
+            jobs.append(_Job(ModelledCall("conductor", "plan", count_tokens(patch), part=f"{mode} branch grounded"),
+                             (k, 3, j), f"ground:{mode}", after=f"branch:{mode}"))
+    done = _serve(jobs, latency, busy_until=[composer_end])
+    ends = {job.key: job.end_s for job in done}
+    grounded = {(e, f): ends[f"ground:{e}/{f}"] for e, f in nominal_failures(graph)}
+    modes: dict[tuple[str, str], float] = {}
+    for (edge_id, failure), end in grounded.items():
+        # A mode can be recovered from once all its branch can reach has arrived, whichever mode brought it.
+        reach = [owners[item] for item in branch_reach(graph, edge_id, failure) if item in owners]
+        modes[(edge_id, failure)] = max([end, *(grounded[o] for o in reach)])
+    for edge in graph.recovery_edges():
+        owner = owners.get(edge.id)
+        for failure in edge.failures:
+            modes[(edge.id, failure.name)] = modes[owner] if owner is not None else composer_end
+    calls = [ScheduledCall(composer, 0.0, composer_end)]
+    calls += [ScheduledCall(job.call, job.start_s, job.end_s) for job in sorted(done, key=lambda j: (j.start_s, j.priority))]
+    edge_ready = {edge_id: ends[f"edge:{edge_id}"] for edge_id in path}
+    first = edge_ready[path[0]] if path else composer_end
+    listed = {edge_id: ends[f"modes:{edge_id}"] for edge_id in path}
+    return PlanSchedule(tuple(calls), first, edge_ready, modes, listed, owners)
+
+
+def _serve(jobs: list[_Job], latency: AnyLatencyModel, busy_until: list[float]) -> list[_Job]:
+    """List scheduling: whenever a slot is free, the released job first in need starts."""
+    slots = list(busy_until) + [0.0] * (latency.concurrency - len(busy_until))
+    pending = list(jobs)
+    ended: dict[str, float] = {}
+    done: list[_Job] = []
+    while pending:
+        for job in pending:
+            if job.release_s is None and job.after in ended:
+                job.release_s = ended[job.after]
+        released = [j for j in pending if j.release_s is not None]
+        slot = min(range(len(slots)), key=lambda i: slots[i])
+        now = max(slots[slot], min(j.release_s for j in released))
+        job = min((j for j in released if j.release_s <= now), key=lambda j: j.priority)
+        job.start_s, job.end_s = now, now + latency.price(job.call)
+        slots[slot] = job.end_s
+        ended[job.key] = job.end_s
+        pending.remove(job)
+        done.append(job)
+    return done

@@ -1,0 +1,60 @@
+"""What each agent call writes: the graph's parts as replies, and their size in tokens."""
+
+import json
+
+from agentchord.agents.replies import (
+    STREAM_ORDER,
+    branch_owners,
+    branch_reply,
+    count_tokens,
+    grounding_patch,
+    modes_reply,
+    nominal_reply,
+    streamed_edge_tokens,
+)
+from agentchord.tasks import load_task_graph
+
+
+def _graph(task="single_arm_pour_water"):
+    return load_task_graph(task)
+
+
+def test_tokens_are_characters_of_compact_json_over_four():
+    assert count_tokens("abcd") == 1 and count_tokens("abcde") == 2
+    assert count_tokens({"a": [1, 2]}) == count_tokens('{"a":[1,2]}') == 3
+
+
+def test_the_nominal_reply_streams_its_edges_before_its_nodes():
+    graph = _graph()
+    reply = nominal_reply(graph)
+    assert [k for k in reply] == [k for k in STREAM_ORDER if k in reply]
+    assert all(not e.get("failures") and e.get("kind", "nominal") == "nominal" for e in reply["edges"])
+    assert {n["id"] for n in reply["nodes"]} == {n.id for n in graph.nodes if not n.is_recovery}
+    ends = streamed_edge_tokens(graph)
+    assert list(ends) == ["e1", "e2", "e3", "e4", "e5", "e6"]
+    assert list(ends.values()) == sorted(ends.values())
+    # The first edge is readable long before the whole reply (the nodes come after the edges).
+    assert ends["e1"] < count_tokens(reply) / 5 and ends["e6"] < count_tokens(reply)
+
+
+def test_every_recovery_edge_comes_with_the_first_failure_mode_that_leads_to_it():
+    graph = _graph()
+    owners = branch_owners(graph)
+    assert set(owners) == {e.id for e in graph.recovery_edges()} | {n.id for n in graph.recovery_nodes()}
+    assert owners["e1_r_bottle_dropped"] == ("e1", "bottle_dropped")
+    # A second drop while the first regrasp carries the bottle on: part of the same branch.
+    assert owners["r_bottle_regrasped_again"] == ("e2", "bottle_dropped")
+    reply = branch_reply(graph, "e2", "bottle_dropped", owners)
+    assert reply["recovery"] == "e2_r_bottle_dropped"
+    assert "r_bottle_regrasped_again" in [e["id"] for e in reply["edges"]]
+    assert [f["name"] for f in modes_reply(graph.edge("e2"))] == ["bottle_dropped", "cup_tipped", "cup_shifted", "bottle_slipped"]
+
+
+def test_the_conductor_writes_the_values_it_grounds_not_the_structure():
+    graph = _graph()
+    patch = grounding_patch([graph.edge("e2")])
+    assert patch["e2"]["0.right.offset"] == [0.0, -0.09, 0.08] and patch["e2"]["0.right.yaw"] == 180
+    assert patch["e2"]["bottle_dropped"] == [0.0, 3]
+    assert "obj" not in json.dumps(patch)  # an object's name is structure, kept as the composer wrote it
+    grasp = graph.edge("e1").model_copy(update={"failures": []})
+    assert grounding_patch([grasp]) == {}  # nothing numeric to ground in a plain grasp

@@ -1,0 +1,73 @@
+"""When each part of the plan arrives: the sequential plan and the pipelined schedule."""
+
+import pytest
+
+from agentchord.execution.planning import composer_call, pipelined_schedule, sequential_calls
+from agentchord.execution.reasoning import LatencyModel, TokenLatencyModel
+from agentchord.graph.progress import forward_filter, nominal_path
+from agentchord.tasks import load_task_graph
+
+TASKS = ["single_arm_pour_water", "dual_arm_pour_water", "rearrange_table", "handover_block", "fold_towel", "setup_coffee_tray"]
+
+
+def _graph(task="single_arm_pour_water"):
+    return forward_filter(load_task_graph(task)).graph
+
+
+def _overlap(calls, moment):
+    return sum(1 for c in calls if c.start_s <= moment < c.end_s)
+
+
+@pytest.mark.parametrize("task", TASKS)
+def test_the_robot_moves_once_the_first_edge_is_grounded_and_parts_arrive_in_the_order_needed(task):
+    graph = _graph(task)
+    model = TokenLatencyModel()
+    schedule = pipelined_schedule(graph, model)
+    path = nominal_path(graph)
+    composer = model.price(composer_call(graph))
+    assert schedule.first_motion_s == schedule.edge_ready_s[path[0]] < composer  # read from the stream
+    assert schedule.first_motion_s < sum(model.price(c) for c in sequential_calls(graph)) / 10
+    for edge_id in path:
+        listed = schedule.modes_listed_s[edge_id]
+        assert listed >= composer  # the arranger reads the whole nominal graph
+        assert all(schedule.mode_ready_s[(edge_id, f.name)] > listed for f in graph.edge(edge_id).failures)
+    # Never more calls in flight than the model serves.
+    for call in schedule.calls:
+        assert _overlap(schedule.calls, call.start_s) <= model.concurrency
+
+
+def test_a_mode_is_ready_only_when_everything_its_branch_reaches_has_arrived():
+    graph = _graph()
+    schedule = pipelined_schedule(graph, TokenLatencyModel())
+    ends = {c.call.part: c.end_s for c in schedule.calls}
+    assert schedule.mode_ready_s[("e2", "bottle_dropped")] >= ends["e2/bottle_dropped branch grounded"]
+    # The regrasp's second drop recovers within the branch that brought it.
+    assert schedule.mode_ready_s[("r_bottle_regrasped_again", "bottle_dropped")] == schedule.mode_ready_s[("e2", "bottle_dropped")]
+
+
+def test_fewer_calls_at_once_or_a_slower_model_delay_the_branches_not_the_order():
+    graph = _graph()
+    wide = pipelined_schedule(graph, TokenLatencyModel())
+    narrow = pipelined_schedule(graph, TokenLatencyModel(concurrency=1))
+    slow = pipelined_schedule(graph, TokenLatencyModel(tokens_per_s=30.0))
+    for later in (narrow, slow):
+        assert later.branches_ready_s("e6") > wide.branches_ready_s("e6")
+    one_at_a_time = sorted(narrow.calls, key=lambda c: c.start_s)
+    assert all(a.end_s <= b.start_s + 1e-9 for a, b in zip(one_at_a_time, one_at_a_time[1:]))
+    assert slow.first_motion_s > wide.first_motion_s
+
+
+def test_a_flat_model_does_not_stream_and_the_schedule_is_deterministic():
+    graph = _graph()
+    flat = pipelined_schedule(graph, LatencyModel())
+    assert flat.first_motion_s == pytest.approx(14.0)  # the whole nominal graph (7 s), then the first edge's grounding (7 s)
+    assert pipelined_schedule(graph, LatencyModel()) == flat
+    assert [c.agent for c in sequential_calls(graph)] == ["composer", "arranger", "conductor"]
+
+
+def test_ticks_count_from_the_first_motion():
+    schedule = pipelined_schedule(_graph(), TokenLatencyModel())
+    assert schedule.tick_of(schedule.first_motion_s) == 0
+    assert schedule.tick_of(schedule.first_motion_s + 1.0) == 50
+    assert schedule.tick_of(schedule.first_motion_s + 0.011) == 1  # armed on the first tick at or after it
+    assert schedule.tick_of(0.0) == 0
