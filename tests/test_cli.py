@@ -142,3 +142,24 @@ def test_run_prints_a_recovery_that_had_nothing_left_to_do(seed, line):
     result = CliRunner().invoke(main, ["run", "single_arm_pour_water", "--protocol", "real", "--seed", str(seed)])
     assert result.exit_code == 0, result.output
     assert line in " ".join(result.output.split())  # the console wraps long lines
+
+
+class _FakeVideo:
+    """What ``_write_video`` asks of a recorder: ``path`` set, then ``write``."""
+
+    path = None
+
+    def write(self):
+        self.path.write_bytes(b"mp4")
+        return self.path
+
+
+def test_a_video_output_that_is_a_symlink_is_written_through_to_its_target(tmp_path):
+    from agentchord.cli.episode import _write_video
+
+    target, link = tmp_path / "real.mp4", tmp_path / "link.mp4"
+    target.write_bytes(b"old")
+    link.symlink_to(target)
+    _write_video(_FakeVideo(), link)
+    assert link.is_symlink() and target.read_bytes() == b"mp4"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["link.mp4", "real.mp4"]

@@ -21,6 +21,7 @@ from agentchord.cli.support import (
     REASONER_NAMES,
     BadInput,
     GuardedGroup,
+    catches_sigterm,
     check_outputs,
     check_task_name,
     failed_calls_trace,
@@ -64,6 +65,7 @@ def tasks() -> None:
 @click.option("--port", type=click.IntRange(0, 65535), default=5555, show_default=True, help="TCP port (0: any free one, printed).")
 @click.option("--host", default="127.0.0.1", show_default=True, help="Interface to listen on (0.0.0.0: every one).")
 @click.option("--seed", type=click.IntRange(0), default=0, show_default=True, help="Seed of a trial a client opens without one.")
+@catches_sigterm
 def serve(task, port, host, seed) -> None:
     """Serve TASK's simulator over the world protocol (ZeroMQ) until interrupted.
 
@@ -96,6 +98,7 @@ def serve(task, port, host, seed) -> None:
 @click.option("--render", "render_path", type=click.Path(dir_okay=False), help="Also draw it (.svg, .png, .pdf, .dot, .mmd).")
 @click.option("--trace", "trace_path", type=click.Path(dir_okay=False), help="Write the agents' calls as JSON lines.")
 @click.option("--explain", is_flag=True, help="Print the parse: clauses -> goal predicates -> skills -> graph (rules reasoner).")
+@catches_sigterm
 def plan(instruction, task, seed, goal_path, reasoner, perception, output, render_path, trace_path, explain) -> None:
     """Compose, arrange and conduct the graph for INSTRUCTION in TASK's scene; write it to --output.
 
@@ -110,7 +113,7 @@ def plan(instruction, task, seed, goal_path, reasoner, perception, output, rende
     from agentchord.worlds.sim.trial import open_world  # noqa: PLC0415
 
     check_task_name(task, "--task")
-    _check_plan_outputs(output, render_path, trace_path)
+    _check_plan_outputs(output, render_path, trace_path, goal_path)
     goal = load_goal_option(goal_path)
     if not instruction and goal is None:
         raise click.UsageError("give an INSTRUCTION or --goal")
@@ -148,8 +151,9 @@ def plan(instruction, task, seed, goal_path, reasoner, perception, output, rende
         console.print(f"trace: {trace.write(trace_path)}")
 
 
-def _check_plan_outputs(output, render_path, trace_path) -> None:
+def _check_plan_outputs(output, render_path, trace_path, goal_path=None) -> None:
     from agentchord.graph.loader import JSON_SUFFIXES, YAML_SUFFIXES  # noqa: PLC0415
     from agentchord.graph.render import FORMATS  # noqa: PLC0415
 
-    check_outputs(("-o", output, YAML_SUFFIXES + JSON_SUFFIXES), ("--render", render_path, FORMATS), ("--trace", trace_path, ()))
+    check_outputs(("-o", output, YAML_SUFFIXES + JSON_SUFFIXES), ("--render", render_path, FORMATS), ("--trace", trace_path, ()),
+                  inputs=(("--goal", goal_path),))

@@ -19,6 +19,7 @@ from agentchord.cli.support import (
     check_task_name,
     failed_calls_trace,
     load_goal_option,
+    catches_sigterm,
 )
 from agentchord.guard.outputs import atomic_write_text, finite_json
 
@@ -82,6 +83,7 @@ def _world_address(ctx, param, value: str | None) -> str | None:
 @click.option("--camera", default="front", show_default=True, help="Scene camera for --video.")
 @click.option("--world", "world", callback=_world_address, help=WORLD_HELP)
 @click.option("--rerun", "rerun_path", type=click.Path(dir_okay=False), help="Write a Rerun recording (.rrd) of the episode (docs/data.md).")
+@catches_sigterm
 def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, instruction, goal_path, reasoner, repair,
         trace_path, json_path, video_path, camera, world, rerun_path) -> None:
     """Run one episode of TASK and print its path through the graph.
@@ -96,7 +98,7 @@ def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, inst
     if world is not None and rerun_path is not None:
         raise click.UsageError("--rerun records the simulator in this process: it cannot be used with --world")
     check_outputs(("--trace", trace_path, ()), ("--json", json_path, ()), ("--video", video_path, (".mp4",)),
-                  ("--rerun", rerun_path, (".rrd",)))
+                  ("--rerun", rerun_path, (".rrd",)), inputs=(("--graph", graph_path), ("--goal", goal_path)))
     _check_camera(task, camera, video_path)
     rerun_log = open_rerun(rerun_path, task)
     graph = _load_graph_option(graph_path)
@@ -139,14 +141,19 @@ def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, inst
     spec = EpisodeSpec(task=task, strategy=strategy, p=p, seed=seed, graph=graph, disturb=disturb, protocol=protocol is not None,
                        perception=perception, instruction=instruction, goal=goal, reasoner=reasoner, repair=repair,
                        world=world)
-    result = _run_or_explain(spec, on_tick, trace_path, graph_path)
-    _print_episode(console, result)
-    _write_outputs(console, [
-        ("trace", trace_path, lambda: result.trace.write(trace_path)),
-        ("summary", json_path, lambda: atomic_write_text(json_path, finite_json(result.summary(), indent=2) + "\n")),
-        ("video", video_path if "video" in recorder else None, lambda: _write_video(recorder["video"], video_path)),
-        ("rerun", rerun_path, lambda: rerun_log.close(result)),
-    ])
+    # Ctrl-C or SIGTERM (@catches_sigterm) release the renderer; _write_video leaves no temporary file.
+    try:
+        result = _run_or_explain(spec, on_tick, trace_path, graph_path)
+        _print_episode(console, result)
+        _write_outputs(console, [
+            ("trace", trace_path, lambda: result.trace.write(trace_path)),
+            ("summary", json_path, lambda: atomic_write_text(json_path, finite_json(result.summary(), indent=2) + "\n")),
+            ("video", video_path if "video" in recorder else None, lambda: _write_video(recorder["video"], video_path)),
+            ("rerun", rerun_path, lambda: rerun_log.close(result)),
+        ])
+    finally:
+        if "video" in recorder:
+            recorder["video"].close()
     sys.exit(0 if result.success else 1)
 
 
@@ -215,24 +222,36 @@ def open_rerun(path: str | None, task: str):
 
 
 def _write_video(video, path) -> Path:
-    """Encode the video beside ``path`` and rename it over ``path``: never half an MP4."""
+    """Encode the video beside ``path`` and rename it over ``path``: never half an MP4.
+
+    A symlink is written through to its target (the link kept), as every other output is; a
+    device or FIFO (``/dev/null``) gets the bytes written into it.
+    """
     import os  # noqa: PLC0415
+    import shutil  # noqa: PLC0415
     import tempfile  # noqa: PLC0415
 
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".mp4", dir=path.parent)  # the encoder needs .mp4
+    given = Path(path)
+    special = given.exists() and not given.is_file()
+    target = Path(os.path.realpath(given))
+    folder = Path(tempfile.gettempdir()) if special else target.parent
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.stem}.", suffix=".mp4", dir=folder)  # the encoder needs .mp4
     os.close(fd)
     try:
         video.path = Path(tmp)
         video.write()
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp's file is private; a video is not
-        os.replace(tmp, path)
+        if special:
+            with open(tmp, "rb") as source, open(given, "wb") as sink:
+                shutil.copyfileobj(source, sink)
+        else:
+            umask = os.umask(0)
+            os.umask(umask)
+            os.chmod(tmp, 0o666 & ~umask)  # mkstemp's file is private; a video is not
+            os.replace(tmp, target)
     finally:
         if os.path.exists(tmp):
             os.unlink(tmp)
-    return path
+    return given
 
 
 def _write_outputs(console: Console, outputs) -> None:
@@ -325,6 +344,7 @@ def _print_episode(console: Console, result) -> None:
 @click.option("--reasoner", type=click.Choice(REASONER_NAMES), default="rules", show_default=True)
 @click.option("--json", "json_path", type=click.Path(dir_okay=False), help="Write the aggregates (and each episode's summary) as JSON.")
 @click.option("--world", "world", callback=_world_address, help=WORLD_HELP + " Episodes then run one at a time.")
+@catches_sigterm
 def demo(task, trials, first_seed, p, disturb, protocol, perception, strategies, workers, planned, instruction, reasoner, json_path,
          world) -> None:
     """Seeded episodes of each strategy under random drops, then a table per strategy."""

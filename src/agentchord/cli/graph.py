@@ -180,7 +180,7 @@ def import_release_command(
     """
     from agentchord.graph.interop import FrameMap, ReleaseImportError, import_release  # noqa: PLC0415
 
-    check_outputs(("-o", output, GRAPH_SUFFIXES))
+    check_outputs(("-o", output, GRAPH_SUFFIXES), inputs=(("TASK_GRAPH", task_graph), ("RECOVERY_SPEC", recovery_spec)))
     try:
         frame_map = FrameMap.parse(frame)
     except ValueError as error:

@@ -11,18 +11,22 @@ Exit statuses of every ``agentchord`` command:
 3     internal error: anything unexpected; one line on stderr, the traceback in a
       log file that the line names
 130   interrupted (Ctrl-C)
+143   terminated (SIGTERM, in the commands that catch it: ``run``, ``demo``, ``record``, ``serve``, ``plan``)
 ====  ==========================================================================
 """
 
 from __future__ import annotations
 
+import contextlib
 import datetime
+import functools
 import math
 import os
+import signal
 import sys
 import tempfile
 import traceback
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -36,6 +40,7 @@ EXIT_TASK_FAILED = 1
 EXIT_BAD_INPUT = 2
 EXIT_INTERNAL = 3
 EXIT_INTERRUPTED = 130  # the shell's convention for Ctrl-C (128 + SIGINT)
+EXIT_TERMINATED = 143  # 128 + SIGTERM
 
 #: Where internal-error logs go; default ``$XDG_CACHE_HOME/agentchord`` (``~/.cache/agentchord``).
 ENV_LOG_DIR = "AGENTCHORD_LOG_DIR"
@@ -79,6 +84,49 @@ def _bad_input_types() -> tuple[type[BaseException], ...]:
     return (InputError, GraphFileError, GraphNotRunnableError, RenderError, ReasonerError)
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised where the command is, so that its ``finally`` blocks (temporary files,
+    renderers, half-written episodes) run as they do for Ctrl-C."""
+
+
+@contextlib.contextmanager
+def sigterm_as_interrupt() -> Iterator[None]:
+    """While inside, SIGTERM raises :class:`Terminated` in this process (exit status 143).
+
+    A child process forked meanwhile (a worker pool) inherits the handler; there it dies of
+    SIGTERM as it would have without it.
+    """
+    owner = os.getpid()
+
+    def handler(signum: int, frame: Any) -> None:
+        if os.getpid() != owner:
+            signal.signal(signal.SIGTERM, signal.SIG_DFL)
+            os.kill(os.getpid(), signal.SIGTERM)
+            return
+        raise Terminated
+
+    try:
+        previous = signal.signal(signal.SIGTERM, handler)
+    except ValueError:  # not the main thread (a test's runner): nothing to catch
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def catches_sigterm(command: Callable[..., Any]) -> Callable[..., Any]:
+    """A command function run inside :func:`sigterm_as_interrupt` (put it under ``@click.command``)."""
+
+    @functools.wraps(command)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        with sigterm_as_interrupt():
+            return command(*args, **kwargs)
+
+    return wrapper
+
+
 class GuardedGroup(click.Group):
     """A click group whose commands never end in a traceback.
 
@@ -92,6 +140,9 @@ class GuardedGroup(click.Group):
             return super().invoke(ctx)
         except (click.exceptions.ClickException, click.exceptions.Exit, click.exceptions.Abort, SystemExit):
             raise
+        except Terminated:
+            click.echo("agentchord: terminated", err=True)
+            raise click.exceptions.Exit(EXIT_TERMINATED) from None
         except KeyboardInterrupt:
             # click would say "Aborted!" and exit 1, which means "the task failed".
             click.echo("agentchord: interrupted", err=True)
@@ -136,17 +187,26 @@ def write_error_log(error: BaseException) -> Path | None:
     return None
 
 
-def check_outputs(*outputs: tuple[str, str | Path | None, Iterable[str]]) -> None:
+def check_outputs(*outputs: tuple[str, str | Path | None, Iterable[str]],
+                  inputs: Iterable[tuple[str, str | Path | None]] = ()) -> None:
     """Check every output path before any work starts (missing folders are created).
+
+    Two outputs that name one file (``--trace out.json --json out.json``, or two spellings of
+    it, or a symlink and its target) are refused: the second would overwrite the first. So is an
+    output that names an input file (``--graph g.yaml --json g.yaml``). A device such as
+    ``/dev/null`` may be shared.
 
     Args:
         outputs: ``(option, path or None, accepted suffixes)``; ``None`` paths are skipped,
             an empty suffix list accepts any.
+        inputs: ``(option, path or None)`` of the files the command reads.
 
     Raises:
         BadInput: Every path that cannot be written, one line each.
     """
     problems = []
+    given = [(option, path) for option, path, _ in outputs if path is not None]
+    problems.extend(_shared_paths(given, [(option, path) for option, path in inputs if path is not None]))
     for option, path, suffixes in outputs:
         if path is None:
             continue
@@ -156,6 +216,34 @@ def check_outputs(*outputs: tuple[str, str | Path | None, Iterable[str]]) -> Non
             problems.append(str(error))
     if problems:
         raise BadInput("\n".join(problems))
+
+
+def _file_key(path: str | Path) -> tuple | None:
+    """What identifies the file ``path`` names (None for a device or FIFO, which many outputs may share)."""
+    if os.path.exists(path):
+        if not os.path.isfile(path):
+            return None
+        stat = os.stat(path)
+        return ("inode", stat.st_dev, stat.st_ino)  # hard links and symlinks included
+    return ("path", os.path.realpath(path))
+
+
+def _shared_paths(outputs: list[tuple[str, Any]], inputs: list[tuple[str, Any]]) -> list[str]:
+    seen: dict[tuple, str] = {}
+    problems = []
+    for option, path in inputs:
+        key = _file_key(path)
+        if key is not None:
+            seen.setdefault(key, f"the {option} input")
+    for option, path in outputs:
+        key = _file_key(path)
+        if key is None:
+            continue
+        if key in seen:
+            problems.append(f"cannot write {option} {path}: it is the same file as {seen[key]}; give each output its own path")
+        else:
+            seen[key] = option
+    return problems
 
 
 class FiniteFloatRange(click.FloatRange):

@@ -35,7 +35,7 @@ class VideoRecorder:
 
     def capture(self, caption: str = "") -> None:
         """Render the current state if this tick is filmed."""
-        if self.world.tick % self.every:
+        if self.world.tick % self.every or self.renderer is None:
             return
         self.renderer.update_scene(self.world.data, camera=self.camera)
         image = self.renderer.render()
@@ -67,5 +67,15 @@ class VideoRecorder:
         with imageio.get_writer(self.path, fps=fps, codec="libx264", quality=7, macro_block_size=8) as writer:
             for frame in self.frames:
                 writer.append_data(frame)
-        self.renderer.close()
+        self.close()
         return self.path
+
+    def close(self) -> None:
+        """Release the renderer (its GL context); a second call does nothing.
+
+        Called on an interrupted episode too: a renderer left to the interpreter's exit can
+        fail there, after the command has already said why it stopped.
+        """
+        renderer, self.renderer = self.renderer, None
+        if renderer is not None:
+            renderer.close()
