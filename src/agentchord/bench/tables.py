@@ -7,7 +7,10 @@ Pure functions: records in, rows and Markdown/CSV text out. Conventions (docs/re
   successful episodes (the paper measures it "until the task is completed"; a failed
   episode ends early and would flatter a method that gives up), with a Student-t interval;
 - steps (control ticks) over the successful episodes that saw a disturbance, the episodes
-  where recovery is what is compared.
+  where recovery is what is compared;
+- time to first motion (the reasoning and compute the robot waited for before it moved) and
+  reasoning on the critical path (all the robot held still for: before its first motion, for a
+  blocking call, for a part of a pipelined plan), over the successful episodes like time.
 """
 
 from __future__ import annotations
@@ -52,6 +55,8 @@ class Cell:
     disturbed: int
     reasoning_calls: float
     replans: float
+    first_motion_s: float | None = None
+    critical_reasoning_s: float | None = None
 
     @property
     def success_rate(self) -> float:
@@ -86,7 +91,15 @@ def cell(records: list[dict]) -> Cell:
         disturbed=len([r for r in records if r["disturbances_injected"] > 0]),
         reasoning_calls=mean(sum(r["reasoning_calls"].values()) for r in records) if records else 0.0,
         replans=mean(r["replans"] for r in records) if records else 0.0,
+        first_motion_s=_mean_of(won, "first_motion_s"),
+        critical_reasoning_s=_mean_of(won, "critical_reasoning_s"),
     )
+
+
+def _mean_of(records: list[dict], name: str) -> float | None:
+    """The mean of a field over records that have it (records written before the field lack it)."""
+    values = [r[name] for r in records if r.get(name) is not None]
+    return mean(values) if values else None
 
 
 def group(records: list[dict]) -> dict[tuple[str, str, str], Cell]:
@@ -121,6 +134,21 @@ def _steps(c: Cell | None) -> str:
     return "-" if c is None or c.steps_disturbed is None else f"{c.steps_disturbed:.0f}"
 
 
+def _seconds(value: float | None) -> str:
+    return "-" if value is None else f"{value:.1f}"
+
+
+#: Per-method column groups of a table: header prefix, cell text, the value the average row means.
+_PARTS = {
+    "success": ("Success %", _pct, lambda c: 100 * c.success_rate, "{:.1f}"),
+    "time": ("Exec. time s", _time, lambda c: c.time_s, "{:.1f}"),
+    "first": ("First motion s", lambda c: "-" if c is None else _seconds(c.first_motion_s), lambda c: c.first_motion_s, "{:.1f}"),
+    "critical": ("Critical reasoning s", lambda c: "-" if c is None else _seconds(c.critical_reasoning_s),
+                 lambda c: c.critical_reasoning_s, "{:.1f}"),
+    "steps": ("Steps", _steps, lambda c: c.steps_disturbed, "{:.0f}"),
+}
+
+
 def markdown_table(header: list[str], rows: list[list[str]]) -> str:
     """A Markdown table."""
     lines = ["| " + " | ".join(header) + " |", "|" + "|".join("---" for _ in header) + "|"]
@@ -128,35 +156,30 @@ def markdown_table(header: list[str], rows: list[list[str]]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _average_row(cells: dict, keys: list[tuple[str, str]], methods: list[str], parts) -> list[str]:
-    """Mean over the table's rows of each method's success, time and steps (blank where a row lacks it)."""
-    row = ["Average", ""] if parts[0] == "cond" else ["Average"]
-    for part in parts[1:]:
+def _average_row(cells: dict, keys: list[tuple[str, str]], methods: list[str], parts: list[str], with_condition: bool) -> list[str]:
+    """Mean over the table's rows of each method's figures (blank where no row has one)."""
+    row = ["Average", ""] if with_condition else ["Average"]
+    for part in parts:
+        _, _, value, form = _PARTS[part]
         for method in methods:
             found = [cells.get((task, cond, method)) for task, cond in keys]
-            found = [c for c in found if c is not None]
-            if part == "success":
-                row.append(f"{100 * mean(c.success_rate for c in found):.1f}" if found else "-")
-            elif part == "time":
-                times = [c.time_s for c in found if c.time_s is not None]
-                row.append(f"{mean(times):.1f}" if times else "-")
-            else:
-                steps = [c.steps_disturbed for c in found if c.steps_disturbed is not None]
-                row.append(f"{mean(steps):.0f}" if steps else "-")
+            values = [value(c) for c in found if c is not None]
+            values = [v for v in values if v is not None]
+            row.append(form.format(mean(values)) if values else "-")
     return row
 
 
 def table_layout(records: list[dict], methods: list[str] | None = None, with_steps: bool = True,
-                 with_condition: bool = True) -> tuple[list[str], list[list[str]]]:
-    """Rows in the paper's layout: a row per task (and condition), success | time | steps per method."""
+                 with_condition: bool = True, with_timing: bool = True) -> tuple[list[str], list[list[str]]]:
+    """Rows in the paper's layout: a row per task (and condition), per method success | time (| time to first
+    motion | reasoning on the critical path) (| steps)."""
     cells = group(records)
     methods = ordered({m for _, _, m in cells} if methods is None else methods, METHODS)
     tasks = ordered({t for t, _, _ in cells}, list(TASK_TITLES))
     conditions = sorted({c for _, c, _ in cells}, key=lambda label: (label.startswith("protocol"), label))
+    parts = ["success", "time"] + (["first", "critical"] if with_timing else []) + (["steps"] if with_steps else [])
     header = ["Task"] + (["Condition"] if with_condition else [])
-    header += [f"Success % {SHORT.get(m, m)}" for m in methods] + [f"Exec. time s {SHORT.get(m, m)}" for m in methods]
-    if with_steps:
-        header += [f"Steps {SHORT.get(m, m)}" for m in methods]
+    header += [f"{_PARTS[part][0]} {SHORT.get(m, m)}" for part in parts for m in methods]
     rows, keys = [], []
     for task in tasks:
         for condition in conditions:
@@ -164,20 +187,16 @@ def table_layout(records: list[dict], methods: list[str] | None = None, with_ste
                 continue
             keys.append((task, condition))
             row = [TASK_TITLES.get(task, task)] + ([condition] if with_condition else [])
-            row += [_pct(cells.get((task, condition, m))) for m in methods]
-            row += [_time(cells.get((task, condition, m))) for m in methods]
-            if with_steps:
-                row += [_steps(cells.get((task, condition, m))) for m in methods]
+            row += [_PARTS[part][1](cells.get((task, condition, m))) for part in parts for m in methods]
             rows.append(row)
-    parts = ["cond" if with_condition else "task", "success", "time"] + (["steps"] if with_steps else [])
-    rows.append(_average_row(cells, keys, methods, parts))
+    rows.append(_average_row(cells, keys, methods, parts, with_condition))
     return header, rows
 
 
 def table_markdown(records: list[dict], title: str, caption: str, methods: list[str] | None = None,
-                   with_steps: bool = True, with_condition: bool = True) -> str:
+                   with_steps: bool = True, with_condition: bool = True, with_timing: bool = True) -> str:
     """A titled Markdown table with its caption (the latency model, the intervals)."""
-    header, rows = table_layout(records, methods, with_steps, with_condition)
+    header, rows = table_layout(records, methods, with_steps, with_condition, with_timing)
     return f"### {title}\n\n{markdown_table(header, rows)}\n{caption}\n"
 
 
@@ -187,7 +206,8 @@ def summary_csv(records: list[dict]) -> str:
     writer = csv.writer(out)
     writer.writerow(["task", "condition", "method", "episodes", "successes", "success_rate", "success_ci_low", "success_ci_high",
                      "exec_time_s", "exec_time_ci_low", "exec_time_ci_high", "robot_time_s", "reasoning_s",
-                     "steps_disturbed_success", "episodes_disturbed", "reasoning_calls", "replans"])
+                     "steps_disturbed_success", "episodes_disturbed", "reasoning_calls", "replans", "first_motion_s",
+                     "critical_reasoning_s"])
     for (task, condition, method), c in sorted(group(records).items(), key=lambda item: (
             list(TASK_TITLES).index(item[0][0]) if item[0][0] in TASK_TITLES else 99, item[0][1],
             METHODS.index(item[0][2]) if item[0][2] in METHODS else 99)):
@@ -195,7 +215,8 @@ def summary_csv(records: list[dict]) -> str:
             return "" if x is None else round(x, digits)
         writer.writerow([task, condition, method, c.n, c.successes, r(c.success_rate), r(c.success_ci[0]), r(c.success_ci[1]),
                          r(c.time_s), r(c.time_ci[0] if c.time_ci else None), r(c.time_ci[1] if c.time_ci else None),
-                         r(c.robot_time_s), r(c.reasoning_s), r(c.steps_disturbed, 1), c.disturbed, r(c.reasoning_calls, 2), r(c.replans, 2)])
+                         r(c.robot_time_s), r(c.reasoning_s), r(c.steps_disturbed, 1), c.disturbed, r(c.reasoning_calls, 2), r(c.replans, 2),
+                         r(c.first_motion_s), r(c.critical_reasoning_s)])
     return out.getvalue()
 
 

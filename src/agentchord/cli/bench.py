@@ -216,6 +216,12 @@ def write_report(records: list[dict], out: Path, config, console: Console | None
         write(out / "tables" / "paired.csv", paired_csv(records))
         if console is not None:
             console.print(paired, markup=False, highlight=False)
+    from agentchord.bench.pipeline import decomposition_markdown, early_failures_markdown  # noqa: PLC0415
+
+    timing = decomposition_markdown(records) + "\n" + early_failures_markdown(records)
+    write(out / "tables" / "timing.md", timing)
+    if console is not None:
+        console.print(timing, markup=False, highlight=False)
     if config.reasoner == "rules" and len(methods) > 1:
         # Modelled latencies only: a measured LLM call has no price to scale.
         from agentchord.bench.latency import latency_csv, latency_markdown  # noqa: PLC0415

@@ -33,6 +33,7 @@ from agentchord.execution.planning import PlanSchedule
 from agentchord.expr import Vocabulary
 from agentchord.graph.models import FailureMode, TaskGraph
 from agentchord.monitor import Detection, EdgeMonitors
+from agentchord.worlds.protocol import CONTROL_HZ
 
 if TYPE_CHECKING:
     from agentchord.execution.trace import Trace
@@ -69,6 +70,7 @@ class Waiting:
         what: ``branch`` (its failure modes and recovery branches) or ``grounding`` (the edge itself).
         failure: What fired before the branch (None when waiting for a grounding).
         then: Called when it arrives: the episode's outcome, or None to go on.
+        began: The tick this leg of the wait began (a failure may wait for the modes' list, then a branch).
     """
 
     until: int
@@ -77,6 +79,11 @@ class Waiting:
     what: str
     failure: str | None
     then: Callable[[], tuple[bool, str] | None]
+    began: int = -1
+
+    def __post_init__(self) -> None:
+        if self.began < 0:
+            self.began = self.since
 
 
 class PlanArrivals:
@@ -115,7 +122,7 @@ class PlanArrivals:
             self.trace.add(self.world.tick, "reasoning", kind=call.kind, agent=call.agent, part=call.part, tokens=call.tokens,
                            start_s=round(scheduled.start_s, 4), end_s=round(scheduled.end_s, 4),
                            latency_s=round(scheduled.end_s - scheduled.start_s, 4), measured=False,
-                           arrives_tick=schedule.tick_of(scheduled.end_s), critical=scheduled.end_s <= schedule.first_motion_s)
+                           arrives_tick=schedule.tick_of(scheduled.end_s), critical=call.part in schedule.critical)
 
     # ------------------------------------------------------------ queries
     def _tick_at(self, seconds: float | None) -> int | None:
@@ -138,6 +145,10 @@ class PlanArrivals:
         ticks = [self._mode_tick(edge_id, f.name) for f in self.graph.edge(edge_id).failures] if edge_id in self.monitors else []
         ticks.append(self._tick_at(self.schedule.modes_listed_s.get(edge_id)))
         return sorted(t for t in ticks if t is not None)
+
+    def _listed_tick(self, edge_id: str) -> int | None:
+        """The tick the arranger's list of ``edge_id``'s failure modes arrives, if still to come."""
+        return self._tick_at(self.schedule.modes_listed_s.get(edge_id)) if self.schedule is not None else None
 
     def branch_pending(self, edge_id: str) -> bool:
         """Whether some failure mode of ``edge_id`` (its monitor or branch) is still to come."""
@@ -186,14 +197,17 @@ class PlanArrivals:
         """Wait for the branch of a failure that fired before it arrived (True when it waits).
 
         A mode that fires before its branch (a strategy's detection) waits for its own branch. A derived
-        monitor (``keeps: ...``) is the mode of its edge that watches the same constraint, if the
-        arranger wrote one: it waits for that mode and switches to its recovery then, as if that mode
-        had fired (it would have, had it been there). Otherwise it waits for every mode of the edge and
-        asks them what the scene is: one that reads it violated switches to its recovery, else the
-        edge goes on.
+        monitor (``keeps: ...``) first waits for the arranger's list of the edge's modes, if it has not
+        come; then it is the mode that watches the same constraint, if there is one: it waits for that
+        mode's branch and switches to its recovery then, as if the mode had fired (it would have, had it
+        been there). Otherwise it waits for every mode of the edge and asks them what the scene is: one
+        that reads it violated switches to its recovery, else the edge goes on.
         """
         derived = detection.failure.intent == DERIVED_INTENT
-        if derived:
+        listed = self._listed_tick(detection.edge_id) if derived else None
+        if listed is not None:
+            until = listed  # which modes the edge has is not known yet
+        elif derived:
             watching = self.as_arranged(detection)
             if watching is not detection:
                 return self._early_failure(watching, suspended, since)
@@ -208,6 +222,14 @@ class PlanArrivals:
 
         def arrived() -> tuple[bool, str] | None:
             self.program = suspended
+            if listed is not None:  # the edge's modes are known now: the one watching this constraint, or all
+                watching = self.as_arranged(detection)
+                self.trace.add(self.world.tick, "modes_listed", edge=detection.edge_id, failure=detection.failure.name,
+                               taken_as=watching.failure.name if watching is not detection else None)
+                if self._early_failure(detection, suspended, since):
+                    return None
+                self._arrived(f"recovery for {watching.failure.name}", since)
+                return self._on_failure(detection)
             if not derived:
                 self._arrived(f"recovery for {detection.failure.name}", since)
                 return self._on_failure(detection)
@@ -225,13 +247,13 @@ class PlanArrivals:
             self.trace.add(self.world.tick, "failure_before_branch", edge=detection.edge_id, failure=detection.failure.name,
                            arrives_tick=until)
         self.program, self.armed = None, None
-        self.waiting = Waiting(until, since, detection.edge_id, "branch", detection.failure.name, arrived)
+        self.waiting = Waiting(until, since, detection.edge_id, "branch", detection.failure.name, arrived, self.world.tick)
         return True
 
     def as_arranged(self, detection: Detection) -> Detection:
         """A derived monitor's detection as the arranger's mode of its edge that reads the same constraint, if
         there is one (the mode would have fired, had it been there); any other detection as it is."""
-        if detection.failure.intent != DERIVED_INTENT:
+        if detection.failure.intent != DERIVED_INTENT or self._listed_tick(detection.edge_id) is not None:
             return detection
         constraint = " ".join(detection.failure.monitor.split())
         for failure in self.graph.edge(detection.edge_id).failures:
@@ -288,9 +310,15 @@ class PlanArrivals:
         if waiting is None:
             return False
         if self.world.tick < waiting.until:
-            self.plan_wait_ticks += 1
             self._step()
             return None
+        self.plan_wait_ticks += self.world.tick - waiting.began
         self.waiting, self._arriving = None, waiting
         outcome = waiting.then()
         return False if outcome is None else outcome
+
+    @property
+    def plan_wait_s(self) -> float:
+        """Seconds the robot held still for parts of the plan, the wait under way included."""
+        ongoing = self.world.tick - self.waiting.began if self.waiting is not None else 0
+        return (self.plan_wait_ticks + ongoing) / CONTROL_HZ

@@ -252,7 +252,7 @@ class Executor(RecoverySwitching, PlanArrivals):
             reaction_latency_s=self.disturbances.latency_s,
             replans=self.replans,
             first_motion_s=first_motion_s,
-            plan_wait_s=self.plan_wait_ticks / CONTROL_HZ,
+            plan_wait_s=self.plan_wait_s,
             early_failures=self.early_failures,
         )
         self.trace.add(self.world.tick, "episode_end", success=success, reason=reason, steps=result.steps)

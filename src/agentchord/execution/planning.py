@@ -9,8 +9,8 @@ its first. The composer's reply streams, edges first (:data:`~agentchord.agents.
 as soon as an edge has streamed, the conductor grounds it. Once the nominal graph is whole, the
 arranger is asked per edge for its failure modes, then per mode for its recovery branch, and the
 conductor grounds each branch as it comes. The calls are served as the model allows
-(``concurrency`` at once), in the order the robot needs them: edge k's grounding, its modes and
-their branches before edge k+1's. The robot moves once the first edge is grounded; every other part
+(``concurrency`` at once), in the order the robot needs them: the edges' groundings, then edge
+k's modes and their branches before edge k+1's. The robot moves once the first edge is grounded; every other part
 arrives while it moves, as an event on the episode's clock (:class:`PlanSchedule`). A failure mode
 is armed once its branch, and whatever the branch can reach (a second failure while recovering may
 enter another mode's branch), has arrived grounded.
@@ -79,6 +79,7 @@ class PlanSchedule:
             modes come with the branch that brings the edge.
         modes_listed_s: Nominal edge id -> when the arranger's list of its failure modes has arrived.
         owners: Recovery edge or node id -> the (nominal edge, failure mode) whose branch brings it.
+        critical: The parts the first motion waited for (the composer's stream, the first edge's grounding).
     """
 
     calls: tuple[ScheduledCall, ...]
@@ -87,6 +88,7 @@ class PlanSchedule:
     mode_ready_s: dict[tuple[str, str], float]
     modes_listed_s: dict[str, float] = field(default_factory=dict)
     owners: dict[str, tuple[str, str]] = field(default_factory=dict)
+    critical: tuple[str, ...] = ()
 
     def tick_of(self, seconds: float) -> int:
         """The control tick (counted from the first motion) at which a part arriving at ``seconds`` is armed."""
@@ -112,8 +114,9 @@ class _Job:
 def pipelined_schedule(graph: TaskGraph, latency: AnyLatencyModel) -> PlanSchedule:
     """The pipelined plan of ``graph``: each call's start and end, and when each part is armed.
 
-    Calls, in the order the robot needs them (edge by edge): the edge's grounding, the list of its
-    failure modes, then per mode its branch and the branch's grounding. A call starts when what it
+    Calls, in the order the robot needs them: the nominal edges' groundings first (without them the
+    robot cannot go on; without a branch it can), then edge by edge the list of its failure modes,
+    per mode its branch and the branch's grounding. A call starts when what it
     reads has arrived and the model has a free slot (``latency.concurrency`` at once; the composer
     holds one while it streams); among the calls ready, the first in need goes first. A flat latency
     model does not stream: every edge arrives with the whole nominal graph.
@@ -129,17 +132,17 @@ def pipelined_schedule(graph: TaskGraph, latency: AnyLatencyModel) -> PlanSchedu
         edge = graph.edge(edge_id)
         nominal = edge.model_copy(update={"failures": []})
         jobs.append(_Job(ModelledCall("conductor", "plan", count_tokens(grounding_patch([nominal])), part=f"{edge_id} grounded"),
-                         (k, 0), f"edge:{edge_id}", release_s=min(at, composer_end)))
+                         (0, k), f"edge:{edge_id}", release_s=min(at, composer_end)))
         jobs.append(_Job(ModelledCall("arranger", "plan", count_tokens(modes_reply(edge)), part=f"{edge_id} failure modes"),
-                         (k, 1), f"modes:{edge_id}", release_s=composer_end))
+                         (1, k, 0), f"modes:{edge_id}", release_s=composer_end))
         for j, failure in enumerate(edge.failures):
             mode = f"{edge_id}/{failure.name}"
             jobs.append(_Job(ModelledCall("arranger", "plan", count_tokens(branch_reply(graph, edge_id, failure.name, owners)),
-                                          part=f"{mode} branch"), (k, 2, j), f"branch:{mode}", after=f"modes:{edge_id}"))
+                                          part=f"{mode} branch"), (1, k, 1, j), f"branch:{mode}", after=f"modes:{edge_id}"))
             patch = grounding_patch([edge.model_copy(update={"failures": [failure]}),
                                      *branch_edges(graph, edge_id, failure.name, owners)])
             jobs.append(_Job(ModelledCall("conductor", "plan", count_tokens(patch), part=f"{mode} branch grounded"),
-                             (k, 3, j), f"ground:{mode}", after=f"branch:{mode}"))
+                             (1, k, 2, j), f"ground:{mode}", after=f"branch:{mode}"))
     done = _serve(jobs, latency, busy_until=[composer_end])
     ends = {job.key: job.end_s for job in done}
     grounded = {(e, f): ends[f"ground:{e}/{f}"] for e, f in nominal_failures(graph)}
@@ -157,7 +160,8 @@ def pipelined_schedule(graph: TaskGraph, latency: AnyLatencyModel) -> PlanSchedu
     edge_ready = {edge_id: ends[f"edge:{edge_id}"] for edge_id in path}
     first = edge_ready[path[0]] if path else composer_end
     listed = {edge_id: ends[f"modes:{edge_id}"] for edge_id in path}
-    return PlanSchedule(tuple(calls), first, edge_ready, modes, listed, owners)
+    critical = (composer.part, f"{path[0]} grounded") if path else (composer.part,)
+    return PlanSchedule(tuple(calls), first, edge_ready, modes, listed, owners, critical)
 
 
 def _serve(jobs: list[_Job], latency: AnyLatencyModel, busy_until: list[float]) -> list[_Job]:

@@ -1,0 +1,81 @@
+"""A pipelined plan arriving while the robot moves: monitors armed as they arrive, failures that come first wait."""
+
+import copy
+
+import pytest
+
+from agentchord.execution.episode import EpisodeSpec, run_episode
+from agentchord.execution.reasoning import ReasoningConfig, TokenLatencyModel
+from agentchord.worlds.sim.disturbances import ScriptedDisturbance, ScriptedDrop
+
+TASK = "single_arm_pour_water"
+
+
+def _run(strategy="agentchord", disturbance=None, seed=1, **latency):
+    reasoning = ReasoningConfig(latency=TokenLatencyModel(**latency))
+    return run_episode(EpisodeSpec(TASK, strategy=strategy, seed=seed, disturbance=copy.deepcopy(disturbance), reasoning=reasoning))
+
+
+def _events(result, *names):
+    return [(e["tick"], e["event"], e.get("edge"), e.get("failure")) for e in result.trace.events if e["event"] in names]
+
+
+def test_monitors_are_armed_as_their_modes_arrive_and_an_undisturbed_episode_is_unchanged():
+    pipelined, sequential = _run(), _run("agentchord-sequential")
+    assert pipelined.success and pipelined.steps == sequential.steps and pipelined.early_failures == []
+    armed = pipelined.trace.of("monitors_armed")
+    assert armed and all(e["tick"] > 0 for e in armed)
+    # Parts arrive in the order the robot needs them: every call is on the clock, few before the first motion.
+    calls = pipelined.trace.of("reasoning")
+    critical = [c for c in calls if c["critical"]]
+    assert [c["agent"] for c in critical] == ["composer", "conductor"] and len(calls) > 20
+    assert pipelined.exec_time_s < sequential.exec_time_s - 30
+
+
+@pytest.mark.parametrize("disturbance,edge", [
+    (ScriptedDrop("move_to_obj", after=30), "e2"),
+    (ScriptedDrop("rotate_eef", after=10), "e3"),
+    (ScriptedDisturbance("move_to_obj", "pull", after=30), "e2"),
+])
+def test_a_failure_before_its_branch_waits_for_it_then_recovers_as_the_sequential_plan_does(disturbance, edge):
+    pipelined, sequential = _run(disturbance=disturbance), _run("agentchord-sequential", disturbance=disturbance)
+    assert pipelined.success and sequential.success
+    (early,) = pipelined.early_failures
+    before, arrived = pipelined.trace.of("failure_before_branch")[0], pipelined.trace.of("branch_arrived")[0]
+    # The hold the edge keeps (a monitor derived from its own constraints) fired; once the arranger's list
+    # of the edge's modes came, it is the mode that watches the same hold, which recovers once its branch
+    # is here, from where things are then.
+    assert before["edge"] == edge
+    if before["failure"] != "bottle_dropped":  # the list had not come yet
+        assert before["failure"] == "keeps: 0.5 - holding(right, bottle)"
+        (listed,) = pipelined.trace.of("modes_listed")
+        assert listed["tick"] == before["arrives_tick"] <= arrived["tick"] and listed["taken_as"] == "bottle_dropped"
+    assert early["waited_ticks"] == arrived["tick"] - before["tick"] > 0
+    assert early["then"] == "recovery for bottle_dropped"
+    switch = pipelined.trace.of("recovery_switch")[0]
+    assert switch["tick"] == arrived["tick"] and switch["to"] == sequential.trace.of("recovery_switch")[0]["to"]
+    # The sequential plan detected it at the same tick and switched at once.
+    assert sequential.trace.of("failure_detected")[0]["tick"] == before["tick"]
+    assert pipelined.plan_wait_s == pytest.approx(early["waited_ticks"] / 50)
+
+
+def test_a_faster_model_leaves_no_failure_waiting():
+    drop = ScriptedDrop("move_to_obj", after=30)
+    fast = _run(disturbance=drop, tokens_per_s=5000.0, ttft_s=0.01)
+    assert fast.success and fast.early_failures == [] and fast.plan_wait_s == 0.0
+
+
+def test_the_same_seed_gives_the_same_pipelined_episode():
+    drop = ScriptedDrop("move_to_obj", after=30)
+    first, second = _run(disturbance=drop), _run(disturbance=drop)
+    assert first.trace.events == second.trace.events
+    first, second = _run(seed=4), _run(seed=4)
+    assert first.trace.events == second.trace.events
+
+
+def test_an_edge_not_grounded_yet_when_the_robot_gets_there_waits_for_it():
+    # One call at a time at 2 tokens/s: each edge's grounding takes longer than the edge before it.
+    result = _run(concurrency=1, tokens_per_s=2.0)
+    grounded = result.trace.of("edge_grounded")
+    assert result.success and grounded and all(e["waited_ticks"] > 0 for e in grounded)
+    assert result.plan_wait_s >= sum(e["waited_ticks"] for e in grounded) / 50
