@@ -4,7 +4,8 @@ The robot starts once the first edge is grounded (:mod:`agentchord.execution.pla
 of the plan arrives at ticks of the episode. Until an edge's failure modes and branches have
 arrived, the edge runs with what needs no reasoner: **monitors derived from its own constraints**
 -- each constraint its source and target nodes share (what is held stays held; what stands stays
-standing) and each of its path constraints, as a monitor with the default persistence window.
+standing), each of its path constraints, and the hold of what its own grasps take once the gripper
+has closed, each as a monitor with the default persistence window.
 The arranger's other monitors (a cup drifting, a bottle slipping in the hand) are armed when they
 arrive; the persistence history starts then.
 
@@ -46,14 +47,19 @@ DERIVED_INTENT = "wait for the arranger's branch"
 def derived_monitors(graph: TaskGraph, vocabulary: Vocabulary) -> dict[str, EdgeMonitors]:
     """Per nominal edge, monitors of the constraints it must keep, known before any arranger reply.
 
-    A constraint both ends of the edge share (the same text, spaces aside) must hold all along it;
-    a path constraint must too. Each is a failure mode named ``keeps: <constraint>``.
+    A constraint both ends of the edge share (the same text, spaces aside) must hold all along it; a
+    path constraint must too; and what one of the edge's grasps takes stays in that hand once its
+    gripper has closed (``arm.closed * (0.5 - holding(arm, obj))``, the grasp-done signal gating
+    the hold). Each is a failure mode named ``keeps: <constraint>``.
     """
     out = {}
     for edge in graph.nominal_edges():
         source = {" ".join(c.split()): c for c in graph.node(edge.source).constraints}
         shared = [source[key] for key in (" ".join(c.split()) for c in graph.node(edge.target).constraints) if key in source]
-        kept = list(dict.fromkeys([*shared, *edge.path_constraints]))
+        # What the edge's own grasps take stays in the hand once the gripper has closed on it.
+        grasped = [f"{arm}.closed * (0.5 - holding({arm}, {call.args['obj']}))" for arm, call in edge.calls
+                   if call.fn == "grasp" and isinstance(call.args.get("obj"), str)]
+        kept = list(dict.fromkeys([*shared, *edge.path_constraints, *grasped]))
         failures = [FailureMode(name=f"keeps: {c}", monitor=c, intent=DERIVED_INTENT, recovery=edge.id) for c in kept]
         out[edge.id] = EdgeMonitors.compile(edge.model_copy(update={"failures": failures}), vocabulary)
     return out
