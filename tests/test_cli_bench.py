@@ -8,6 +8,7 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
 from click.testing import CliRunner
 
 from agentchord.cli import main
@@ -120,8 +121,10 @@ def test_an_llm_sweep_plans_every_episode_and_charges_what_the_calls_measured(tm
         assert len(server.requests) == 3  # composer, arranger, conductor
     (record,) = [json.loads(line) for line in (out / "records.jsonl").read_text().splitlines()]
     assert record["success"], record["reason"]
-    # Three measured calls of about 0.2 s each, not three modelled 7 s ones.
-    assert 0.5 <= record["reasoning_s"] < 5.0, record["reasoning_s"]
+    # AgentChord's plan is pipelined: the robot waited for the composer's measured call (about 0.2 s), not for
+    # modelled ones; the arranger and conductor answered while it moved.
+    assert 0.15 <= record["reasoning_s"] < 2.0, record["reasoning_s"]
+    assert record["first_motion_s"] == pytest.approx(record["reasoning_s"] + record["compute_s"], abs=1e-3)
     assert json.loads((out / "sweep.json").read_text())["reasoner"] == "llm"
     assert "planning calls measured" in " ".join(result.output.split())
 

@@ -77,10 +77,45 @@ def plan_task(instruction: str, scene: Scene, reasoner: Reasoner, task: str = ""
 
 
 def _plan(instruction: str, scene: Scene, reasoner: Reasoner, task: str, first: int) -> PlanResult:
-    seconds: dict[str, float] = {}
     start = time.perf_counter()
     nominal = reasoner.compose(ComposeRequest(instruction=instruction, scene=scene, task=task))
-    seconds["composer"] = time.perf_counter() - start
+    composed = time.perf_counter() - start
+    result = _augment(nominal, scene, reasoner, first)
+    result.seconds = {"composer": composed, **result.seconds}
+    return result
+
+
+def compose_task(instruction: str, scene: Scene, reasoner: Reasoner, task: str = "") -> TaskGraph:
+    """The composer alone: the nominal graph a pipelined plan starts the robot on.
+
+    Raises:
+        ReasonerError: No valid nominal graph (the refused replies travel with the error).
+    """
+    first = len(reasoner.calls)
+    try:
+        return reasoner.compose(ComposeRequest(instruction=instruction, scene=scene, task=task))
+    except ReasonerError as error:
+        error.calls = list(reasoner.calls[first:])
+        raise
+
+
+def augment_task(nominal: TaskGraph, scene: Scene, reasoner: Reasoner) -> PlanResult:
+    """The arranger (then the forward-moving filter) and the conductor on a composed graph: the rest of
+    a pipelined plan, asked while the robot moves.
+
+    Raises:
+        ReasonerError: An agent could not produce a valid graph.
+    """
+    first = len(reasoner.calls)
+    try:
+        return _augment(nominal, scene, reasoner, first)
+    except ReasonerError as error:
+        error.calls = list(reasoner.calls[first:])
+        raise
+
+
+def _augment(nominal: TaskGraph, scene: Scene, reasoner: Reasoner, first: int) -> PlanResult:
+    seconds: dict[str, float] = {}
     start = time.perf_counter()
     arranged = reasoner.arrange(ArrangeRequest(graph=nominal, scene=scene))
     filtered = forward_filter(arranged)

@@ -29,10 +29,12 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
+from agentchord.execution.background import ScriptedPlan, ThreadedPlan
 from agentchord.execution.edge_program import EdgeProgram
 from agentchord.execution.planning import PlanSchedule
 from agentchord.expr import Vocabulary
 from agentchord.graph.models import FailureMode, TaskGraph
+from agentchord.graph.progress import forward_filter, nominal_path
 from agentchord.monitor import Detection, EdgeMonitors
 from agentchord.worlds.protocol import CONTROL_HZ
 
@@ -42,6 +44,8 @@ if TYPE_CHECKING:
 
 #: The intent of a derived monitor's failure: there is no recovery before the arranger's arrives.
 DERIVED_INTENT = "wait for the arranger's branch"
+#: Seconds standing for "not known yet": the parts of a background plan before its reply is in.
+UNKNOWN_S = 1e9
 
 
 def derived_monitors(graph: TaskGraph, vocabulary: Vocabulary) -> dict[str, EdgeMonitors]:
@@ -112,6 +116,10 @@ class PlanArrivals:
     plan_wait_ticks: int
     _derived: dict[str, EdgeMonitors]
     frame: Any
+    background: ThreadedPlan | ScriptedPlan | None
+    _incoming: tuple[int, TaskGraph] | None
+    compute_s: float
+    _compile: Callable[[TaskGraph], None]
     _on_failure: Callable[[Detection], tuple[bool, str] | None]
     _on_program_failed: Callable[[], tuple[bool, str] | None]
     _start: Callable[[EdgeProgram], None]
@@ -129,6 +137,45 @@ class PlanArrivals:
                            start_s=round(scheduled.start_s, 4), end_s=round(scheduled.end_s, 4),
                            latency_s=round(scheduled.end_s - scheduled.start_s, 4), measured=False,
                            arrives_tick=schedule.tick_of(scheduled.end_s), critical=call.part in schedule.critical)
+
+    def follow_background(self) -> None:
+        """Start the robot on the composed graph and ask the rest of the plan in the background
+        (:mod:`agentchord.execution.background`): every mode arrives with its reply, whenever that is."""
+        first = self.reasoning_s + self.compute_s
+        path = nominal_path(self.graph)
+        self.schedule = PlanSchedule((), first, {e: first for e in path}, {}, {e: first + UNKNOWN_S for e in path})
+        self.background.start()
+        self.trace.add(self.world.tick, "plan_asked", agents=["arranger", "conductor"], first_motion_s=round(first, 4))
+
+    def _poll_background(self) -> None:
+        """Take the background plan's reply when it is in, and adopt its graph at the tick it arrives."""
+        if self.background is not None:
+            arrival = self.background.poll(self.world.tick / CONTROL_HZ)
+            if arrival is not None:
+                self.background = None
+                self._received(arrival)
+        if self._incoming is not None and self.world.tick >= self._incoming[0]:
+            graph, self._incoming = self._incoming[1], None
+            self._compile(graph)
+            self.trace.add(self.world.tick, "plan_arrived", failures=len(graph.failures()), recovery_edges=len(graph.recovery_edges()))
+
+    def _received(self, arrival) -> None:
+        schedule = self.schedule
+        at = schedule.first_motion_s + arrival.latency_s
+        tick = schedule.tick_of(at)
+        self.trace.add(self.world.tick, "plan_replied", latency_s=round(arrival.latency_s, 4), arrives_tick=tick,
+                       error=arrival.error, calls=[c.to_trace_event(messages=False) for c in arrival.calls])
+        listed = {edge_id: at for edge_id in schedule.modes_listed_s}
+        modes: dict[tuple[str, str], float] = {}
+        if arrival.graph is not None:
+            graph = forward_filter(arrival.graph).graph
+            modes = {(edge.id, failure.name): at for edge, failure in graph.failures()}
+            self._incoming = (tick, graph)
+        self.schedule = PlanSchedule(schedule.calls, schedule.first_motion_s, schedule.edge_ready_s, modes, listed)
+        if self.waiting is not None:
+            self.waiting.until = min(self.waiting.until, tick)
+        if self._early_armed is not None:
+            self._rearm_tick = min(self._rearm_tick, tick)
 
     # ------------------------------------------------------------ queries
     def _tick_at(self, seconds: float | None) -> int | None:

@@ -47,6 +47,7 @@ class ExecutionContext(Protocol):
     visited_nominal: list[str]
     keyframes: dict[str, dict[str, tuple[np.ndarray, float]]]
     compute_s: float
+    background: object | None
 
     def charge(self, kind: str, agent: str, latency_s: float, measured: bool = False, compute_s: float = 0.0,
                tokens: int | None = None) -> None:
@@ -55,6 +56,10 @@ class ExecutionContext(Protocol):
 
     def follow_schedule(self, schedule: PlanSchedule) -> None:
         """Plan with a pipelined schedule: the robot moves at its first motion, the rest arrives at its ticks."""
+        ...
+
+    def follow_background(self) -> None:
+        """Start on the composed graph; the rest of the plan is asked in the background."""
         ...
 
     def constraints_hold(self, node_id: str) -> bool:

@@ -6,14 +6,15 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from agentchord.agents.observe import observe, task_regions
-from agentchord.agents.pipeline import ReasonerRepairer, Replanner, make_reasoner, plan_task
+from agentchord.agents.pipeline import ReasonerRepairer, Replanner, augment_task, compose_task, make_reasoner, plan_task
 from agentchord.agents.scene import Scene
 from agentchord.agents.rules.goals import GoalSpec
 from agentchord.execution.baselines.progress import GoalEvents
+from agentchord.execution.background import ScriptedPlan, ThreadedPlan
 from agentchord.execution.baselines.strategies import BaselineContext
 from agentchord.execution.executor import Executor, ExecutorConfig
 from agentchord.execution.harness import SuccessTracker
-from agentchord.execution.methods import is_baseline, make_method
+from agentchord.execution.methods import PIPELINED_METHODS, is_baseline, make_method
 from agentchord.execution.reasoning import ReasoningConfig
 from agentchord.execution.repair import Repairer
 from agentchord.execution.result import EpisodeResult
@@ -54,6 +55,8 @@ class EpisodeSpec:
             AgentChord's strategies, the defaults for the baselines).
         world: The address of a world served by another process (``tcp://host:port``, see
             ``agentchord serve``); None: the simulator in this process. Same seed, same episode.
+        background: The rest of a pipelined plan, known in advance (``graph`` is then the composed
+            graph the robot starts on): an LLM episode's latencies replayed offline.
     """
 
     task: str
@@ -73,6 +76,7 @@ class EpisodeSpec:
     repair: bool | None = None
     reasoning: ReasoningConfig | None = None
     world: str | None = None
+    background: ScriptedPlan | None = None
 
     @property
     def planned(self) -> bool:
@@ -112,12 +116,19 @@ def _run_in(world: World, spec: EpisodeSpec, on_tick: Callable[[Executor], None]
     calls = []
     first_scene: Scene | None = None
     goal_spec: GoalSpec | None = spec.goal
+    background = spec.background
     if spec.planned:
         regions = task_regions(task)
         reasoner = make_reasoner(spec.reasoner, goal=spec.goal, watch_visibility=spec.perception == "rgbd")
         first_scene = observe(world, regions, spec.perception)
-        planned = plan_task(spec.instruction or "", first_scene, reasoner, task=spec.task)
-        graph, calls = planned.graph, planned.calls
+        if spec.reasoner == "llm" and spec.strategy in PIPELINED_METHODS:
+            # The robot starts on the composed graph; the arranger and conductor answer while it moves.
+            graph = compose_task(spec.instruction or "", first_scene, reasoner, task=spec.task)
+            calls = list(reasoner.calls)
+            background = ThreadedPlan(_augmenting(graph, first_scene, reasoner, world, spec.task))
+        else:
+            planned = plan_task(spec.instruction or "", first_scene, reasoner, task=spec.task)
+            graph, calls = planned.graph, planned.calls
         goal_spec = goal_spec or getattr(reasoner, "last_goal", None)
         tracker = planned_goal_tracker(spec.task, goal_spec, graph, first_scene)
         if repairer is None and spec.repair is not False:
@@ -144,6 +155,7 @@ def _run_in(world: World, spec: EpisodeSpec, on_tick: Callable[[Executor], None]
         on_tick=on_tick,
         perception=spec.perception,
         repairer=repairer,
+        background=background,
     )
     result = executor.run()
     start = next(e for e in result.trace.events if e["event"] == "episode_start")
@@ -151,6 +163,19 @@ def _run_in(world: World, spec: EpisodeSpec, on_tick: Callable[[Executor], None]
     # The agents' calls came before the first tick: they open the trace.
     result.trace.events[:0] = [{"tick": 0, "event": "reasoner_call", **call.to_trace_event()} for call in calls]
     return result
+
+
+def _augmenting(nominal: TaskGraph, scene: Scene, reasoner, world: World, task: str):
+    """The background work of a pipelined LLM plan: arranger, filter, conductor, then the same checks a
+    graph passes before it runs (a failure is the episode's to survive, not a crash)."""
+
+    def work() -> tuple[TaskGraph, list]:
+        first = len(reasoner.calls)
+        planned = augment_task(nominal, scene, reasoner)
+        require_runnable(planned.graph, [*world.object_names, *world.cloth_point_names], task, "planned graph")
+        return planned.graph, list(reasoner.calls[first:])
+
+    return work
 
 
 def planned_goal_tracker(task_name: str, goal: GoalSpec | None, graph: TaskGraph, scene: Scene) -> SuccessTracker:

@@ -25,6 +25,7 @@ from agentchord.actions.base import ArmAction, Status
 from agentchord.actions.catalog import ACTIONS
 from agentchord.actions.controller import RobotController
 from agentchord.execution.arrivals import PlanArrivals, Waiting, derived_monitors
+from agentchord.execution.background import ScriptedPlan, ThreadedPlan
 from agentchord.execution.binding import Binding, HoldMemory
 from agentchord.execution.edge_program import EdgeProgram
 from agentchord.execution.feasibility import FeasibilityChecker, first_grasps, off_table
@@ -91,6 +92,8 @@ class Executor(RecoverySwitching, PlanArrivals):
             segmentation of two cameras at 10 Hz, fused and shape-fitted).
         repairer: Proposes a branch for an unanticipated failure (None: no online
             repair; the episode goes on from the unmet sub-goal as before).
+        background: The rest of a pipelined plan asked while the robot moves (an LLM's arranger and
+            conductor); ``graph`` is then the composed graph it starts on.
     """
 
     def __init__(
@@ -104,6 +107,7 @@ class Executor(RecoverySwitching, PlanArrivals):
         on_tick: Callable[[Executor], None] | None = None,
         perception: str = "oracle",
         repairer: Repairer | None = None,
+        background: ThreadedPlan | ScriptedPlan | None = None,
     ) -> None:
         filtered = forward_filter(graph)
         self.world = world
@@ -159,6 +163,8 @@ class Executor(RecoverySwitching, PlanArrivals):
         self._early_armed: str | None = None
         self._rearm_tick = 0
         self._arriving: Waiting | None = None
+        self.background = background
+        self._incoming: tuple[int, TaskGraph] | None = None
 
     def _compile(self, graph: TaskGraph) -> None:
         """Adopt a (filtered) graph: compile what the tick loop evaluates.
@@ -256,6 +262,8 @@ class Executor(RecoverySwitching, PlanArrivals):
             early_failures=self.early_failures,
         )
         self.trace.add(self.world.tick, "episode_end", success=success, reason=reason, steps=result.steps)
+        if self.background is not None:
+            self.background.close()
         close = getattr(self.extractor, "close", None)
         if close is not None:
             close()
@@ -286,6 +294,7 @@ class Executor(RecoverySwitching, PlanArrivals):
         if lost is not None:
             return False, lost
         # A part of a pipelined plan the robot waits for; then a failure mode arriving as the edge runs.
+        self._poll_background()
         waited = self._tick_waiting()
         if waited is not False:
             return waited

@@ -16,6 +16,10 @@ SHORT = {"inner-monologue": "IM", "doremi": "DRM", "rekep": "ReKep", "code-as-mo
          "agentchord-sequential": "AC-seq", "agentchord": "AgentChord"}
 
 
+#: The methods whose plan is pipelined: the robot moves before the arranger and conductor have answered.
+PIPELINED_METHODS = frozenset({"agentchord"})
+
+
 def is_baseline(name: str) -> bool:
     """Whether ``name`` is one of the four re-planning or backtracking baselines."""
     return name in BASELINES

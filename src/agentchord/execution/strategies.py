@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 
 from agentchord.execution.edge_program import EdgeProgram, ReturnToKeyframe
 from agentchord.execution.feasibility import first_grasps
-from agentchord.execution.planning import pipelined_schedule, sequential_calls
+from agentchord.execution.planning import composer_call, pipelined_schedule, sequential_calls
 from agentchord.execution.reasoning import ModelledCall, ReasoningConfig, charge_calls
 from agentchord.monitor import Detection
 
@@ -117,6 +117,12 @@ class AgentChordStrategy(RecoveryStrategy):
     merges_met_subgoals = True
 
     def begin(self, executor: Executor) -> None:
+        if executor.background is not None:
+            # An LLM composed the graph; its arranger and conductor answer while the robot moves.
+            if self.reasoning is not None:
+                charge_calls(executor, self.reasoning, [composer_call(executor.graph)], self.planned_calls)
+            executor.follow_background()
+            return
         if self.reasoning is None:
             return
         if any(call.reasoner != "rules" for call in self.planned_calls):

@@ -1,0 +1,90 @@
+"""A pipelined plan answered by an LLM in a thread: the robot moves before the arranger replies, and the
+episode equals the offline one with the same latencies (a local replay server, 127.0.0.1 only)."""
+
+import json
+
+import pytest
+from replay_server import Completion, ReplayServer
+
+from agentchord.agents.observe import observe, task_regions
+from agentchord.agents.pipeline import plan_task
+from agentchord.agents.rules import RulesReasoner
+from agentchord.execution.background import ScriptedPlan, ThreadedPlan
+from agentchord.execution.episode import EpisodeSpec, run_episode
+from agentchord.execution.reasoning import ReasoningConfig
+from agentchord.graph.models import TaskGraph
+from agentchord.tasks import load_task_graph
+from agentchord.worlds.sim.disturbances import ScriptedDrop
+from agentchord.worlds.sim.tasks import SIM_TASKS
+from agentchord.worlds.sim.trial import open_world
+
+TASK = "single_arm_pour_water"
+DELAY_S = 2.0
+
+
+def _physical(result) -> list[tuple]:
+    """What happened in the world and the executor, not what was charged."""
+    kept = ("edge_start", "node_reached", "disturbance", "failure_detected", "recovery_switch", "failure_before_branch",
+            "branch_arrived", "modes_listed", "monitors_armed", "recovery_bound", "episode_end")
+    return [(e["tick"], e["event"], e.get("edge"), e.get("failure"), e.get("to"), e.get("node")) for e in result.trace.events
+            if e["event"] in kept]
+
+
+def test_the_robot_moves_before_the_arranger_replies_and_the_episode_equals_the_offline_one(monkeypatch):
+    instruction = load_task_graph(TASK).instruction
+    rules = RulesReasoner()
+    plan_task(instruction, observe(open_world(TASK, 0), task_regions(SIM_TASKS[TASK])), rules, TASK)
+    drop = ScriptedDrop("move_to_obj", after=5)  # on the second edge, before the plan's rest can be there
+    with ReplayServer() as server:
+        for call in rules.calls:  # composer, arranger, conductor: each answers after DELAY_S
+            server.push(Completion(json.dumps(call.reply), delay_s=DELAY_S))
+        monkeypatch.setenv("AGENTCHORD_LLM_BASE_URL", server.base_url)
+        monkeypatch.setenv("AGENTCHORD_LLM_MODEL", "replay-model")
+        monkeypatch.setenv("AGENTCHORD_LLM_API_KEY", "test-key")
+        live = run_episode(EpisodeSpec(TASK, seed=0, instruction=instruction, reasoner="llm", repair=False,
+                                       reasoning=ReasoningConfig(), disturbance=drop))
+        assert len(server.requests) == 3
+    assert live.success, live.reason
+    (asked,) = live.trace.of("plan_asked")
+    (replied,) = live.trace.of("plan_replied")
+    first_edge = live.trace.of("edge_start")[0]
+    # The first motion came before the arranger's reply: the robot ran while the agents thought.
+    assert asked["tick"] == first_edge["tick"] == 0 and replied["arrives_tick"] > 0
+    assert 2 * DELAY_S <= replied["latency_s"] < 2 * DELAY_S + 1.0
+    assert replied["arrives_tick"] == pytest.approx(replied["latency_s"] * 50, abs=1)
+    assert live.first_motion_s == pytest.approx(DELAY_S, abs=0.5)  # the composer's measured call only
+    # The drop came before the modes: it waited for them, then recovered.
+    assert live.early_failures and live.early_failures[0]["then"] == "recovery for bottle_dropped"
+
+    # The same episode offline, the plan's rest arriving after the latency the live one measured.
+    calls = [e for e in live.trace.events if e["event"] == "reasoner_call"]
+    composed = TaskGraph.model_validate(calls[0]["reply"])
+    conducted = TaskGraph.model_validate(replied["calls"][-1]["reply"])
+    offline = run_episode(EpisodeSpec(TASK, seed=0, graph=composed, reasoning=ReasoningConfig(), disturbance=ScriptedDrop("move_to_obj", after=5),
+                                      background=ScriptedPlan(replied["latency_s"], conducted)))
+    assert _physical(offline) == _physical(live)
+    assert offline.steps == live.steps and offline.success
+
+
+def test_a_failed_background_plan_is_survived_with_its_reason_in_the_trace():
+    graph = load_task_graph(TASK)
+    from agentchord.agents.prompts import nominal_part
+
+    result = run_episode(EpisodeSpec(TASK, seed=0, graph=nominal_part(graph), reasoning=ReasoningConfig(),
+                                     background=ScriptedPlan(1.0, None, error="ReasonerError: no valid reply")))
+    assert result.success, result.reason  # undisturbed: the composed graph is enough
+    (replied,) = result.trace.of("plan_replied")
+    assert replied["error"] == "ReasonerError: no valid reply" and not result.trace.of("plan_arrived")
+
+
+def test_the_control_loop_does_not_run_ahead_of_a_pending_reply():
+    import time
+
+    clock = [0.0]
+    plan = ThreadedPlan(lambda: (time.sleep(0.3), (None, []))[1], clock=time.perf_counter)
+    plan.start()
+    started = time.perf_counter()
+    assert plan.poll(0.0) is None  # nothing to wait for at the first motion
+    arrival = plan.poll(5.0)  # the loop would be 5 s ahead: it waits for the reply instead
+    assert arrival is not None and 0.25 < time.perf_counter() - started < 2.0
+    assert arrival.latency_s == pytest.approx(0.3, abs=0.15) and clock == [0.0]
