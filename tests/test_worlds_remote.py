@@ -8,6 +8,7 @@ import subprocess
 import sys
 
 import numpy as np
+import zmq
 import pytest
 from click.testing import CliRunner
 
@@ -79,9 +80,10 @@ def test_the_server_answers_errors_instead_of_dying():
     assert "no trial is open" in server.handle({"op": "step"})["error"]
     assert "this server serves 'single_arm_pour_water'" in server.handle({"op": "open", "task": "handover_block"})["error"]
     assert server.handle({"op": "open", "seed": -1})["ok"] is False
-    assert server.handle({"op": "open", "seed": 1})["ok"] is True
-    assert "unknown simulator call" in server.handle({"op": "sim", "method": "reset"})["error"]
-    assert "6 joint targets" in server.handle({"op": "step", "commands": {"left": {"q": [0.0], "grip": 0.0}}})["error"]
+    trial = server.handle({"op": "open", "seed": 1})["trial"]
+    assert "unknown simulator call" in server.handle({"op": "sim", "method": "reset", "trial": trial})["error"]
+    assert "6 joint targets" in server.handle({"op": "step", "trial": trial,
+                                               "commands": {"left": {"q": [0.0], "grip": 0.0}}})["error"]
 
 
 def test_a_refused_trial_and_a_missing_server_are_remote_world_errors(server):
@@ -190,3 +192,206 @@ def test_agentchord_serve_and_run_with_world(tmp_path):
         for key in [k for k in summary if "wall" in k or "compute" in k or k == "exec_time_s"]:
             del summary[key]
     assert remote == local
+
+
+# ---------------------------------------------------------------------------- hardening (issue 43)
+class CorruptingServer(WorldServer):
+    """A world server whose replies are bent by ``corrupt(op, reply)`` (or raw bytes returned)."""
+
+    def __init__(self, corrupt, **kwargs) -> None:
+        super().__init__(TASK, **kwargs)
+        self.corrupt = corrupt
+        self.ticks = 0
+
+    def handle(self, request):
+        reply = super().handle(request)
+        return self.corrupt(request.get("op"), reply, self)
+
+
+def _serve(server):
+    import threading  # noqa: PLC0415
+
+    stop, bound, endpoint = threading.Event(), threading.Event(), []
+
+    def ready(address):
+        endpoint.append(address)
+        bound.set()
+
+    thread = threading.Thread(target=server.serve, args=("tcp://127.0.0.1:*",), kwargs={"ready": ready, "stop": stop},
+                              daemon=True)
+    thread.start()
+    assert bound.wait(30)
+    return endpoint[0], stop, thread
+
+
+class _RawReply(dict):
+    """A marker: the server sends these bytes instead of a message."""
+
+
+def _nan_arm_q_after(ticks):
+    def corrupt(op, reply, server):
+        if op == "step" and reply.get("ok") and reply["state"]["tick"] >= ticks:
+            reply["state"]["arm_q"] = reply["state"]["arm_q"].copy()
+            reply["state"]["arm_q"][1, 2] = np.nan
+        return reply
+    return corrupt
+
+
+def _drop(path):
+    def corrupt(op, reply, server):
+        if op == "open" and reply.get("ok"):
+            node = reply
+            *parents, last = path.split(".")
+            for key in parents:
+                node = node[key]
+            del node[last]
+        return reply
+    return corrupt
+
+
+def _replace(op_name, key, value):
+    def corrupt(op, reply, server):
+        if op == op_name and reply.get("ok"):
+            if key in reply.get("state", {}):
+                reply["state"][key] = value
+            else:
+                reply[key] = value
+        return reply
+    return corrupt
+
+
+@pytest.mark.parametrize(("corrupt", "message"), [
+    (_drop("world.objects"), "malformed 'open' reply: world.objects: missing"),
+    (_drop("world.control_hz"), "malformed 'open' reply: world.control_hz: missing"),
+    (_drop("state"), "malformed 'open' reply: state: missing"),
+    (_drop("trial"), "malformed 'open' reply: trial: missing"),
+    (_drop("state.arm_q"), "malformed 'open' reply: state.arm_q: missing"),
+    (_replace("open", "arm_q", np.zeros((2, 5))), "state.arm_q: expected shape 2x6, got 2x5"),
+    (_replace("open", "arm_q", "joints"), "state.arm_q: expected ndarray or list or tuple, got str"),
+    (_replace("open", "tcp_pos", np.full((2, 3), np.inf)), "state.tcp_pos: not finite (inf at index (0, 0))"),
+    (_replace("open", "obj_pos", np.full((2, 3), np.nan)), "state.obj_pos: not finite (nan at index (0, 0))"),
+    (_replace("open", "tick", -1), "state.tick: -1 is out of range"),
+    (_replace("open", "holding", [["right", "ghost"]]), "state.holding: expected [arm, object] pairs of this scene"),
+    (_replace("open", "world", [1, 2]), "malformed 'open' reply: world: expected dict, got list"),
+    (_replace("open", "seed", "zero"), "malformed 'open' reply: seed: expected int, got str"),
+    (lambda op, reply, server: {"result": 1} if op == "open" else reply, "malformed 'open' reply: ok: missing"),
+    (lambda op, reply, server: {**reply, "ok": "yes"} if op == "open" else reply, "ok: expected true or false, got 'yes'"),
+    (lambda op, reply, server: {**reply, "protocol": 99} if op == "hello" else reply, "speaks world protocol 99"),
+])
+def test_a_malformed_or_non_finite_reply_is_a_remote_world_error_naming_the_field(corrupt, message):
+    address, stop, thread = _serve(CorruptingServer(corrupt))
+    try:
+        with pytest.raises(RemoteWorldError, match=re.escape(message)):
+            RemoteWorld(address, TASK, 0, timeout_s=10)
+    finally:
+        stop.set()
+        thread.join(5)
+
+
+def test_a_reply_that_is_not_the_protocol_is_a_remote_world_error():
+    context = zmq.Context.instance()
+    socket = context.socket(zmq.REP)
+    socket.setsockopt(zmq.LINGER, 0)
+    port = socket.bind_to_random_port("tcp://127.0.0.1")
+    import threading  # noqa: PLC0415
+
+    def answer():
+        if socket.poll(10000):
+            socket.recv()
+            socket.send(b"HTTP/1.1 200 OK\r\n\r\nhello")
+
+    thread = threading.Thread(target=answer, daemon=True)
+    thread.start()
+    try:
+        with pytest.raises(RemoteWorldError, match="does not speak the world protocol: its reply to 'hello' is not a world-protocol message"):
+            RemoteWorld(f"tcp://127.0.0.1:{port}", TASK, 0, timeout_s=10)
+    finally:
+        thread.join(5)
+        socket.close(0)
+
+
+def test_a_nan_reading_mid_episode_ends_run_with_exit_2_not_a_verdict():
+    address, stop, thread = _serve(CorruptingServer(_nan_arm_q_after(30)))
+    try:
+        result = CliRunner().invoke(main, ["run", TASK, "--world", address])
+    finally:
+        stop.set()
+        thread.join(5)
+    assert result.exit_code == 2, result.output
+    assert "malformed 'step' reply: state.arm_q: not finite (nan at index (1, 2))" in result.output
+    assert "SUCCESS" not in result.output and "internal error" not in result.output
+
+
+def test_a_non_finite_simulator_answer_is_refused():
+    def corrupt(op, reply, server):
+        if op == "sim" and reply.get("ok"):
+            reply["result"] = float("nan") if isinstance(reply["result"], float) else "yes"
+        return reply
+
+    address, stop, thread = _serve(CorruptingServer(corrupt))
+    try:
+        with RemoteWorld(address, TASK, 0, timeout_s=10) as world:
+            with pytest.raises(RemoteWorldError, match=r"malformed 'sim object_velocity' reply: result: not finite \(nan\)"):
+                world.object_velocity("bottle")
+            with pytest.raises(RemoteWorldError, match="malformed 'sim on_table' reply: result: expected bool, got str"):
+                world.on_table("bottle")
+    finally:
+        stop.set()
+        thread.join(5)
+
+
+def test_a_second_client_is_refused_and_the_first_episode_equals_the_local_one():
+    address, stop, thread = serve_in_thread(TASK)
+    refused = []
+
+    def intrude(executor):
+        if executor.world.tick == 40:
+            with pytest.raises(RemoteWorldError, match="this world is in use: agentchord on .* holds its trial") as info:
+                RemoteWorld(address, TASK, 9, timeout_s=10)
+            refused.append(str(info.value))
+
+    try:
+        config = ExecutorConfig(tick_limit=150)
+        remote = run_episode(EpisodeSpec(task=TASK, seed=2, config=config, world=address), on_tick=intrude)
+        local = run_episode(EpisodeSpec(task=TASK, seed=2, config=config))
+        assert refused and "(seed 2)" in refused[0]
+        assert _comparable(remote) == _comparable(local)
+        # The first closed its trial: the world is free again.
+        with RemoteWorld(address, TASK, 9, timeout_s=10) as again:
+            assert again.seed == 9
+    finally:
+        stop.set()
+        thread.join(5)
+
+
+def test_the_reply_timeout_is_configurable_and_checked(monkeypatch):
+    from agentchord.worlds.remote import ENV_TIMEOUT, RemoteWorldSettingError, timeout_from_env  # noqa: PLC0415
+
+    assert timeout_from_env({}) == 120.0
+    assert timeout_from_env({ENV_TIMEOUT: "2.5"}) == 2.5
+    for bad in ("abc", "nan", "inf", "-1", "0", "1e12"):
+        with pytest.raises(RemoteWorldSettingError, match=re.escape(f"{ENV_TIMEOUT}={bad!r}: expected seconds")):
+            timeout_from_env({ENV_TIMEOUT: bad})
+    with pytest.raises(RemoteWorldSettingError, match="reply timeout must be seconds within"):
+        RemoteWorld("tcp://127.0.0.1:9", TASK, 0, timeout_s=1e12)
+    monkeypatch.setenv(ENV_TIMEOUT, "0.3")
+    with pytest.raises(RemoteWorldError, match=r"no reply from the world at tcp://127.0.0.1:9 within 0.3 s .*AGENTCHORD_WORLD_TIMEOUT"):
+        RemoteWorld("tcp://127.0.0.1:9", TASK, 0)
+    monkeypatch.setenv(ENV_TIMEOUT, "1e400")
+    result = CliRunner().invoke(main, ["run", TASK, "--world", "tcp://127.0.0.1:9"])
+    assert result.exit_code == 2 and "AGENTCHORD_WORLD_TIMEOUT='1e400': expected seconds" in result.output
+
+
+@pytest.mark.parametrize(("address", "message"), [
+    ("tcp://::1:5555", "an IPv6 address goes in brackets, tcp://[::1]:5555"),
+    ("tcp://[::zz]:5555", "[::zz] is not an IPv6 address"),
+    ("tcp://*:5555", "'*' is not a host a client can connect to"),
+    ("tcp://no-such-host.invalid:5555", "cannot resolve 'no-such-host.invalid'"),
+])
+def test_an_address_the_client_cannot_use_is_refused_at_once(address, message):
+    import time  # noqa: PLC0415
+
+    start = time.monotonic()
+    result = CliRunner().invoke(main, ["run", TASK, "--world", address])
+    assert result.exit_code == 2 and message in result.output, result.output
+    assert time.monotonic() - start < 5

@@ -20,6 +20,7 @@ from agentchord.cli.support import (
     PERCEPTION_NAMES,
     REASONER_NAMES,
     BadInput,
+    FiniteFloatRange,
     GuardedGroup,
     catches_sigterm,
     check_outputs,
@@ -63,26 +64,33 @@ def tasks() -> None:
 @main.command()
 @click.option("--task", required=True, help="The simulated task served.")
 @click.option("--port", type=click.IntRange(0, 65535), default=5555, show_default=True, help="TCP port (0: any free one, printed).")
-@click.option("--host", default="127.0.0.1", show_default=True, help="Interface to listen on (0.0.0.0: every one).")
+@click.option("--host", default="127.0.0.1", show_default=True, help="Interface to listen on (0.0.0.0: every IPv4 one; ::1 or :: for IPv6).")
 @click.option("--seed", type=click.IntRange(0), default=0, show_default=True, help="Seed of a trial a client opens without one.")
+@click.option("--release-after", "release_after", type=FiniteFloatRange(0.1, 86400.0), default=300.0, show_default=True,
+              help="Seconds without a request after which a client's trial may be taken over by another client.")
 @catches_sigterm
-def serve(task, port, host, seed) -> None:
+def serve(task, port, host, seed, release_after) -> None:
     """Serve TASK's simulator over the world protocol (ZeroMQ) until interrupted.
 
     `run`/`demo --world tcp://HOST:PORT` drive it as a remote world, the way they would drive a
-    real robot's driver: docs/world_protocol.md lists the messages. One client at a time.
+    real robot's driver: docs/world_protocol.md lists the messages. One client at a time: while a
+    client's trial is open, another client's is refused (exit status 2, naming the holder) until the
+    first closes it or sends nothing for --release-after seconds.
     """
     check_task_name(task, "--task")
     import zmq  # noqa: PLC0415
 
-    from agentchord.worlds.sim.serve import WorldServer  # noqa: PLC0415
+    from agentchord.worlds.sim.serve import WorldServer, bind_host  # noqa: PLC0415
 
     def ready(endpoint: str) -> None:
-        click.echo(f"serving {task} on {endpoint} (Ctrl-C to stop)")
+        click.echo(f"serving {task} on {endpoint} (Ctrl-C to stop; a trial idle for {release_after:g} s is released)")
         sys.stdout.flush()
 
+    if any(c in host for c in " /@?#*") or not host:
+        raise click.BadParameter(f"{host!r} is not an interface address or name (e.g. 127.0.0.1, 0.0.0.0, ::1)",
+                                 param_hint="--host")
     try:
-        WorldServer(task, seed).serve(f"tcp://{host}:{port or '*'}", ready=ready)
+        WorldServer(task, seed, release_after_s=release_after).serve(f"tcp://{bind_host(host)}:{port or '*'}", ready=ready)
     except zmq.ZMQError as exc:
         raise BadInput(f"cannot listen on {host}:{port}: {exc}") from exc
 

@@ -48,18 +48,20 @@ def _kinds(ctx, param, value: str) -> tuple[str, ...]:
         raise click.BadParameter(str(exc)) from exc
 
 
-WORLD_HELP = ("Drive the world served at this address (tcp://HOST:PORT, see `agentchord serve`) instead of the "
-              "simulator in this process: same seed, same episode.")
+WORLD_HELP = ("Drive the world served at this address (tcp://HOST:PORT or tcp://[IPv6]:PORT, see `agentchord serve`) "
+              "instead of the simulator in this process: same seed, same episode. A world that does not answer within "
+              "$AGENTCHORD_WORLD_TIMEOUT seconds (default 120) ends the command with exit status 2.")
 
 
 def _world_address(ctx, param, value: str | None) -> str | None:
     if value is None:
         return None
-    from agentchord.worlds.remote import check_address  # noqa: PLC0415
+    from agentchord.worlds.remote import RemoteWorldError, resolve_address, timeout_from_env  # noqa: PLC0415
 
     try:
-        return check_address(value)
-    except ValueError as exc:
+        timeout_from_env()  # a bad $AGENTCHORD_WORLD_TIMEOUT is refused before any work, too
+        return resolve_address(value)
+    except RemoteWorldError as exc:
         raise click.BadParameter(str(exc)) from exc
 
 

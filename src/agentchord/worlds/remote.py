@@ -7,10 +7,19 @@ commands and receives the state after the tick, so every query between two ticks
 poses, widths, grasp signals, object poses) is answered locally; only camera frames and the
 simulator's own calls (used by disturbances and success checks) are round trips of their own.
 Arrays travel as raw float64 bytes: the same seed gives the same episode as the local world.
+
+Every reply is checked before it is used: a reply that is not the protocol (a missing field, a
+wrong type or shape) or a reading that is not finite (a NaN joint angle or pose) is a
+:class:`RemoteWorldError` naming the field, never an internal error nor a verdict computed
+from NaN.
 """
 
 from __future__ import annotations
 
+import ipaddress
+import math
+import os
+import socket as sockets
 from typing import Any
 
 import numpy as np
@@ -18,29 +27,181 @@ import zmq
 
 from agentchord.robot.aloha import ARMS
 from agentchord.worlds.protocol import ArmCommand, CameraFrame, ObjectInfo
-from agentchord.worlds.wire import PROTOCOL_VERSION, pack, unpack
+from agentchord.worlds.wire import PROTOCOL_VERSION, WireError, pack, unpack
 
 #: Seconds a reply may take before the server counts as gone (a camera frame or a trial's set-up included).
 DEFAULT_TIMEOUT_S = 120.0
+#: Environment variable that sets it (seconds, a number within ``(0, MAX_TIMEOUT_S]``).
+ENV_TIMEOUT = "AGENTCHORD_WORLD_TIMEOUT"
+#: The longest reply wait accepted (a day): ZeroMQ takes the wait as a 32-bit count of milliseconds.
+MAX_TIMEOUT_S = 86_400.0
+#: Protocol versions this client speaks (1: without trial tokens).
+PROTOCOLS = (1, PROTOCOL_VERSION)
 
 
 class RemoteWorldError(RuntimeError):
     """The remote world did not answer, refused a request, or speaks another protocol version."""
 
 
+class RemoteWorldSettingError(RemoteWorldError, ValueError):
+    """An address or a timeout that cannot be used, found before anything is sent."""
+
+
 def check_address(address: str) -> str:
     """``address`` if it is a ZeroMQ endpoint a client can connect to (``tcp://host:port``, ``ipc://path``).
+
+    An IPv6 address goes in brackets (``tcp://[::1]:5555``). Names are not resolved here
+    (see :func:`resolve_address`).
 
     Raises:
         ValueError: Anything else, saying what is expected.
     """
+    expected = "expected tcp://HOST:PORT (e.g. tcp://127.0.0.1:5555, tcp://[::1]:5555) or ipc://PATH"
     if address.startswith("tcp://"):
         host, sep, port = address[len("tcp://"):].rpartition(":")
         if sep and host and port.isdigit() and 0 < int(port) < 65536:
+            if host.startswith("[") and host.endswith("]"):
+                try:
+                    ipaddress.IPv6Address(host[1:-1])
+                except ValueError:
+                    raise ValueError(f"bad world address {address!r}: {host} is not an IPv6 address") from None
+                return address
+            if ":" in host:
+                raise ValueError(f"bad world address {address!r}: an IPv6 address goes in brackets, "
+                                 f"tcp://[{host}]:{port}")
+            if host == "*" or any(c in host for c in " /[]@?#"):
+                raise ValueError(f"bad world address {address!r}: {host!r} is not a host a client can connect to; "
+                                 f"{expected}")
             return address
     elif address.startswith("ipc://") and len(address) > len("ipc://"):
         return address
-    raise ValueError(f"bad world address {address!r}: expected tcp://HOST:PORT (e.g. tcp://127.0.0.1:5555) or ipc://PATH")
+    raise ValueError(f"bad world address {address!r}: {expected}")
+
+
+def resolve_address(address: str) -> str:
+    """Check ``address`` and that its host name resolves, so that a name no one answers to is refused at once.
+
+    Raises:
+        RemoteWorldSettingError: A bad address or a name that does not resolve.
+    """
+    try:
+        check_address(address)
+    except ValueError as exc:
+        raise RemoteWorldSettingError(str(exc)) from None
+    if address.startswith("tcp://"):
+        host, _, port = address[len("tcp://"):].rpartition(":")
+        try:
+            sockets.getaddrinfo(host.strip("[]"), int(port), type=sockets.SOCK_STREAM)
+        except (OSError, UnicodeError) as exc:
+            reason = getattr(exc, "strerror", None) or str(exc)
+            raise RemoteWorldSettingError(f"bad world address {address!r}: cannot resolve {host!r} ({reason})") from None
+    return address
+
+
+def timeout_from_env(env: dict[str, str] | None = None) -> float:
+    """The reply timeout: :data:`ENV_TIMEOUT` if set, else :data:`DEFAULT_TIMEOUT_S`.
+
+    Raises:
+        RemoteWorldSettingError: The variable is not a number of seconds within ``(0, MAX_TIMEOUT_S]``.
+    """
+    value = (os.environ if env is None else env).get(ENV_TIMEOUT)
+    if value is None or not value.strip():
+        return DEFAULT_TIMEOUT_S
+    try:
+        return check_timeout(float(value))
+    except ValueError:
+        raise RemoteWorldSettingError(f"{ENV_TIMEOUT}={value!r}: expected seconds, a number within "
+                                      f"(0, {MAX_TIMEOUT_S:g}]") from None
+
+
+def check_timeout(seconds: float) -> float:
+    """``seconds`` if it is a usable reply timeout.
+
+    Raises:
+        RemoteWorldSettingError: Not finite, not positive, or beyond :data:`MAX_TIMEOUT_S`.
+    """
+    if isinstance(seconds, bool) or not isinstance(seconds, (int, float)) or not math.isfinite(seconds) \
+            or not 0 < seconds <= MAX_TIMEOUT_S:
+        raise RemoteWorldSettingError(f"the world's reply timeout must be seconds within (0, {MAX_TIMEOUT_S:g}], "
+                                      f"got {seconds!r}")
+    return float(seconds)
+
+
+class MalformedReplyError(RemoteWorldError):
+    """A reply that is not the protocol, or whose readings are not finite."""
+
+
+def _client_name() -> str:
+    return f"agentchord on {sockets.gethostname()} (pid {os.getpid()})"
+
+
+class _Reader:
+    """Reads the fields of one reply, each checked: present, of its type and shape, finite."""
+
+    def __init__(self, address: str, what: str) -> None:
+        self.address, self.what = address, what
+
+    def fail(self, where: str, problem: str) -> MalformedReplyError:
+        """The error for ``where``."""
+        return MalformedReplyError(f"the world at {self.address} sent a malformed {self.what!r} reply: {where}: {problem}")
+
+    def field(self, mapping: Any, key: str, kind: type | tuple[type, ...], where: str | None = None) -> Any:
+        """``mapping[key]``, which must be a ``kind``."""
+        where = where or key
+        if not isinstance(mapping, dict):
+            raise self.fail(where.rpartition(".")[0] or "the reply", f"expected a map, got {type(mapping).__name__}")
+        if key not in mapping:
+            raise self.fail(where, "missing")
+        value = mapping[key]
+        if not isinstance(value, kind) or (isinstance(value, bool) and bool not in (kind if isinstance(kind, tuple) else (kind,))):
+            names = kind.__name__ if isinstance(kind, type) else " or ".join(k.__name__ for k in kind)
+            raise self.fail(where, f"expected {names}, got {type(value).__name__}")
+        return value
+
+    def array(self, mapping: Any, key: str, shape: tuple[int, ...], where: str | None = None, finite: bool = True,
+              dtype: Any = None) -> np.ndarray:
+        """``mapping[key]`` as an array of ``shape`` (-1: any length), finite (or at least not NaN)."""
+        where = where or key
+        value = self.field(mapping, key, (np.ndarray, list, tuple), where)
+        try:
+            if isinstance(value, np.ndarray) and value.dtype.kind in "biuf" and dtype is None:
+                array = value  # as it came: the local world's dtype and bits
+            else:
+                array = np.asarray(value, dtype=dtype or float)
+        except (TypeError, ValueError, OverflowError):
+            raise self.fail(where, "expected numbers") from None
+        if array.dtype.kind not in "biuf":
+            raise self.fail(where, f"expected numbers, got {array.dtype}")
+        if len(array.shape) != len(shape) or any(n not in (-1, m) for n, m in zip(shape, array.shape)):
+            wanted = "x".join("n" if n < 0 else str(n) for n in shape) or "a scalar"
+            raise self.fail(where, f"expected shape {wanted}, got {'x'.join(map(str, array.shape)) or 'a scalar'}")
+        if array.dtype.kind == "f":
+            bad = ~np.isfinite(array) if finite else np.isnan(array)
+            if bad.any():
+                raise self.fail(where, f"{'not finite' if finite else 'NaN'} ({array[bad].ravel()[0]} at index "
+                                       f"{tuple(int(i) for i in np.argwhere(bad)[0])})")
+        return array
+
+    def number(self, mapping: Any, key: str, where: str | None = None, low: float = -math.inf, high: float = math.inf,
+               integer: bool = False) -> float:
+        """``mapping[key]``, a finite number within ``[low, high]`` (an integer where asked)."""
+        where = where or key
+        value = self.field(mapping, key, int if integer else (int, float), where)
+        if isinstance(value, float) and not math.isfinite(value):
+            raise self.fail(where, f"not finite ({value})")
+        if not low <= value <= high:
+            raise self.fail(where, f"{value} is out of range [{low:g}, {high:g}]")
+        return value
+
+    def __enter__(self) -> _Reader:
+        return self
+
+    def __exit__(self, kind: Any, error: Any, traceback: Any) -> None:
+        # What the field checks did not foresee (a list of the wrong length, a name that is not a string)
+        # is still the reply's fault, not ours.
+        if error is not None and not isinstance(error, RemoteWorldError) and isinstance(
+                error, (KeyError, TypeError, ValueError, IndexError, AttributeError, OverflowError)):
+            raise self.fail("a field", f"{type(error).__name__}: {error}") from error
 
 
 class RemoteCamera:
@@ -51,9 +212,20 @@ class RemoteCamera:
 
     def capture(self) -> CameraFrame:
         """A frame of the remote world as it is now."""
-        frame = self.world.request("camera", name=self.name, width=self.width, height=self.height)["frame"]
-        return CameraFrame(camera=frame["camera"], depth=frame["depth"], fovy=float(frame["fovy"]), pos=frame["pos"],
-                           rot=frame["rot"], far=float(frame["far"]), labels=frame.get("labels"), rgb=frame.get("rgb"))
+        reply = self.world.request("camera", name=self.name, width=self.width, height=self.height)
+        with self.world.reading("camera") as read:
+            frame = read.field(reply, "frame", dict)
+            shape = (self.height, self.width)
+            labels, rgb = frame.get("labels"), frame.get("rgb")
+            return CameraFrame(
+                camera=read.field(frame, "camera", str, "frame.camera"),
+                depth=read.array(frame, "depth", shape, "frame.depth", finite=False),
+                fovy=read.number(frame, "fovy", "frame.fovy", low=0.0, high=180.0),
+                pos=read.array(frame, "pos", (3,), "frame.pos"), rot=read.array(frame, "rot", (3, 3), "frame.rot"),
+                far=read.number(frame, "far", "frame.far", low=0.0),
+                labels=None if labels is None else read.array(frame, "labels", shape, "frame.labels", dtype=np.int64),
+                rgb=None if rgb is None else read.array(frame, "rgb", (*shape, 3), "frame.rgb", dtype=np.uint8),
+            )
 
     def close(self) -> None:
         """Nothing to release on this side."""
@@ -72,45 +244,75 @@ class RemoteWorld:
         RemoteWorldError: No server answered, or it refused the trial.
     """
 
-    def __init__(self, address: str, task: str, seed: int, timeout_s: float = DEFAULT_TIMEOUT_S) -> None:
-        self.address = check_address(address)
-        self.timeout_ms = int(timeout_s * 1000)
+    def __init__(self, address: str, task: str, seed: int, timeout_s: float | None = None) -> None:
+        self.address = resolve_address(address)
+        self.timeout_s = timeout_from_env() if timeout_s is None else check_timeout(timeout_s)
+        self.timeout_ms = int(self.timeout_s * 1000)
         self._context = zmq.Context.instance()
         self._socket: zmq.Socket | None = None
+        #: The open trial's token (protocol 2): every request of the trial carries it.
+        self.trial: str | None = None
         #: Requests answered so far (hello and open included).
         self.requests = 0
         self._connect()
-        hello = self.request("hello")
-        if hello.get("protocol") != PROTOCOL_VERSION:
+        try:
+            self._open(task, seed)
+        except BaseException:
             self.close()
-            raise RemoteWorldError(f"{address} speaks world protocol {hello.get('protocol')!r}, this client {PROTOCOL_VERSION}")
-        opened = self.request("open", task=task, seed=seed)
-        info = opened["world"]
-        self.task, self.seed = opened["task"], opened["seed"]
-        self.control_hz = int(info["control_hz"])
-        self._objects = {
-            o["name"]: ObjectInfo(
-                name=o["name"], shape=o["shape"], size=tuple(float(x) for x in o["size"]),
-                rgba=tuple(float(x) for x in o["rgba"]), mass=float(o["mass"]), friction=float(o["friction"]),
-                parts=tuple((tuple(float(x) for x in h), tuple(float(x) for x in c)) for h, c in o["parts"]),
-                pos=tuple(float(x) for x in o["pos"]), yaw=float(o["yaw"]),
-            )
-            for o in info["objects"]
-        }
-        self._object_index = {name: k for k, name in enumerate(self._objects)}
-        self._cloth_points = list(info["cloth_points"])
-        self._cloth_index = {name: k for k, name in enumerate(self._cloth_points)}
-        self._cloth_radius = float(info["cloth_radius"])
-        self._cameras = list(info["cameras"])
-        self._arm_base = {arm: np.asarray(pos, dtype=float) for arm, pos in info["arm_base"].items()}
-        self.has_ground_truth = bool(info.get("ground_truth", False))
-        self.commands: dict[str, ArmCommand] = {
-            arm: ArmCommand(q=np.asarray(c["q"], dtype=float), grip=float(c["grip"])) for arm, c in info["commands"].items()
-        }
+            raise
+
+    def _open(self, task: str, seed: int) -> None:
+        hello = self.request("hello")
+        if hello.get("protocol") not in PROTOCOLS:
+            raise RemoteWorldError(f"{self.address} speaks world protocol {hello.get('protocol')!r}, "
+                                   f"this client {' or '.join(map(str, PROTOCOLS))}")
+        opened = self.request("open", task=task, seed=seed, client=_client_name())
+        with self.reading("open") as read:
+            trial = opened.get("trial")
+            if hello["protocol"] >= 2 and not isinstance(trial, str):
+                raise read.fail("trial", "missing (protocol 2 hands out a trial token)")
+            self.trial = trial
+            info = read.field(opened, "world", dict)
+            self.task = read.field(opened, "task", str)
+            self.seed = read.number(opened, "seed", integer=True, low=0)
+            self.control_hz = int(read.number(info, "control_hz", "world.control_hz", integer=True, low=1, high=10_000))
+            self._objects = {}
+            for k, o in enumerate(read.field(info, "objects", list, "world.objects")):
+                at = f"world.objects[{k}]"
+                name = read.field(o, "name", str, f"{at}.name")
+                self._objects[name] = ObjectInfo(
+                    name=name, shape=read.field(o, "shape", str, f"{at}.shape"),
+                    size=tuple(float(x) for x in read.array(o, "size", (-1,), f"{at}.size")),
+                    rgba=tuple(float(x) for x in read.array(o, "rgba", (4,), f"{at}.rgba")),
+                    mass=float(read.number(o, "mass", f"{at}.mass", low=0.0)),
+                    friction=float(read.number(o, "friction", f"{at}.friction", low=0.0)),
+                    parts=tuple((tuple(float(x) for x in h), tuple(float(x) for x in c))
+                                for h, c in read.field(o, "parts", list, f"{at}.parts")),
+                    pos=tuple(float(x) for x in read.array(o, "pos", (-1,), f"{at}.pos")),
+                    yaw=float(read.number(o, "yaw", f"{at}.yaw")),
+                )
+            self._object_index = {name: k for k, name in enumerate(self._objects)}
+            self._cloth_points = [str(p) for p in read.field(info, "cloth_points", list, "world.cloth_points")]
+            self._cloth_index = {name: k for k, name in enumerate(self._cloth_points)}
+            self._cloth_radius = float(read.number(info, "cloth_radius", "world.cloth_radius", low=0.0))
+            self._cameras = [str(c) for c in read.field(info, "cameras", list, "world.cameras")]
+            bases = read.field(info, "arm_base", dict, "world.arm_base")
+            self._arm_base = {arm: read.array(bases, arm, (3,), f"world.arm_base.{arm}") for arm in ARMS}
+            self.has_ground_truth = bool(info.get("ground_truth", False))
+            commands = read.field(info, "commands", dict, "world.commands")
+            self.commands: dict[str, ArmCommand] = {}
+            for arm in ARMS:
+                command = read.field(commands, arm, dict, f"world.commands.{arm}")
+                self.commands[arm] = ArmCommand(q=read.array(command, "q", (6,), f"world.commands.{arm}.q"),
+                                                grip=float(read.number(command, "grip", f"world.commands.{arm}.grip")))
         self._state: dict[str, Any] = {}
         self._holding: frozenset[tuple[str, str]] = frozenset()
         self.tick = 0
-        self._adopt(opened["state"])
+        self._adopt(opened.get("state"), "open")
+
+    def reading(self, what: str) -> _Reader:
+        """The checker of a reply to ``what``, as a context: anything amiss is a :class:`MalformedReplyError`."""
+        return _Reader(self.address, what)
 
     # ------------------------------------------------------------------ transport
     def _connect(self) -> None:
@@ -118,29 +320,45 @@ class RemoteWorld:
         socket.setsockopt(zmq.LINGER, 0)
         socket.setsockopt(zmq.RCVTIMEO, self.timeout_ms)
         socket.setsockopt(zmq.SNDTIMEO, self.timeout_ms)
-        socket.connect(self.address)
+        socket.setsockopt(zmq.IPV6, 1)  # a name or tcp://[::1]:port may be IPv6; IPv4 still works
+        try:
+            socket.connect(self.address)
+        except zmq.ZMQError as exc:
+            socket.close(0)
+            raise RemoteWorldSettingError(f"cannot connect to the world at {self.address}: {exc}") from None
         self._socket = socket
 
     def request(self, op: str, **fields: Any) -> dict[str, Any]:
         """Send one request, return the reply.
 
         Raises:
-            RemoteWorldError: No reply in time (the connection is then closed), or an error reply.
+            RemoteWorldError: No reply in time (the connection is then closed), a reply that is not
+                the protocol, or an error reply.
         """
         if self._socket is None:
             raise RemoteWorldError(f"the connection to {self.address} is closed")
+        if self.trial is not None and op not in ("hello", "open"):
+            fields["trial"] = self.trial
         try:
             self._socket.send(pack({"op": op, **fields}))
             reply = unpack(self._socket.recv())
         except zmq.Again:
             self.close()
             raise RemoteWorldError(
-                f"no reply from the world at {self.address} within {self.timeout_ms / 1000:g} s "
-                "(is `agentchord serve` running there?)"
+                f"no reply from the world at {self.address} within {self.timeout_s:g} s "
+                f"(is `agentchord serve` running there? {ENV_TIMEOUT} sets the wait)"
             ) from None
+        except WireError as exc:
+            self.close()
+            raise MalformedReplyError(f"the world at {self.address} does not speak the world protocol: "
+                                      f"its reply to {op!r} is {exc}") from None
         self.requests += 1
-        if not reply.get("ok"):
-            raise RemoteWorldError(f"the world at {self.address} refused {op!r}: {reply.get('type')}: {reply.get('error')}")
+        ok = reply.get("ok")
+        if ok is not True:
+            if ok is False:
+                raise RemoteWorldError(f"the world at {self.address} refused {op!r}: {reply.get('type')}: {reply.get('error')}")
+            raise MalformedReplyError(f"the world at {self.address} sent a malformed {op!r} reply: ok: "
+                                      f"{'missing' if 'ok' not in reply else f'expected true or false, got {ok!r:.40}'}")
         return reply
 
     def close(self) -> None:
@@ -149,11 +367,13 @@ class RemoteWorld:
             return
         socket, self._socket = self._socket, None
         try:
-            socket.send(pack({"op": "close"}), zmq.NOBLOCK)
-            if socket.poll(1000):
-                socket.recv()
+            if self.trial is not None:  # a refused open has no trial to close (and must not close another's)
+                socket.send(pack({"op": "close", "trial": self.trial}), zmq.NOBLOCK)
+                if socket.poll(1000):
+                    socket.recv()
         except zmq.ZMQError:
             pass
+        self.trial = None
         socket.close(0)
 
     def __enter__(self) -> RemoteWorld:
@@ -162,10 +382,31 @@ class RemoteWorld:
     def __exit__(self, *exc: Any) -> None:
         self.close()
 
-    def _adopt(self, state: dict[str, Any]) -> None:
-        self._state = state
-        self.tick = int(state["tick"])
-        self._holding = frozenset((arm, name) for arm, name in state["holding"])
+    def _adopt(self, state: Any, op: str = "step") -> None:
+        n, m = len(self._objects), len(self._cloth_points)
+        names = {*self._objects, *self._cloth_points}
+        with self.reading(op) as read:
+            if not isinstance(state, dict):
+                raise read.fail("state", "missing" if state is None else f"expected a map, got {type(state).__name__}")
+            checked: dict[str, Any] = {
+                "tick": read.number(state, "tick", "state.tick", integer=True, low=0),
+                "arm_q": read.array(state, "arm_q", (2, 6), "state.arm_q"),
+                "tcp_pos": read.array(state, "tcp_pos", (2, 3), "state.tcp_pos"),
+                "tcp_rot": read.array(state, "tcp_rot", (2, 3, 3), "state.tcp_rot"),
+                "width": read.array(state, "width", (2,), "state.width"),
+                "hand_busy": read.field(state, "hand_busy", bool, "state.hand_busy"),
+            }
+            holding = read.field(state, "holding", list, "state.holding")
+            for pair in holding:
+                if not (isinstance(pair, (list, tuple)) and len(pair) == 2 and pair[0] in ARMS and pair[1] in names):
+                    raise read.fail("state.holding", f"expected [arm, object] pairs of this scene, got {pair!r:.80}")
+            if self.has_ground_truth:
+                for key, shape in (("obj_pos", (n, 3)), ("obj_rot", (n, 3, 3)), ("obj_quat", (n, 4)),
+                                   ("cloth_pos", (m, 3)), ("cloth_out", (m, 3))):
+                    checked[key] = read.array(state, key, shape, f"state.{key}")
+        self._state = {**state, **checked}
+        self.tick = int(checked["tick"])
+        self._holding = frozenset((arm, name) for arm, name in holding)
 
     # ------------------------------------------------------------------ World
     @property
@@ -263,8 +504,18 @@ class RemoteWorld:
     def _sim(self, method: str, *args: Any) -> Any:
         reply = self.request("sim", method=method, args=list(args))
         if "state" in reply:
-            self._adopt(reply["state"])
+            self._adopt(reply["state"], f"sim {method}")
         return reply.get("result")
+
+    def _sim_number(self, method: str, *args: Any) -> float:
+        result = self._sim(method, *args)
+        with self.reading(f"sim {method}") as read:
+            return float(read.number({"result": result}, "result", low=0.0))
+
+    def _sim_flag(self, method: str, *args: Any) -> bool:
+        result = self._sim(method, *args)
+        with self.reading(f"sim {method}") as read:
+            return read.field({"result": result}, "result", bool)
 
     @property
     def hand_busy(self) -> bool:
@@ -273,31 +524,33 @@ class RemoteWorld:
 
     def object_velocity(self, name: str) -> float:
         """Linear speed of an object (m/s)."""
-        return float(self._sim("object_velocity", name))
+        return self._sim_number("object_velocity", name)
 
     def on_table(self, obj: str) -> bool:
         """Whether the object rests on the table."""
-        return bool(self._sim("on_table", obj))
+        return self._sim_flag("on_table", obj)
 
     def touching(self, obj_a: str, obj_b: str) -> bool:
         """Whether two objects touch."""
-        return bool(self._sim("touching", obj_a, obj_b))
+        return self._sim_flag("touching", obj_a, obj_b)
 
     def touching_cloth(self, arm: str) -> bool:
         """Whether either finger pad of ``arm`` touches the cloth."""
-        return bool(self._sim("touching_cloth", arm))
+        return self._sim_flag("touching_cloth", arm)
 
     def cloth_speed(self) -> float:
         """Largest speed of a cloth vertex (m/s)."""
-        return float(self._sim("cloth_speed"))
+        return self._sim_number("cloth_speed")
 
     def cloth_vertices(self) -> np.ndarray:
         """Positions of the cloth's vertices (n x 3)."""
-        return np.asarray(self._sim("cloth_vertices"), dtype=float)
+        result = self._sim("cloth_vertices")
+        with self.reading("sim cloth_vertices") as read:
+            return np.asarray(read.array({"result": result}, "result", (-1, 3)), dtype=float)
 
     def gripper_faulted(self, arm: str) -> bool:
         """Whether a gripper fault is forcing ``arm`` open now."""
-        return bool(self._sim("gripper_faulted", arm))
+        return self._sim_flag("gripper_faulted", arm)
 
     def inject_gripper_fault(self, arm: str, ticks: int) -> None:
         """Force ``arm``'s gripper open for ``ticks`` ticks (the drop disturbance)."""

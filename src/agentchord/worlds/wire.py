@@ -14,7 +14,8 @@ import msgpack
 import numpy as np
 
 #: Version of the message protocol; a client and a server of different versions refuse each other.
-PROTOCOL_VERSION = 1
+#: 2: ``open`` returns a trial token that the trial's later requests carry (one client at a time).
+PROTOCOL_VERSION = 2
 #: msgpack extension type code of a numpy array.
 ARRAY_EXT = 1
 
