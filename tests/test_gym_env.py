@@ -93,3 +93,24 @@ def test_replaying_an_agentchord_episode_succeeds_in_the_env() -> None:
             break
     env.close()
     assert terminated and reward == 1.0 and info["is_success"]
+
+
+@pytest.mark.parametrize(("action", "message"), [
+    (np.zeros(13), r"action must have shape \(14,\) \(the action space is Box"),
+    (np.zeros((2, 14)), r"action must have shape \(14,\)"),
+    (np.full(14, np.nan), "action must be finite: left_waist, left_shoulder"),
+    ([0.0] * 13 + [float("inf")], "action must be finite: right_gripper is inf"),
+    (["open"] * 14, "action must be 14 numbers"),
+    (None, "action must have shape"),
+])
+def test_an_action_outside_the_action_space_is_a_clear_error(action, message) -> None:
+    env = AgentChordEnv("single_arm_pour_water")
+    try:
+        env.reset(seed=0)
+        with pytest.raises(ValueError, match=message):
+            env.step(action)
+        assert env.world.tick == 0  # refused before anything moved
+        obs, *_ = env.step(np.clip(np.zeros(14), env.action_space.low, env.action_space.high))
+        assert np.all(np.isfinite(obs["agent_pos"])) and env.world.tick == 1
+    finally:
+        env.close()

@@ -133,7 +133,7 @@ class AgentChordEnv(gym.Env):
         """One control tick with ``action`` as the arms' targets."""
         if self.extractor is None:
             raise RuntimeError("call reset() before step()")
-        action = np.asarray(action, dtype=np.float32)
+        action = self._checked(action)
         for arm, command in arm_commands(action).items():
             self.world.command(arm, command)
         self.world.step()
@@ -149,6 +149,30 @@ class AgentChordEnv(gym.Env):
         terminated = self.success
         truncated = not terminated and self.world.tick >= self.max_steps
         return self._observation(), reward, terminated, truncated, self._info()
+
+    def _checked(self, action) -> np.ndarray:
+        """``action`` as the space's float32 array (values beyond the bounds are passed on, as before).
+
+        Raises:
+            ValueError: Not numbers, another shape than the action space's, or NaN/infinite entries
+                (which would make every later observation NaN).
+        """
+        shape = self.action_space.shape
+        try:
+            array = np.asarray(action, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise ValueError(f"action must be {shape[0]} numbers (the action space is {self.action_space}), "
+                             f"got {action!r:.80}") from None
+        if array.shape != shape:
+            raise ValueError(f"action must have shape {shape} (the action space is {self.action_space}), got shape "
+                             f"{array.shape}")
+        bad = ~np.isfinite(array)
+        if bad.any():
+            names = [JOINT_NAMES[k] for k in np.flatnonzero(bad)]
+            more = f" and {len(names) - 3} more" if len(names) > 3 else ""
+            raise ValueError(f"action must be finite: {', '.join(names[:3])}{more} {'is' if len(names) == 1 else 'are'} "
+                             f"{array[bad][0]}")
+        return np.asarray(action, dtype=np.float32)
 
     def _observation(self) -> dict:
         obs = {"agent_pos": joint_state(self.world), "environment_state": environment_state(self.world)}
