@@ -7,7 +7,7 @@ from pathlib import Path
 import click
 from rich.console import Console
 
-from agentchord.cli.support import BadInput, FiniteFloatRange
+from agentchord.cli.support import BadInput, FiniteFloatRange, catches_sigterm
 
 
 def _kinds(ctx, param, value: str) -> tuple[str, ...]:
@@ -32,7 +32,8 @@ def _size(ctx, param, value: str) -> tuple[int, int]:
 @click.command("record")
 @click.argument("task")
 @click.option("--episodes", type=click.IntRange(1), default=10, show_default=True, help="Episodes to write.")
-@click.option("--out", "out", type=click.Path(file_okay=False), required=True, help="Dataset directory (must not exist).")
+@click.option("--out", "out", type=click.Path(file_okay=False), required=True,
+              help="Dataset directory: a new one, or one this command was interrupted writing (rerun it to resume).")
 @click.option("--p", "p", type=FiniteFloatRange(0.0, 1.0), default=0.0, show_default=True, help="Disturbance probability per atomic action.")
 @click.option("--disturb", default="drop", show_default=True, callback=_kinds, help="Disturbance kinds, comma-separated: drop, pull, perturb, shift, knock.")
 @click.option("--protocol", type=click.Choice(("real", "stress", "custom")), is_flag=False, flag_value="custom", default=None,
@@ -43,13 +44,16 @@ def _size(ctx, param, value: str) -> tuple[int, int]:
 @click.option("--max-tries", type=click.IntRange(1), default=None, help="Seeds to run at most (default 10 x --episodes).")
 @click.option("--camera", "cameras", multiple=True, default=("top", "right_wrist"), show_default=True, help="Scene camera recorded (repeat for more; 'none' for no images).")
 @click.option("--size", default="320x240", show_default=True, callback=_size, help="Image size WIDTHxHEIGHT.")
+@catches_sigterm
 def record_command(task, episodes, out, p, disturb, protocol, only_recovered, keep_failed, seed, max_tries, cameras, size) -> None:
     """Run TASK's seeded episodes and write them as a LeRobot v3.0 dataset at --out.
 
     Each frame has the 14-dim ALOHA joint state and action, the objects' poses, camera images
     (videos), the instruction as its task, and columns marking the active graph node and edge and
     whether it lies in a recovery segment. Failed episodes are not written unless --keep-failed.
-    Exit status 0 when --episodes episodes were written, 1 when fewer were.
+    Each episode is on disk once it is reported written: interrupted (Ctrl-C, SIGTERM), the same
+    command resumes the dataset with the next seed. Exit status 0 when --episodes episodes were
+    written, 1 when fewer were.
     """
     import sys  # noqa: PLC0415
 
@@ -61,19 +65,26 @@ def record_command(task, episodes, out, p, disturb, protocol, only_recovered, ke
         raise click.BadParameter(f"unknown task {task!r} (tasks: {', '.join(SIM_TASKS)})", param_hint="TASK")
     if task not in library_tasks():
         raise click.BadParameter(f"{task!r} has no library graph to record", param_hint="TASK")
-    if Path(out).exists():
-        raise BadInput(f"--out {out}: already exists (a dataset is written into a new directory)")
     cameras = () if tuple(cameras) == ("none",) else tuple(cameras)
+    from agentchord.data.record import ResumeError, record_settings, recorded_state  # noqa: PLC0415
+
+    kinds = PRESETS.get(protocol or "", disturb)
+    try:
+        state = recorded_state(out, record_settings(task, p, kinds, protocol is not None, only_recovered, keep_failed, seed,
+                                                    cameras, size, "agentchord"))
+    except ResumeError as exc:
+        raise BadInput(f"--out {out}: {exc}") from None
     from agentchord.worlds.sim.trial import open_world  # noqa: PLC0415
 
     known = open_world(task, seed).camera_names
     unknown = [c for c in cameras if c not in known]
     if unknown:
         raise click.BadParameter(f"no camera {unknown[0]!r} in the {task} scene (cameras: {', '.join(known)})", param_hint="--camera")
-    kinds = PRESETS.get(protocol or "", disturb)
     from agentchord.data.record import record  # noqa: PLC0415
 
     console = Console()
+    if state is not None:
+        console.print(f"resuming {out}: {len(state['episodes'])} episodes written, going on from seed {state['next_seed']}")
 
     def progress(s: int, entry: dict | None, why: str) -> None:
         if entry is None:
@@ -86,8 +97,10 @@ def record_command(task, episodes, out, p, disturb, protocol, only_recovered, ke
         report = record(task, episodes, out, p=p, disturb=kinds, protocol=protocol is not None, only_recovered=only_recovered,
                         keep_failed=keep_failed, seed=seed, max_tries=max_tries, cameras=cameras, image_size=size,
                         progress=progress)
+    except ResumeError as exc:
+        raise BadInput(f"--out {out}: {exc}") from None
     except OSError as exc:
-        raise BadInput(f"--out {out}: {exc}") from exc
+        raise BadInput(f"--out {out}: {exc.strerror or exc}") from exc
     frames = sum(e["frames"] for e in report.written)
     console.print(f"dataset: {report.root} ({len(report.written)} episodes, {frames} frames, "
                   f"{len(report.skipped)} seeds not written)")

@@ -7,6 +7,11 @@ frames) and one H.264 MP4 per episode and camera, ``videos/{key}/chunk-CCC/file-
 episode's rows name its file and its from/to timestamps, as v3.0 allows). Features follow
 ``lerobot``: ``{"dtype", "shape", "names"}``, shape ``(1,)`` stored as a scalar column, the
 default columns ``timestamp``, ``frame_index``, ``episode_index``, ``index``, ``task_index``.
+
+Every saved episode is on disk at once: :meth:`DatasetWriter.checkpoint` rewrites the metadata
+and data files (each through a temporary file renamed over it), so that an interrupted writer
+leaves a dataset of the episodes it saved, which :meth:`DatasetWriter.resume` takes up again.
+The episode being written lives under ``tmp/`` until it is saved; a resumed writer removes it.
 """
 
 from __future__ import annotations
@@ -31,6 +36,9 @@ DEFAULT_FEATURES = {
     "task_index": {"dtype": "int64", "shape": [1], "names": None},
 }
 QUANTILES = (0.01, 0.10, 0.50, 0.90, 0.99)
+#: The saved episodes' image samples (the image statistics), kept so that a resumed writer can
+#: compute them again; not a lerobot file.
+SAMPLES_PATH = "meta/agentchord_image_samples.npz"
 
 
 class DatasetWriter:
@@ -47,9 +55,9 @@ class DatasetWriter:
         FileExistsError: ``root`` exists.
     """
 
-    def __init__(self, root: str | Path, fps: int, features: dict, robot_type: str = "aloha") -> None:
+    def __init__(self, root: str | Path, fps: int, features: dict, robot_type: str = "aloha", *, exist_ok: bool = False) -> None:
         self.root = Path(root)
-        self.root.mkdir(parents=True, exist_ok=False)
+        self.root.mkdir(parents=True, exist_ok=exist_ok)
         self.fps = fps
         self.features = {k: {**v, "shape": list(v["shape"])} for k, v in features.items()}
         self.robot_type = robot_type
@@ -63,6 +71,50 @@ class DatasetWriter:
         #: Per camera, pixel samples of the saved episodes (the image statistics).
         self._samples: dict[str, list[np.ndarray]] = {k: [] for k in self.video_keys}
         self._new_episode()
+
+    @classmethod
+    def resume(cls, root: str | Path, fps: int, features: dict, episodes: int, robot_type: str = "aloha") -> DatasetWriter:
+        """A writer that goes on with the first ``episodes`` saved episodes of the dataset at ``root``.
+
+        Files a writer interrupted during a checkpoint may have written for a later episode are
+        ignored (and overwritten as it goes on); the unsaved episode under ``tmp/`` is removed.
+
+        Raises:
+            ValueError: The dataset's features or fps differ, or it holds fewer episodes.
+            OSError: A file cannot be read.
+        """
+        import pyarrow.parquet as pq  # noqa: PLC0415
+
+        writer = cls(root, fps, features, robot_type, exist_ok=True)
+        shutil.rmtree(writer.root / "tmp", ignore_errors=True)
+        for key in writer.video_keys:  # an episode whose video was moved in before the checkpoint that kept it
+            for path in (writer.root / "videos" / key).glob("chunk-*/file-*.mp4"):
+                chunk, file = int(path.parent.name[6:]), int(path.stem[5:])
+                if chunk * CHUNK_SIZE + file >= episodes:
+                    path.unlink()
+        info = json.loads((writer.root / "meta/info.json").read_text())
+        if info.get("fps") != fps or info.get("features") != {**writer.features, **DEFAULT_FEATURES}:
+            raise ValueError("its frame rate or features (cameras, image size, objects) differ")
+        if episodes == 0:
+            return writer
+        rows = pq.read_table(writer.root / EPISODES_PATH).to_pylist()
+        if len(rows) < episodes:
+            raise ValueError(f"meta/episodes holds {len(rows)} episodes, not the {episodes} recorded")
+        writer.episodes = rows[:episodes]
+        frames = writer.episodes[-1]["dataset_to_index"]
+        table = pq.read_table(writer.root / DATA_PATH.format(chunk_index=0, file_index=0)).slice(0, frames)
+        data = table.to_pydict()
+        for key in writer.columns:
+            writer.columns[key] = list(data[key])
+        tasks = pq.read_table(writer.root / "meta/tasks.parquet").to_pydict()
+        writer.tasks = {t: int(i) for t, i in zip(tasks["__index_level_0__"], tasks["task_index"])}
+        samples = writer.root / SAMPLES_PATH
+        if writer.video_keys and samples.exists():
+            with np.load(samples) as stored:
+                for key in writer.video_keys:
+                    parts = [stored[f"{key}/{k}"] for k in range(episodes) if f"{key}/{k}" in stored]
+                    writer._samples[key] = parts
+        return writer
 
     def _data_keys(self) -> list[str]:
         return [k for k in self.features if k not in self.video_keys]
@@ -153,31 +205,39 @@ class DatasetWriter:
             stats = _stats(self._buffer[key], self.features[key])
             for name, value in (stats or {}).items():
                 row[f"stats/{key}/{name}"] = value
-        for key in self.video_keys:
-            self._samples[key].extend(self._episode_samples[key])
+        for key in self.video_keys:  # one array per episode (saved beside the dataset for a resumed writer)
+            parts = self._episode_samples[key]
+            self._samples[key].append(np.concatenate(parts) if parts else np.zeros((0, 3), np.uint8))
         row.update(extra or {})
         self.episodes.append(row)
         self._new_episode()
         return index
 
     def finalize(self) -> Path:
-        """Write the data, episodes, tasks, stats and info files; returns the root."""
+        """Drop an unsaved episode and write every file of the saved ones; returns the root."""
+        self.discard_episode()
+        shutil.rmtree(self.root / "tmp", ignore_errors=True)
+        return self.checkpoint()
+
+    def checkpoint(self) -> Path:
+        """Write the data, episodes, tasks, stats and info files of the episodes saved so far.
+
+        Each file is written to a temporary file and renamed over the old one, ``info.json`` last.
+        """
         import pyarrow as pa  # noqa: PLC0415
         import pyarrow.parquet as pq  # noqa: PLC0415
 
-        self.discard_episode()
-        shutil.rmtree(self.root / "tmp", ignore_errors=True)
         (self.root / "meta").mkdir(exist_ok=True)
         features = {**self.features, **DEFAULT_FEATURES}
         if self.episodes:
             arrays = {key: _arrow_column(self.columns[key], features[key]) for key in self.columns}
-            path = self.root / DATA_PATH.format(chunk_index=0, file_index=0)
-            path.parent.mkdir(parents=True, exist_ok=True)
-            pq.write_table(pa.table(arrays), path)
+            _atomic(self.root / DATA_PATH.format(chunk_index=0, file_index=0), lambda p: pq.write_table(pa.table(arrays), p))
             keys = list(dict.fromkeys(k for row in self.episodes for k in row))
             episodes = pa.table({k: pa.array([row.get(k) for row in self.episodes]) for k in keys})
-            (self.root / EPISODES_PATH).parent.mkdir(parents=True, exist_ok=True)
-            pq.write_table(episodes, self.root / EPISODES_PATH)
+            _atomic(self.root / EPISODES_PATH, lambda p: pq.write_table(episodes, p))
+            if self.video_keys:
+                samples = {f"{key}/{k}": part for key in self.video_keys for k, part in enumerate(self._samples[key])}
+                _atomic(self.root / SAMPLES_PATH, lambda p: np.savez(p, **samples), suffix=".npz")
         self._write_tasks()
         stats = {key: _stats(self.columns[key], features[key]) for key in self.columns}
         for key in self.video_keys:
@@ -218,7 +278,7 @@ class DatasetWriter:
             "creator": {"library": "pyarrow", "version": pa.__version__}, "pandas_version": "2.2.0",
         }
         table = table.replace_schema_metadata({b"pandas": json.dumps(pandas_meta).encode()})
-        pq.write_table(table, self.root / "meta/tasks.parquet")
+        _atomic(self.root / "meta/tasks.parquet", lambda p: pq.write_table(table, p))
 
 
 def _arrow_column(values: list, feature: dict):
@@ -249,6 +309,7 @@ def _stats(values: list, feature: dict) -> dict | None:
 
 def _video_stats(parts: list[np.ndarray]) -> dict | None:
     """Image statistics (per channel, shape (3, 1, 1), values in [0, 1]) from pixel samples."""
+    parts = [p for p in parts if len(p)]
     if not parts:
         return None
     pixels = np.concatenate(parts).astype(np.float64) / 255.0  # (n, 3)
@@ -265,5 +326,15 @@ def _video_stats(parts: list[np.ndarray]) -> dict | None:
 
 
 def _write_json(path: Path, data: dict) -> None:
+    _atomic(path, lambda p: p.write_text(json.dumps(data, indent=4) + "\n"))
+
+
+def _atomic(path: Path, write, suffix: str = ".tmp") -> None:
+    """``write(tmp)`` then rename ``tmp`` over ``path``: a reader (or a resumed writer) never sees half a file."""
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(data, indent=4) + "\n")
+    tmp = path.with_name(f".{path.stem}.writing{suffix}")
+    try:
+        write(tmp)
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)

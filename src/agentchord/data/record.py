@@ -6,11 +6,17 @@ joint-position command of the tick (``action``), and what the executor was doing
 node and edge (names and indices into ``meta/agentchord.json``'s lists), the edge's kind, and
 whether the frame lies in a recovery segment (from the switch to a recovery edge until it merges
 back into the nominal path). The instruction is the task text.
+
+Each episode is on disk as soon as it is reported written (the dataset's files are rewritten
+after it, ``meta/agentchord.json`` last: it lists the episodes kept and the next seed). An
+interrupted recording (Ctrl-C, SIGTERM) leaves the dataset of the episodes it finished, and the
+same call resumes it (:func:`recorded_state`); the episode it was writing is dropped.
 """
 
 from __future__ import annotations
 
 import json
+import shutil
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -19,6 +25,7 @@ import numpy as np
 
 from agentchord.data.lerobot import DatasetWriter
 from agentchord.execution.episode import EpisodeSpec, run_episode
+from agentchord.guard.outputs import atomic_write_text
 from agentchord.gym.aloha import JOINT_NAMES, environment_names, environment_state, joint_action, joint_state
 from agentchord.gym.cameras import RgbCameras
 from agentchord.tasks import load_task_graph
@@ -26,6 +33,65 @@ from agentchord.worlds.protocol import CONTROL_HZ
 
 #: Cameras recorded by default (ALOHA's high camera and the right wrist).
 DEFAULT_CAMERAS = ("top", "right_wrist")
+#: The file that says what a recording is, which episodes it kept and where it goes on.
+META_PATH = "meta/agentchord.json"
+
+
+class ResumeError(ValueError):
+    """A folder that ``record`` cannot go on with: not its dataset, unreadable, or recorded otherwise."""
+
+
+def recorded_state(out: str | Path, settings: dict) -> dict | None:
+    """What a recording at ``out`` made with ``settings`` has done so far, to go on with it.
+
+    Args:
+        out: The dataset directory.
+        settings: The recording's settings (:func:`record_settings`).
+
+    Returns:
+        ``None`` when ``out`` is missing or an empty folder (a new recording), else the recording's
+        ``meta/agentchord.json``: ``episodes`` (those kept), ``skipped``, ``next_seed``.
+
+    Raises:
+        ResumeError: ``out`` is a file, a folder that holds something else, an unreadable or
+            damaged recording, or one made with other settings (the first differing one named).
+    """
+    root = Path(out)
+    if not root.exists():
+        return None
+    if not root.is_dir():
+        raise ResumeError("it exists and is not a directory")
+    meta_path = root / META_PATH
+    try:
+        if not meta_path.exists():
+            if not any(p.name != "tmp" for p in root.iterdir()):
+                return None  # empty, or interrupted before the first checkpoint
+            raise ResumeError("it exists and holds no dataset that `record` wrote (no meta/agentchord.json): "
+                              "give a new directory")
+        meta = json.loads(meta_path.read_text())
+    except OSError as exc:
+        raise ResumeError(f"cannot read it: {exc.strerror or exc}") from None
+    except ValueError as exc:
+        raise ResumeError(f"{META_PATH} is damaged ({exc}): give a new directory") from None
+    recorded = meta.get("settings") if isinstance(meta, dict) else None
+    if not isinstance(recorded, dict) or not isinstance(meta.get("episodes"), list) \
+            or not isinstance(meta.get("next_seed"), int):
+        raise ResumeError(f"{META_PATH} does not say how it was recorded (written by an older agentchord?): "
+                          "give a new directory")
+    for key, value in settings.items():
+        if recorded.get(key) != value:
+            raise ResumeError(f"it was recorded with {key} = {recorded.get(key)!r}, not {value!r}: rerun with the "
+                              "same options to resume it, or give a new directory")
+    return meta
+
+
+def record_settings(task: str, p: float, disturb: tuple[str, ...], protocol: bool, only_recovered: bool,
+                    keep_failed: bool, seed: int, cameras: tuple[str, ...], image_size: tuple[int, int],
+                    strategy: str) -> dict:
+    """What decides a recording's episodes: a resumed recording must have the same."""
+    return {"task": task, "p": float(p), "disturb": list(disturb), "protocol": bool(protocol),
+            "only_recovered": bool(only_recovered), "keep_failed": bool(keep_failed), "first_seed": int(seed),
+            "cameras": list(cameras), "image_size": list(image_size), "strategy": strategy}
 
 
 @dataclass
@@ -135,7 +201,8 @@ def record(task: str, episodes: int, out: str | Path, *, p: float = 0.0, disturb
     Args:
         task: A simulated task with a library graph.
         episodes: Episodes to write.
-        out: The dataset directory (must not exist).
+        out: The dataset directory: new, empty, or a recording of the same settings to go on with
+            (its episodes kept, the seeds after the last one tried run).
         p, disturb, protocol: The disturbances, as ``agentchord run`` takes them.
         only_recovered: Write only episodes with at least one recovery that merged back.
         keep_failed: Write failed episodes too.
@@ -144,7 +211,7 @@ def record(task: str, episodes: int, out: str | Path, *, p: float = 0.0, disturb
         progress: Called after each seed with (seed, the written episode's entry or None, why not).
 
     Raises:
-        FileExistsError: ``out`` exists.
+        ResumeError: ``out`` holds something else, or a recording made with other settings.
         KeyError: Unknown task.
     """
     graph = load_task_graph(task)
@@ -153,45 +220,76 @@ def record(task: str, episodes: int, out: str | Path, *, p: float = 0.0, disturb
     instruction = graph.instruction or task.replace("_", " ")
     from agentchord.worlds.sim.trial import open_world  # noqa: PLC0415  (the scene's object names)
 
+    settings = record_settings(task, p, disturb, protocol, only_recovered, keep_failed, seed, cameras, image_size, strategy)
+    state = recorded_state(out, settings)
     env_names = environment_names(open_world(task, seed))
-    writer = DatasetWriter(out, CONTROL_HZ, features(env_names, cameras, image_size), robot_type="aloha")
+    frames_features = features(env_names, cameras, image_size)
     report = RecordReport(root=Path(out))
-    tries = max_tries if max_tries is not None else 10 * episodes
     current = seed
-    while len(report.written) < episodes and current < seed + tries:
-        recorder = EpisodeRecorder(writer, cameras, image_size, nodes, edges)
-        spec = EpisodeSpec(task=task, strategy=strategy, p=p, seed=current, disturb=disturb, protocol=protocol)
+    if state is None:
+        writer = DatasetWriter(out, CONTROL_HZ, frames_features, robot_type="aloha", exist_ok=True)
+    else:
         try:
-            result = run_episode(spec, on_tick=recorder)
-        finally:
-            recorder.close()
-        why = ""
-        if not result.success and not keep_failed:
-            why = f"failed: {result.reason}"
-        elif only_recovered and not result.trace.of("recovery_merged"):
-            why = "no recovery"
-        elif writer.episode_frames == 0:
-            why = "no frames"
-        entry = None
-        if why:
-            writer.discard_episode()
-            report.skipped.append((current, why))
-        else:
-            entry = {"seed": current, "success": result.success, "steps": result.steps, "frames": writer.episode_frames,
-                     "recoveries": result.recoveries,
-                     "recovery_frames": recorder.recovery_frames,
-                     "disturbances": ",".join(e["kind"] for e in result.trace.of("disturbance"))}
-            writer.save_episode(instruction, extra=entry)
-            report.written.append(entry)
-        if progress is not None:
-            progress(current, entry, why)
-        current += 1
+            writer = DatasetWriter.resume(out, CONTROL_HZ, frames_features, len(state["episodes"]), robot_type="aloha")
+        except (OSError, ValueError, KeyError) as exc:
+            raise ResumeError(f"its dataset cannot be taken up again ({exc}): give a new directory") from None
+        report.written = list(state["episodes"])
+        report.skipped = [tuple(s) for s in state.get("skipped", [])]
+        nodes = list(state.get("nodes", nodes))
+        edges = list(state.get("edges", edges))
+        current = state["next_seed"]
+
+    def save(complete: bool = False) -> None:
+        writer.checkpoint()
+        meta = {"task": task, "instruction": instruction, "nodes": nodes, "edges": edges,
+                "disturbances": {"p": p, "kinds": list(disturb), "protocol": protocol}, "strategy": strategy,
+                "settings": settings, "next_seed": current, "complete": complete,
+                "skipped": [list(s) for s in report.skipped],
+                "episodes": report.written}
+        atomic_write_text(Path(out) / META_PATH, json.dumps(meta, indent=2) + "\n")
+
+    tries = max_tries if max_tries is not None else 10 * episodes
+    try:
+        if state is None:
+            save()  # a dataset of no episode yet: from here on, the folder can always be resumed
+        while len(report.written) < episodes and current < seed + tries:
+            recorder = EpisodeRecorder(writer, cameras, image_size, nodes, edges)
+            spec = EpisodeSpec(task=task, strategy=strategy, p=p, seed=current, disturb=disturb, protocol=protocol)
+            try:
+                result = run_episode(spec, on_tick=recorder)
+            finally:
+                recorder.close()
+            why = ""
+            if not result.success and not keep_failed:
+                why = f"failed: {result.reason}"
+            elif only_recovered and not result.trace.of("recovery_merged"):
+                why = "no recovery"
+            elif writer.episode_frames == 0:
+                why = "no frames"
+            entry = None
+            if why:
+                writer.discard_episode()
+                report.skipped.append((current, why))
+            else:
+                entry = {"seed": current, "success": result.success, "steps": result.steps, "frames": writer.episode_frames,
+                         "recoveries": result.recoveries,
+                         "recovery_frames": recorder.recovery_frames,
+                         "disturbances": ",".join(e["kind"] for e in result.trace.of("disturbance"))}
+                writer.save_episode(instruction, extra=entry)
+                report.written.append(entry)
+            current += 1
+            save()  # on disk before it is reported
+            if progress is not None:
+                progress(current - 1, entry, why)
+    except BaseException:
+        # Interrupted: the episode being written goes; the saved ones stay, as last checkpointed.
+        writer.discard_episode()
+        shutil.rmtree(Path(out) / "tmp", ignore_errors=True)
+        raise
     writer.finalize()
-    meta = {"task": task, "instruction": instruction, "nodes": nodes, "edges": edges,
-            "disturbances": {"p": p, "kinds": list(disturb), "protocol": protocol}, "strategy": strategy,
-            "episodes": report.written}
-    (Path(out) / "meta/agentchord.json").write_text(json.dumps(meta, indent=2) + "\n")
+    save(complete=True)
     return report
 
 
-__all__ = ["DEFAULT_CAMERAS", "EpisodeRecorder", "RecordReport", "features", "record", "np"]
+__all__ = ["DEFAULT_CAMERAS", "META_PATH", "EpisodeRecorder", "RecordReport", "ResumeError", "features", "record",
+           "record_settings", "recorded_state", "np"]
