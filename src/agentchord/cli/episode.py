@@ -174,6 +174,17 @@ def _load_graph_option(graph_path: str | None):
     if problems:
         lines = "\n".join(f"{graph_path}: {p.path}: {p.message}" for p in problems)
         raise click.UsageError(f"the graph is not valid:\n{lines}")
+    if graph.success.goal_spec is not None:
+        from pydantic import ValidationError  # noqa: PLC0415
+
+        from agentchord.agents.rules.goals import GoalSpec  # noqa: PLC0415
+
+        try:
+            GoalSpec.model_validate(graph.success.goal_spec)
+        except ValidationError as exc:
+            lines = "\n".join(f"{graph_path}: success.goal_spec.{'.'.join(map(str, e['loc']))}: {e['msg']}"
+                              for e in exc.errors())
+            raise click.UsageError(f"the graph is not valid:\n{lines}") from None
     return graph
 
 

@@ -155,6 +155,21 @@ class Edge(_Model):
         return self.kind == "recovery"
 
 
+class Success(_Model):
+    """What success means for a graph: what an episode that runs it is judged by.
+
+    Attributes:
+        judge: ``task``: the scene's built-in check of its task (the paper's tasks: the pour, the
+            handover to its region ...); ``goal``: this graph's own goal, the goal spec below and
+            the goal node's constraints (a planned graph whose instruction is not the task's own).
+        goal_spec: The goal predicates the graph was planned for (a goal spec, as ``agentchord
+            schema goal`` describes), judged on the end state; empty: the goal node's constraints only.
+    """
+
+    judge: Literal["task", "goal"] = "task"
+    goal_spec: dict[str, Any] | None = None
+
+
 class TaskGraph(_Model):
     """A recovery-augmented task graph.
 
@@ -166,6 +181,7 @@ class TaskGraph(_Model):
         objects: Names of the scene objects that actions and expressions may name.
         nodes: Sub-goal and recovery nodes.
         edges: Nominal and recovery edges.
+        success: What an episode running it is judged by (default: the task's own check).
     """
 
     task: str
@@ -175,6 +191,7 @@ class TaskGraph(_Model):
     objects: list[ObjectName] = Field(default_factory=list)
     nodes: list[Node]
     edges: list[Edge]
+    success: Success = Field(default_factory=Success)
 
     def node(self, node_id: str) -> Node:
         """The node with id ``node_id``.
