@@ -1,23 +1,24 @@
 """A pipelined plan's parts arriving while the robot moves: the executor's side of it.
 
 The robot starts once the first edge is grounded (:mod:`agentchord.execution.planning`); the rest
-of the plan arrives at ticks of the episode. Until an edge's failure modes and branches have
-arrived, the edge runs with what needs no reasoner: **monitors derived from its own constraints**
--- each constraint its source and target nodes share (what is held stays held; what stands stays
-standing), each of its path constraints, and the hold of what its own grasps take once the gripper
-has closed, each as a monitor with the default persistence window.
-The arranger's other monitors (a cup drifting, a bottle slipping in the hand) are armed when they
-arrive; the persistence history starts then.
+of the plan arrives at ticks of the episode. Until the arranger's list of an edge's failure modes
+has arrived, the edge runs with what needs no reasoner: **monitors derived from its own
+constraints** -- each constraint its source and target nodes share (what is held stays held; what
+stands stays standing), each of its path constraints, and the hold of what its own grasps take
+once the gripper has closed, each as a monitor with the default persistence window. From the
+list's arrival the edge's own monitors are armed (their persistence history starts then).
 
-A failure before its branch has arrived -- a derived monitor that fires, a skill that reports
-failure, a failure mode the strategy names -- **waits for the branch**: the arms hold still (the
-world keeps stepping, disturbances keep acting), and when the branch arrives the failure is taken
-again on what the scene is then: an arrived monitor that reads it violated switches to its
-recovery as if it had just fired; a skill's failure goes to the strategy as usual; a derived
-monitor that no arrived failure mode explains lets the edge go on. A nominal edge whose grounding
-has not arrived when the robot reaches its source waits the same way. Each case is in the trace
-(``failure_before_branch``, then ``branch_arrived`` with what came of it) and in the episode's
-result (:attr:`EpisodeResult.early_failures`).
+A failure before its recovery branch has arrived **waits for the branch**: the arms hold still
+(the world keeps stepping, disturbances keep acting) and the recovery starts when the branch is
+there, from where things are then. A mode that fires waits for its own branch. A derived monitor
+that fires waits for the list, then is the mode that watches the same constraint (it would have
+fired, had it been there) and waits for that mode's branch; if no mode watches it, it waits for
+all the edge's branches and asks their monitors what the scene is: one that reads it violated
+recovers, else the edge goes on. A skill that reports failure waits for the list, then goes to
+the strategy as usual. A nominal edge whose grounding has not arrived when the robot reaches its
+source waits the same way. Each case is in the trace (``failure_before_branch``,
+``modes_listed``, ``branch_arrived`` with what came of it) and in the episode's result
+(:attr:`EpisodeResult.early_failures`).
 
 :class:`PlanArrivals` is a part of :class:`~agentchord.execution.executor.Executor` (a mixin), as
 :class:`~agentchord.execution.switching.RecoverySwitching` is.
@@ -192,7 +193,7 @@ class PlanArrivals:
         return self._tick_at(self.schedule.mode_ready_s.get((edge_id, failure)))
 
     def _pending_modes(self, edge_id: str) -> list[int]:
-        """The ticks still to come at which ``edge_id``'s failure modes (or their list) arrive."""
+        """The ticks still to come at which ``edge_id``'s failure modes (or their list) can be recovered from."""
         if self.schedule is None:
             return []
         ticks = [self._mode_tick(edge_id, f.name) for f in self.graph.edge(edge_id).failures] if edge_id in self.monitors else []
@@ -203,39 +204,39 @@ class PlanArrivals:
         """The tick the arranger's list of ``edge_id``'s failure modes arrives, if still to come."""
         return self._tick_at(self.schedule.modes_listed_s.get(edge_id)) if self.schedule is not None else None
 
-    def branch_pending(self, edge_id: str) -> bool:
-        """Whether some failure mode of ``edge_id`` (its monitor or branch) is still to come."""
-        return bool(self._pending_modes(edge_id))
+    def modes_unknown(self, edge_id: str) -> bool:
+        """Whether the arranger's list of ``edge_id``'s failure modes (their monitors) is still to come."""
+        return self._listed_tick(edge_id) is not None
 
     # ------------------------------------------------------------ arming
     def _arm_early(self, program: EdgeProgram) -> bool:
-        """Arm what of ``program``'s monitors has arrived, and the derived ones (True when some are still to come)."""
-        pending = self._pending_modes(program.edge_id) if program.kind in ("nominal", "recovery") else []
-        if not pending:
+        """Arm the monitors derived from a nominal edge's own constraints while its modes are not known yet
+        (True when so); once they are, the edge's own monitors are armed as usual."""
+        listed = self._listed_tick(program.edge_id) if program.kind == "nominal" else None
+        if listed is None:
             self._early_armed = None
             return False
-        own = self.monitors.get(program.edge_id)
-        arrived = [m for m in own.monitors if self._mode_tick(program.edge_id, m.failure.name) is None] if own else []
-        derived = self._derived.get(program.edge_id) if program.kind == "nominal" else None
-        monitors = arrived + (derived.monitors if derived is not None else [])
-        self.armed = EdgeMonitors(monitors) if monitors else None
+        derived = self._derived.get(program.edge_id)
+        self.armed = derived if derived is not None and derived.monitors else None
         if self.armed is not None:
             self.armed.reset()
         self._early_armed = program.edge_id
-        self._rearm_tick = pending[0]
+        self._rearm_tick = listed
         return True
 
     def _arm_arrived(self) -> None:
-        """A failure mode of the running edge arrived: armed from now on (its persistence history starts)."""
+        """The running edge's modes arrived: their monitors are armed from now on (their persistence history starts)."""
         edge_id, self._early_armed = self._early_armed, None
         if self.program is None or self.program.edge_id != edge_id:
             return
         self._arm_monitors(self.program)
+        # Drift is measured from where things are now: what moved before, the running program has aimed at.
+        self.frame.capture_refs()
         self.trace.add(self.world.tick, "monitors_armed", edge=edge_id,
                        monitors=[m.failure.name for m in self.armed.monitors] if self.armed is not None else [])
 
     def _arrivals_due(self) -> bool:
-        """Whether a failure mode of the running edge arrives at this tick."""
+        """Whether the running edge's modes arrive at this tick."""
         return self._early_armed is not None and self.world.tick >= self._rearm_tick
 
     # ------------------------------------------------------------ waiting
@@ -315,11 +316,11 @@ class PlanArrivals:
         return detection
 
     def _early_program_failure(self) -> bool:
-        """Wait for the failure modes of an edge whose skill failed before they arrived (True when it waits)."""
+        """Wait for the list of modes of an edge whose skill failed before it arrived (True when it waits)."""
         program = self.program
-        pending = self._pending_modes(program.edge_id) if program is not None and program.kind == "nominal" else []
-        if not pending:
-            return False
+        listed = self._listed_tick(program.edge_id) if program is not None and program.kind == "nominal" else None
+        if listed is None:
+            return False  # the strategy reads the edge's monitors; a mode it names waits for its own branch
         since = self.world.tick
 
         def arrived() -> tuple[bool, str] | None:
@@ -328,8 +329,7 @@ class PlanArrivals:
             return self._on_program_failed()
 
         reason = f"skill failed: {program.failure_reason}"
-        self.trace.add(self.world.tick, "failure_before_branch", edge=program.edge_id, failure=reason, arrives_tick=pending[-1])
-        self._wait_for(program.edge_id, pending[-1], reason, arrived)
+        self._wait_for(program.edge_id, listed, reason, arrived)
         return True
 
     def _wait_for_grounding(self, program: EdgeProgram) -> bool:

@@ -379,7 +379,7 @@ class Executor(RecoverySwitching, PlanArrivals):
         if not self.strategy.uses_monitors:
             return None
         into_goal = [e for e in nominal_path(self.graph) if self.graph.edge(e).target == self.graph.goal]
-        if not into_goal or self.branch_pending(into_goal[-1]):
+        if not into_goal or self.modes_unknown(into_goal[-1]):
             return None
         monitors = self.monitors.get(into_goal[-1])
         return monitors.violated_now(self.frame) if monitors is not None else None

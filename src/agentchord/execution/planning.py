@@ -11,9 +11,9 @@ arranger is asked per edge for its failure modes, then per mode for its recovery
 conductor grounds each branch as it comes. The calls are served as the model allows
 (``concurrency`` at once), in the order the robot needs them: the edges' groundings, then edge
 k's modes and their branches before edge k+1's. The robot moves once the first edge is grounded; every other part
-arrives while it moves, as an event on the episode's clock (:class:`PlanSchedule`). A failure mode
-is armed once its branch, and whatever the branch can reach (a second failure while recovering may
-enter another mode's branch), has arrived grounded.
+arrives while it moves, as an event on the episode's clock (:class:`PlanSchedule`). An edge's
+monitors are armed once the arranger's list of its modes has arrived; a mode can be recovered from
+once what its recovery runs has arrived grounded.
 
 Pure functions of a graph and a latency model: the same graph and model give the same schedule.
 """
@@ -27,7 +27,6 @@ from agentchord.agents.replies import (
     augmentation_reply,
     branch_edges,
     branch_owners,
-    branch_reach,
     branch_reply,
     count_tokens,
     grounded_reply,
@@ -39,7 +38,7 @@ from agentchord.agents.replies import (
 )
 from agentchord.execution.reasoning import AnyLatencyModel, ModelledCall
 from agentchord.graph.models import TaskGraph
-from agentchord.graph.progress import nominal_path
+from agentchord.graph.progress import nominal_path, recovery_reach, with_alternatives
 from agentchord.worlds.protocol import CONTROL_HZ
 
 
@@ -74,10 +73,10 @@ class PlanSchedule:
         calls: Every call, in the order they started.
         first_motion_s: When the first edge is grounded: the robot moves from then on.
         edge_ready_s: Nominal edge id -> when its grounding has arrived.
-        mode_ready_s: (edge id, failure mode name) -> when the mode can fire and be recovered from:
-            its monitor, its branch and everything the branch can reach, grounded. A recovery edge's
-            modes come with the branch that brings the edge.
-        modes_listed_s: Nominal edge id -> when the arranger's list of its failure modes has arrived.
+        mode_ready_s: (edge id, failure mode name) -> when the mode can be recovered from: what its
+            recovery runs (entry, alternatives, the way on from the recovery nodes) has arrived grounded.
+        modes_listed_s: Nominal edge id -> when the arranger's list of its failure modes (their monitors)
+            has arrived: the monitors are armed from then on. A recovery edge's come with it.
         owners: Recovery edge or node id -> the (nominal edge, failure mode) whose branch brings it.
         critical: The parts the first motion waited for (the composer's stream, the first edge's grounding).
     """
@@ -147,14 +146,14 @@ def pipelined_schedule(graph: TaskGraph, latency: AnyLatencyModel) -> PlanSchedu
     ends = {job.key: job.end_s for job in done}
     grounded = {(e, f): ends[f"ground:{e}/{f}"] for e, f in nominal_failures(graph)}
     modes: dict[tuple[str, str], float] = {}
-    for (edge_id, failure), end in grounded.items():
-        # A mode can be recovered from once all its branch can reach has arrived, whichever mode brought it.
-        reach = [owners[item] for item in branch_reach(graph, edge_id, failure) if item in owners]
-        modes[(edge_id, failure)] = max([end, *(grounded[o] for o in reach)])
-    for edge in graph.recovery_edges():
-        owner = owners.get(edge.id)
-        for failure in edge.failures:
-            modes[(edge.id, failure.name)] = modes[owner] if owner is not None else composer_end
+    for edge, failure in graph.failures():
+        # A mode can be recovered from once what its recovery runs has arrived grounded: the entry, its
+        # alternatives, the way on from the recovery nodes they reach (a second failure on the way has
+        # its own mode, checked when it fires), whichever mode's branch brought each.
+        items = [*recovery_reach(graph, with_alternatives(graph, [failure.recovery]))[0], failure.recovery]
+        owned = [grounded[owners[item]] for item in items if item in owners]
+        own = grounded.get((edge.id, failure.name), composer_end)
+        modes[(edge.id, failure.name)] = max([own, *owned])
     calls = [ScheduledCall(composer, 0.0, composer_end)]
     calls += [ScheduledCall(job.call, job.start_s, job.end_s) for job in sorted(done, key=lambda j: (j.start_s, j.priority))]
     edge_ready = {edge_id: ends[f"edge:{edge_id}"] for edge_id in path}

@@ -74,7 +74,7 @@ class RecoverySwitching:
     _early_failure: Callable[[Detection], bool]
     as_arranged: Callable[[Detection], Detection]
     _early_program_failure: Callable[[], bool]
-    branch_pending: Callable[[str], bool]
+    modes_unknown: Callable[[str], bool]
 
     def _beyond_every_arm(self, obj: str, confirm_ik: bool) -> tuple[bool, str] | None:
         """The unrecoverable outcome when no arm can take ``obj`` where it is (else None)."""
@@ -160,7 +160,7 @@ class RecoverySwitching:
         """
         edge_id = self.nominal_next.get(node_id)
         monitors = self.monitors.get(edge_id) if edge_id is not None else None
-        if monitors is None or self.branch_pending(edge_id):
+        if monitors is None or self.modes_unknown(edge_id):
             return False
         frame = self.frame
         as_started = replace(frame, refs={name: feats.pos.copy() for name, feats in frame.objects.items()})
@@ -254,7 +254,7 @@ class RecoverySwitching:
         next edge whose monitor watches that constraint, fired now, so its recovery runs rather than
         an edge that cannot start (its monitor may be gated by a signal the cut-short recovery reset).
         """
-        if self.branch_pending(edge_id):
+        if self.modes_unknown(edge_id):
             return None  # its failure modes have not arrived
         violated = {" ".join(c.source.split()): c.scalar(self.frame) for c in self.constraints[node_id]
                      if c.scalar(self.frame) > 0.0}
