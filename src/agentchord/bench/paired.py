@@ -49,6 +49,8 @@ class PairedRow:
         exec_time_s: Execution time over those episodes.
         robot_and_compute_s: Robot time plus measured compute over them (no modelled reasoning).
         steps: Control ticks over those of them that saw a disturbance (in either run).
+        first_motion_s: Time to first motion over the episodes both completed.
+        critical_reasoning_s: Reasoning on the critical path (all the robot held still for) over them.
     """
 
     method: str
@@ -56,6 +58,8 @@ class PairedRow:
     exec_time_s: Difference | None
     robot_and_compute_s: Difference | None
     steps: Difference | None
+    first_motion_s: Difference | None = None
+    critical_reasoning_s: Difference | None = None
 
 
 def _difference(pairs: list[tuple[float, float]]) -> Difference | None:
@@ -100,6 +104,11 @@ def paired_rows(records: list[dict], reference: str = REFERENCE) -> list[PairedR
             robot_and_compute_s=_difference([(a["robot_time_s"] + a["compute_s"], b["robot_time_s"] + b["compute_s"])
                                              for a, b in both]),
             steps=_difference([(a["steps"], b["steps"]) for a, b in both if _disturbed(a, b)]),
+            first_motion_s=_difference([(a["first_motion_s"], b["first_motion_s"]) for a, b in both
+                                        if a.get("first_motion_s") is not None and b.get("first_motion_s") is not None]),
+            critical_reasoning_s=_difference([(a["critical_reasoning_s"], b["critical_reasoning_s"]) for a, b in both
+                                              if a.get("critical_reasoning_s") is not None
+                                              and b.get("critical_reasoning_s") is not None]),
         ))
     return rows
 
@@ -134,11 +143,13 @@ def paired_layout(records: list[dict], reference: str = REFERENCE) -> tuple[list
     header = ["Method", "Both complete",
               f"Exec. time s {ref} / other", "Δ s [95% CI]", f"{ref} faster in",
               f"Robot + compute s {ref} / other", "Δ s [95% CI]",
-              f"Steps {ref} / other (disturbed)", "Δ [95% CI]", f"{ref} fewer in"]
+              f"Steps {ref} / other (disturbed)", "Δ [95% CI]", f"{ref} fewer in",
+              f"First motion s {ref} / other", f"Critical reasoning s {ref} / other"]
     rows = []
     for row in paired_rows(records, reference):
         rows.append([SHORT.get(row.method, row.method), str(row.both_complete), *_cells(row.exec_time_s, 1),
-                     *_cells(row.robot_and_compute_s, 1)[:2], *_cells(row.steps, 0)])
+                     *_cells(row.robot_and_compute_s, 1)[:2], *_cells(row.steps, 0),
+                     _cells(row.first_motion_s, 1)[0], _cells(row.critical_reasoning_s, 1)[0]])
     return header, rows
 
 
@@ -154,7 +165,8 @@ def paired_markdown(records: list[dict], reference: str = REFERENCE) -> str:
             f"Over the episodes both methods completed (same task, condition and seed: the same scene and "
             f"disturbance schedule); steps over those of them with a disturbance in either run. "
             f"Δ = {ref} minus the other method, mean with its 95% t-interval; negative: {ref} is lower. "
-            f"Robot + compute leaves out the modelled reasoning latency.\n\n{common}\n")
+            f"Robot + compute leaves out the modelled reasoning latency. First motion: the reasoning (and compute) "
+            f"the robot waited for before it moved; critical reasoning: all it held still for.\n\n{common}\n")
 
 
 def paired_csv(records: list[dict], reference: str = REFERENCE) -> str:
@@ -162,7 +174,7 @@ def paired_csv(records: list[dict], reference: str = REFERENCE) -> str:
     out = io.StringIO()
     writer = csv.writer(out)
     fields = ("n", "reference", "other", "mean", "low", "high", "reference_better")
-    metrics = ("exec_time_s", "robot_and_compute_s", "steps")
+    metrics = ("exec_time_s", "robot_and_compute_s", "steps", "first_motion_s", "critical_reasoning_s")
     writer.writerow(["reference", "method", "both_complete"] + [f"{m}_{f}" for m in metrics for f in fields])
     for row in paired_rows(records, reference):
         values = []
