@@ -78,7 +78,8 @@ class Waiting:
         until: The tick it arrives.
         since: The tick the wait began.
         edge_id: The nominal edge whose part is awaited.
-        what: ``branch`` (its failure modes and recovery branches) or ``grounding`` (the edge itself).
+        what: ``branch`` (a failure waits: for the edge's list of modes, then a branch) or ``grounding``
+            (the edge itself, for the robot to go on).
         failure: What fired before the branch (None when waiting for a grounding).
         then: Called when it arrives: the episode's outcome, or None to go on.
         began: The tick this leg of the wait began (a failure may wait for the modes' list, then a branch).
@@ -187,7 +188,7 @@ class PlanArrivals:
         return tick if self.world.tick < tick else None
 
     def _mode_tick(self, edge_id: str, failure: str) -> int | None:
-        """The tick a failure mode (its monitor and branch) arrives, if still to come."""
+        """The tick a failure mode can be recovered from (what its recovery runs has arrived), if still to come."""
         if self.schedule is None:
             return None
         return self._tick_at(self.schedule.mode_ready_s.get((edge_id, failure)))
