@@ -22,7 +22,7 @@ from agentchord.execution.reasoning import VQA_REPLY_TOKENS, ModelledCall
 from agentchord.graph.models import TaskGraph
 from agentchord.graph.progress import nominal_path
 
-__all__ = ["composer_call", "next_step_call", "stages_call", "subgoal_calls", "vqa_call"]
+__all__ = ["composer_call", "next_step_call", "stages_call", "stages_reply", "subgoal_calls", "vqa_call"]
 
 #: Views the Code-as-Monitor constraint generator reads (front and top, CaM Eq. 1).
 GENERATOR_IMAGES = 2
@@ -44,6 +44,11 @@ def next_step_call(graph: TaskGraph, edge_id: str) -> ModelledCall:
 
 def stages_call(graph: TaskGraph) -> ModelledCall:
     """ReKep's one call: every stage's sub-goal and path constraints, what it grasps and releases."""
+    return ModelledCall("composer", "plan", count_tokens(stages_reply(graph)), part="every stage's constraints")
+
+
+def stages_reply(graph: TaskGraph) -> dict:
+    """What ReKep's one call writes, per stage (nominal edge): constraints, grasps, releases."""
     stages = []
     for edge_id in nominal_path(graph):
         edge = graph.edge(edge_id)
@@ -52,7 +57,7 @@ def stages_call(graph: TaskGraph) -> ModelledCall:
         released = sorted({c.args["obj"] for _, c in edge.calls if c.fn == "place" and "obj" in c.args})
         stage.update({k: v for k, v in (("grasp", grasped), ("release", released)) if v})
         stages.append(stage)
-    return ModelledCall("composer", "plan", count_tokens({"stages": stages}), part="every stage's constraints")
+    return {"stages": stages}
 
 
 def subgoal_calls(graph: TaskGraph, edge_id: str | None) -> list[ModelledCall]:
