@@ -214,3 +214,10 @@ def test_run_judges_a_planned_graph_by_its_own_goal(tmp_path):
     result = CliRunner().invoke(main, ["run", "single_arm_pour_water", "--graph", str(graph)])
     assert result.exit_code == 0, result.output
     assert "SUCCESS: every goal predicate holds at the end" in result.output
+
+
+def test_run_and_demo_accept_every_method_bench_compares():
+    from agentchord.cli.episode import METHOD_NAMES
+    from agentchord.execution.methods import METHODS
+
+    assert set(METHOD_NAMES) == set(METHODS)

@@ -24,8 +24,9 @@ from agentchord.cli.support import (
 from agentchord.guard.outputs import atomic_write_text, finite_json
 
 STRATEGY_NAMES = ("agentchord", "agentchord-bt")
-#: Every method `run` and `demo` accept: AgentChord, its ablation and the four baselines (`bench` compares them).
-METHOD_NAMES = (*STRATEGY_NAMES, "inner-monologue", "doremi", "rekep", "code-as-monitor")
+#: Every method `run` and `demo` accept: AgentChord, its ablation, AgentChord with the paper's sequential plan and
+#: the four baselines (`bench` compares them; named here so the command line loads without the executor).
+METHOD_NAMES = (*STRATEGY_NAMES, "agentchord-sequential", "inner-monologue", "doremi", "rekep", "code-as-monitor")
 DISTURB_HELP = "Disturbance kinds, comma-separated: drop, pull, perturb, shift, knock."
 PROTOCOL_NAMES = ("real", "stress", "custom")
 PROTOCOL_HELP = ("1-2 disturbances at random moments of each trial (ignores --p): 'real' = perturb + pull (the paper's "
