@@ -96,7 +96,7 @@ class LatencyModel:
 
     def describe(self) -> str:
         """One line for a table's caption."""
-        return "per call: " + ", ".join(f"{f.name} {getattr(self, f.name):g} s" for f in fields(self))
+        return ", ".join(f"{f.name} {getattr(self, f.name):g} s" for f in fields(self))
 
     def to_dict(self) -> dict:
         """JSON-ready (a sweep's manifest): the fields and the model's name."""
