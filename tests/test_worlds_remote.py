@@ -395,3 +395,9 @@ def test_an_address_the_client_cannot_use_is_refused_at_once(address, message):
     result = CliRunner().invoke(main, ["run", TASK, "--world", address])
     assert result.exit_code == 2 and message in result.output, result.output
     assert time.monotonic() - start < 5
+
+
+def test_a_seed_the_protocol_cannot_carry_is_refused_before_anything_is_sent():
+    result = CliRunner().invoke(main, ["run", TASK, "--world", "tcp://127.0.0.1:9", "--seed", str(2**64)])
+    assert result.exit_code == 2, result.output
+    assert "the world protocol carries seeds from 0 to 2^63 - 1" in result.output

@@ -262,6 +262,9 @@ class RemoteWorld:
             raise
 
     def _open(self, task: str, seed: int) -> None:
+        if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**63:
+            raise RemoteWorldSettingError(f"seed {seed!r} cannot be sent to a remote world: the world protocol "
+                                          "carries seeds from 0 to 2^63 - 1")
         hello = self.request("hello")
         if hello.get("protocol") not in PROTOCOLS:
             raise RemoteWorldError(f"{self.address} speaks world protocol {hello.get('protocol')!r}, "
@@ -340,7 +343,11 @@ class RemoteWorld:
         if self.trial is not None and op not in ("hello", "open"):
             fields["trial"] = self.trial
         try:
-            self._socket.send(pack({"op": op, **fields}))
+            message = pack({"op": op, **fields})
+        except (TypeError, ValueError, OverflowError) as exc:  # nothing was sent: the socket stays usable
+            raise RemoteWorldError(f"cannot send {op!r} to the world at {self.address}: {exc}") from None
+        try:
+            self._socket.send(message)
             reply = unpack(self._socket.recv())
         except zmq.Again:
             self.close()
