@@ -190,3 +190,13 @@ def test_a_served_ipv6_world_is_reachable_in_brackets():
     finally:
         stop.set()
         thread.join(5)
+
+
+def test_a_released_trial_whose_successor_closed_is_named_as_released(server, clock):
+    trial = _open(server, "A")
+    clock.now = 100.0
+    other = _open(server, "B")
+    assert server.handle({"op": "close", "trial": other})["ok"]
+    reply = server.handle({"op": "step", "trial": trial, "commands": {}})
+    assert reply["ok"] is False
+    assert f"trial {trial!r} is not open here: it was closed, or released after 60 s without a request" in reply["error"]

@@ -183,9 +183,12 @@ class WorldServer:
 
     def _world(self, request: dict[str, Any]) -> SimWorld:
         """The open trial's world, if ``request`` carries its token."""
-        if self.world is None:
-            raise ProtocolError("no trial is open: send 'open' first")
         token = request.get("trial")
+        if self.world is None:
+            if token is not None:  # its client was away: another one took the world and is done with it
+                raise ProtocolError(f"trial {token!r} is not open here: it was closed, or released after "
+                                    f"{self.release_after_s:g} s without a request")
+            raise ProtocolError("no trial is open: send 'open' first")
         if token != self.trial:
             raise ProtocolError(f"trial {token!r} is not open here: the world now serves {self.holder}'s trial "
                                 f"(a trial is released after {self.release_after_s:g} s without a request)")
