@@ -119,3 +119,56 @@ def test_a_record_missing_a_metric_is_refused_and_one_with_a_field_more_is_kept(
         RecordStore(tmp_path, SweepConfig())
     (tmp_path / RECORDS).write_text(json.dumps(_record(K0, added_later=1)) + "\n")
     assert RecordStore(tmp_path, SweepConfig()).records[K0]["added_later"] == 1
+
+
+# ---------------------------------------------------------------------------- issue 43
+_HOLD = """
+import sys, time
+from agentchord.bench.store import RecordStore
+from agentchord.bench.sweep import SweepConfig
+store = RecordStore(sys.argv[1], SweepConfig())
+print("locked", flush=True)
+time.sleep(30)
+"""
+
+
+def test_a_second_sweep_on_the_same_directory_is_refused_naming_the_first(tmp_path):
+    import subprocess
+    import sys
+
+    holder = subprocess.Popen([sys.executable, "-c", _HOLD, str(tmp_path)], stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "locked"
+        with pytest.raises(SweepStoreError, match=rf"another sweep is running on this directory \(pid {holder.pid}, "
+                                                  r"started .*\); wait for it to end, or use another --out"):
+            RecordStore(tmp_path, SweepConfig())
+    finally:
+        holder.kill()
+        holder.wait(10)
+    RecordStore(tmp_path, SweepConfig()).close()  # the lock went with its process
+
+
+def test_bench_on_a_directory_another_sweep_holds_exits_2(tmp_path):
+    import subprocess
+    import sys
+
+    from click.testing import CliRunner
+
+    from agentchord.cli import main
+
+    holder = subprocess.Popen([sys.executable, "-c", _HOLD, str(tmp_path)], stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "locked"
+        result = CliRunner().invoke(main, ["bench", "--out", str(tmp_path), "--tasks", "single_arm_pour_water",
+                                           "--methods", "agentchord", "--p", "0", "--trials", "1"])
+    finally:
+        holder.kill()
+        holder.wait(10)
+    assert result.exit_code == 2, result.output
+    assert "another sweep is running on this directory" in result.output
+
+
+def test_a_records_file_that_cannot_be_read_is_bad_input(tmp_path):
+    (tmp_path / RECORDS).mkdir()
+    with pytest.raises(SweepStoreError, match="records.jsonl: not a records file"):
+        RecordStore(tmp_path, SweepConfig())

@@ -6,10 +6,16 @@ A sweep's directory holds ``sweep.json`` (the configuration its records depend o
 written; reopening drops that torn tail. Rerunning the sweep skips every key already there,
 except an episode that stopped on an internal error: it runs again, and its new record,
 appended later, is the one that counts.
+
+One sweep at a time per directory: a store holds a lock on ``.sweep.lock`` (a POSIX record lock,
+released when its process ends, however it ends); a second sweep on the same ``--out`` is
+refused, naming the process that holds it.
 """
 
 from __future__ import annotations
 
+import datetime
+import fcntl
 import json
 import os
 from pathlib import Path
@@ -21,6 +27,7 @@ from agentchord.guard.outputs import atomic_write_text, finite_json
 
 MANIFEST = "sweep.json"
 RECORDS = "records.jsonl"
+LOCK = ".sweep.lock"
 
 
 class RecordStore:
@@ -44,9 +51,36 @@ class RecordStore:
         except OSError as error:
             raise SweepStoreError(f"{self.directory}: cannot create the directory ({error.strerror})") from None
         self.path = self.directory / RECORDS
+        self._lock = self._acquire_lock()
         self._check_manifest(config)
         self.records: dict[str, dict] = {}
         self._load()
+
+    def _acquire_lock(self) -> int:
+        """Lock the directory for this process; refuse if another process holds it."""
+        path = self.directory / LOCK
+        try:
+            fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError as error:
+            raise SweepStoreError(f"{path}: cannot open the sweep's lock ({error.strerror})") from None
+        try:
+            # lockf, not flock: a forked worker does not inherit it, so it goes with this process.
+            fcntl.lockf(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            holder = os.read(fd, 200).decode("utf-8", "replace").strip() or "another process"
+            os.close(fd)
+            raise SweepStoreError(f"{self.directory}: another sweep is running on this directory ({holder}); "
+                                  "wait for it to end, or use another --out") from None
+        os.ftruncate(fd, 0)
+        stamp = datetime.datetime.now().isoformat(timespec="seconds")
+        os.write(fd, f"pid {os.getpid()}, started {stamp}\n".encode())
+        return fd
+
+    def close(self) -> None:
+        """Release the directory's lock (it is released anyway when the process ends)."""
+        if self._lock is not None:
+            os.close(self._lock)
+            self._lock = None
 
     def _check_manifest(self, config: SweepConfig) -> None:
         manifest = self.directory / MANIFEST
@@ -73,14 +107,19 @@ class RecordStore:
     def _load(self) -> None:
         if not self.path.exists():
             return
-        data = self.path.read_bytes()
-        end = data.rfind(b"\n") + 1
-        if end < len(data):
-            # A torn last line (killed mid-write): that episode runs again.
-            with open(self.path, "r+b") as handle:
-                handle.truncate(end)
-                handle.flush()
-                os.fsync(handle.fileno())
+        if not self.path.is_file():
+            raise SweepStoreError(f"{self.path}: not a records file (a directory or a device); move it away or use another --out")
+        try:
+            data = self.path.read_bytes()
+            end = data.rfind(b"\n") + 1
+            if end < len(data):
+                # A torn last line (killed mid-write): that episode runs again.
+                with open(self.path, "r+b") as handle:
+                    handle.truncate(end)
+                    handle.flush()
+                    os.fsync(handle.fileno())
+        except OSError as error:
+            raise SweepStoreError(f"{self.path}: cannot read and resume it ({error.strerror})") from None
         for number, line in enumerate(data[:end].splitlines(), start=1):
             if not line.strip():
                 continue

@@ -31,10 +31,21 @@ class Condition:
     p: float = 0.0
     protocol: str | None = None
 
+    def __post_init__(self) -> None:
+        # One value, one condition: -0 is 0 (a label "p=-0" would be a sweep of its own).
+        object.__setattr__(self, "p", float(self.p) + 0.0)
+
     @property
     def label(self) -> str:
-        """``p=0.05`` or ``protocol=real``: the condition part of a record's key."""
-        return f"protocol={self.protocol}" if self.protocol else f"p={self.p:g}"
+        """``p=0.05`` or ``protocol=real``: the condition part of a record's key.
+
+        Short (``%g``) where that names the value exactly, its full repr where not: two
+        probabilities that differ in the seventh digit never share a label.
+        """
+        if self.protocol:
+            return f"protocol={self.protocol}"
+        short = f"{self.p:g}"
+        return f"p={short}" if float(short) == self.p else f"p={self.p!r}"
 
     @classmethod
     def from_label(cls, label: str) -> Condition:
@@ -88,7 +99,11 @@ class SweepConfig:
 
 
 def sweep_keys(tasks: list[str], methods: list[str], conditions: list[Condition], trials: int, first_seed: int = 0) -> list[EpisodeKey]:
-    """Every episode of a sweep, seeds innermost (the same seeds for every method: paired)."""
+    """Every episode of a sweep, seeds innermost (the same seeds for every method: paired).
+
+    A task, method or condition named twice is run, and counted, once.
+    """
+    tasks, methods, conditions = (list(dict.fromkeys(items)) for items in (tasks, methods, conditions))
     return [
         EpisodeKey(task, method, condition, seed)
         for condition in conditions for task in tasks for method in methods
