@@ -96,7 +96,7 @@ def test_replaying_an_agentchord_episode_succeeds_in_the_env() -> None:
 
 
 @pytest.mark.parametrize(("action", "message"), [
-    (np.zeros(13), r"action must have shape \(14,\) \(the action space is Box"),
+    (np.zeros(13), r"action must have shape \(14,\) \(the action space: Box\(14,\) of float32"),
     (np.zeros((2, 14)), r"action must have shape \(14,\)"),
     (np.full(14, np.nan), "action must be finite: left_waist, left_shoulder"),
     ([0.0] * 13 + [float("inf")], "action must be finite: right_gripper is inf"),

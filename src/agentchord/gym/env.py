@@ -158,13 +158,14 @@ class AgentChordEnv(gym.Env):
                 (which would make every later observation NaN).
         """
         shape = self.action_space.shape
+        space = f"Box{shape} of float32, the arms' joint targets and grips"  # its repr lists every bound
         try:
             array = np.asarray(action, dtype=np.float64)
         except (TypeError, ValueError):
-            raise ValueError(f"action must be {shape[0]} numbers (the action space is {self.action_space}), "
+            raise ValueError(f"action must be {shape[0]} numbers (the action space: {space}), "
                              f"got {action!r:.80}") from None
         if array.shape != shape:
-            raise ValueError(f"action must have shape {shape} (the action space is {self.action_space}), got shape "
+            raise ValueError(f"action must have shape {shape} (the action space: {space}), got shape "
                              f"{array.shape}")
         bad = ~np.isfinite(array)
         if bad.any():
