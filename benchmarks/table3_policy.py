@@ -116,11 +116,11 @@ def stage_record(out: Path, n_nominal: int, n_recovered: int) -> dict:
                          ("recovered", {"episodes": n_recovered, "seed": RECOVERED_SEED, "protocol": True,
                                         "disturb": ("shift",), "only_recovered": True})):
         root = dirs[name]
-        if (root / "meta/agentchord.json").exists():
+        meta = root / "meta/agentchord.json"
+        if meta.exists() and json.loads(meta.read_text()).get("complete", True):
             print(f"[record] {name}: {root} exists, kept")
             continue
-        if root.exists():
-            raise SystemExit(f"{root} is an unfinished dataset: remove it and rerun")
+        # An interrupted recording is resumed by the same call (record keeps each finished episode).
         t0 = time.perf_counter()
         report = record(TASK, kwargs.pop("episodes"), root, cameras=(), **kwargs,
                         progress=lambda s, e, why, n=name: print(f"[record] {n} seed {s}: {'written' if e else why}",
