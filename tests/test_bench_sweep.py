@@ -27,3 +27,16 @@ def test_a_task_method_or_condition_named_twice_runs_once():
     keys = sweep_keys(["t", "t"], ["m", "n", "m"], [Condition(p=0.1), Condition(p=0.10), Condition(p=-0.0)], 2)
     ids = [k.id for k in keys]
     assert len(ids) == len(set(ids)) == 1 * 2 * 2 * 2
+
+
+def test_bench_counts_a_task_or_method_named_twice_once(tmp_path):
+    from click.testing import CliRunner
+
+    from agentchord.cli import main
+
+    task = "single_arm_pour_water"
+    result = CliRunner().invoke(main, ["bench", "--out", str(tmp_path), "--tasks", f"{task},{task}", "--methods",
+                                       "agentchord,agentchord", "--p", "0,-0", "--trials", "1", "--workers", "1"])
+    assert result.exit_code == 0, result.output
+    assert "1 task(s) x 1 method(s) x p=0 x 1 seeds = 1 episodes" in " ".join(result.output.split())
+    assert len((tmp_path / "records.jsonl").read_text().splitlines()) == 1

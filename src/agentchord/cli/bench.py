@@ -26,7 +26,8 @@ class EpisodesStoppedOnErrors(click.ClickException):
 
 
 def _csv_list(value: str) -> list[str]:
-    return [part.strip() for part in value.split(",") if part.strip()]
+    # A name given twice is one task or method (it would otherwise be counted twice in the header).
+    return list(dict.fromkeys(part.strip() for part in value.split(",") if part.strip()))
 
 
 def _probabilities(ctx, param, value: str | None) -> list[float] | None:
