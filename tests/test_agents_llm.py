@@ -462,3 +462,17 @@ def test_other_client_errors_become_transport_errors(nominal, scene):
     with pytest.raises(ReasonerTransportError, match="OpenAIError: unreadable response"):
         llm.compose(compose_request(nominal, scene))
     assert len(llm.calls) == 1 and not llm.calls[0].ok
+
+
+@pytest.mark.parametrize("settings,problem", [
+    ({"base_url": "ftp://example.org/v1"}, "base_url: expected an http:// or https:// URL with a host"),
+    ({"base_url": "127.0.0.1:11434/v1"}, "base_url: expected an http:// or https:// URL with a host"),
+    ({"timeout_s": 1e300}, "timeout_s: at most 86400 s (a day)"),
+    ({"deadline_s": 1e9}, "deadline_s: at most 86400 s (a day)"),
+])
+def test_settings_an_endpoint_cannot_use_are_refused_when_read(settings, problem):
+    # Before, an ftp:// or scheme-less URL was retried for ~15 s, and a huge timeout overflowed a clock.
+    values = {"base_url": "http://127.0.0.1:1/v1", "model": "m", "api_key": "k", **settings}
+    with pytest.raises(ReasonerConfigError) as caught:
+        LlmConfig(**values)
+    assert any(problem in line for line in caught.value.problems)

@@ -206,8 +206,6 @@ def test_a_graph_whose_goal_spec_is_invalid_is_refused(tmp_path):
     assert result.exit_code == 2 and "success.judge" in result.output, result.output
 
 
-@pytest.mark.xfail(strict=True, reason="execution/episode.py must judge a --graph run by graph.success (issue 43, "
-                                        "class 6): the patch is in the issue's closing note")
 def test_run_judges_a_planned_graph_by_its_own_goal(tmp_path):
     graph = tmp_path / "handover.yaml"
     assert CliRunner().invoke(main, ["plan", HANDOVER, "--task", "single_arm_pour_water", "-o", str(graph)]).exit_code == 0

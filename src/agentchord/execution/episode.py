@@ -135,7 +135,7 @@ def _run_in(world: World, spec: EpisodeSpec, on_tick: Callable[[Executor], None]
             repairer = ReasonerRepairer(reasoner, regions)
     else:
         graph = spec.graph or load_task_graph(spec.task)
-        tracker = task.success_tracker()
+        tracker = graph_goal_tracker(spec.task, graph)
         if repairer is None and spec.repair:
             repairer = ReasonerRepairer(make_reasoner("rules"), task_regions(task))
     # A graph that fails `graph check` or names objects this scene lacks is refused before the first tick.
@@ -176,6 +176,15 @@ def _augmenting(nominal: TaskGraph, scene: Scene, reasoner, world: World, task: 
         return planned.graph, list(reasoner.calls[first:])
 
     return work
+
+
+def graph_goal_tracker(task_name: str, graph: TaskGraph) -> SuccessTracker:
+    """The success check a graph file asks for (its ``success``): the task's own, or the graph's own goal."""
+    task = SIM_TASKS[task_name]
+    if graph.success.judge == "task":
+        return task.success_tracker()
+    goal = GoalSpec.model_validate(graph.success.goal_spec) if graph.success.goal_spec else None
+    return judge_by_goal(goal, graph.node(graph.goal).constraints, getattr(task, "regions", {}))
 
 
 def planned_goal_tracker(task_name: str, goal: GoalSpec | None, graph: TaskGraph, scene: Scene) -> SuccessTracker:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
+import urllib.parse
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any, Literal, get_args
@@ -43,6 +44,10 @@ _OPTIONAL: tuple[tuple[str, str, Callable[[str], Any]], ...] = (
     ("deadline_s", ENV_DEADLINE, float),
     ("max_reply_chars", ENV_MAX_REPLY, int),
 )
+
+
+#: The longest wait a setting may ask for (a timeout, a deadline, a back-off): beyond it a clock overflows.
+MAX_WAIT_S = 86_400.0
 
 
 @dataclass(frozen=True)
@@ -103,6 +108,13 @@ class LlmConfig:
         for name in ("max_repairs", "max_retries", "backoff_base_s", "backoff_max_s"):
             if not _finite_number(getattr(self, name)) or not getattr(self, name) >= 0:
                 problems.append(f"{name}: expected a finite number >= 0, got {getattr(self, name)!r}")
+        for name in ("timeout_s", "deadline_s", "backoff_base_s", "backoff_max_s"):
+            if _finite_number(getattr(self, name)) and getattr(self, name) > MAX_WAIT_S:
+                problems.append(f"{name}: at most {MAX_WAIT_S:g} s (a day), got {getattr(self, name)!r}")
+        if isinstance(self.base_url, str) and self.base_url.strip():
+            url = urllib.parse.urlsplit(self.base_url.strip())
+            if url.scheme not in ("http", "https") or not url.netloc:
+                problems.append(f"base_url: expected an http:// or https:// URL with a host, got {self.base_url!r}")
         if self.temperature is not None and not (_finite_number(self.temperature) and 0 <= self.temperature <= 2):
             problems.append(f"temperature: expected a number from 0 to 2 or None, got {self.temperature!r}")
         if self.max_tokens is not None and self.max_tokens < 1:
