@@ -78,8 +78,6 @@ class Waiting:
         until: The tick it arrives.
         since: The tick the wait began.
         edge_id: The nominal edge whose part is awaited.
-        what: ``branch`` (a failure waits: for the edge's list of modes, then a branch) or ``grounding``
-            (the edge itself, for the robot to go on).
         failure: What fired before the branch (None when waiting for a grounding).
         then: Called when it arrives: the episode's outcome, or None to go on.
         began: The tick this leg of the wait began (a failure may wait for the modes' list, then a branch).
@@ -88,7 +86,6 @@ class Waiting:
     until: int
     since: int
     edge_id: str
-    what: str
     failure: str | None
     then: Callable[[], tuple[bool, str] | None]
     began: int = -1
@@ -244,7 +241,7 @@ class PlanArrivals:
     def _wait_for(self, edge_id: str, until: int, failure: str | None, then: Callable[[], tuple[bool, str] | None]) -> None:
         """Hold the arms still until tick ``until`` (a part of the plan for ``edge_id`` arrives), then call ``then``."""
         self.program, self.armed = None, None
-        self.waiting = Waiting(until, self.world.tick, edge_id, "branch" if failure else "grounding", failure, then)
+        self.waiting = Waiting(until, self.world.tick, edge_id, failure, then)
         if failure is not None:
             self.trace.add(self.world.tick, "failure_before_branch", edge=edge_id, failure=failure, arrives_tick=until)
 
@@ -302,7 +299,7 @@ class PlanArrivals:
             self.trace.add(self.world.tick, "failure_before_branch", edge=detection.edge_id, failure=detection.failure.name,
                            arrives_tick=until)
         self.program, self.armed = None, None
-        self.waiting = Waiting(until, since, detection.edge_id, "branch", detection.failure.name, arrived, self.world.tick)
+        self.waiting = Waiting(until, since, detection.edge_id, detection.failure.name, arrived, self.world.tick)
         return True
 
     def as_arranged(self, detection: Detection) -> Detection:
