@@ -3,14 +3,15 @@
 import json
 
 from agentchord.agents.replies import (
-    STREAM_ORDER,
+    STREAM_HEADER,
     branch_owners,
     branch_reply,
     count_tokens,
     grounding_patch,
     modes_reply,
     nominal_reply,
-    streamed_edge_tokens,
+    stream_order,
+    streamed_tokens,
 )
 from agentchord.tasks import load_task_graph
 
@@ -24,17 +25,20 @@ def test_tokens_are_characters_of_compact_json_over_four():
     assert count_tokens({"a": [1, 2]}) == count_tokens('{"a":[1,2]}') == 3
 
 
-def test_the_nominal_reply_streams_its_edges_before_its_nodes():
+def test_the_nominal_reply_streams_in_execution_order_each_edge_before_the_node_it_reaches():
     graph = _graph()
     reply = nominal_reply(graph)
-    assert [k for k in reply] == [k for k in STREAM_ORDER if k in reply]
-    assert all(not e.get("failures") and e.get("kind", "nominal") == "nominal" for e in reply["edges"])
-    assert {n["id"] for n in reply["nodes"]} == {n.id for n in graph.nodes if not n.is_recovery}
-    ends = streamed_edge_tokens(graph)
-    assert list(ends) == ["e1", "e2", "e3", "e4", "e5", "e6"]
+    assert [k for k in reply] == [k for k in STREAM_HEADER if k in reply] + ["graph"]
+    edges = [item for item in reply["graph"] if "source" in item]
+    assert all(not e.get("failures") and e.get("kind", "nominal") == "nominal" for e in edges)
+    assert {i["id"] for i in reply["graph"] if "source" not in i} == {n.id for n in graph.nodes if not n.is_recovery}
+    assert stream_order(graph)[:5] == ["e1", graph.start, graph.edge("e1").target, "e2", graph.edge("e2").target]
+    ends = streamed_tokens(graph)
+    assert [i for i in ends if i.startswith("e")] == ["e1", "e2", "e3", "e4", "e5", "e6"]
     assert list(ends.values()) == sorted(ends.values())
-    # The first edge is readable long before the whole reply (the nodes come after the edges).
+    # The first edge is readable long before the whole reply, and every edge comes before the node it reaches.
     assert ends["e1"] < count_tokens(reply) / 5 and ends["e6"] < count_tokens(reply)
+    assert all(ends[e.id] < ends[e.target] for e in graph.nominal_edges())
 
 
 def test_every_recovery_edge_comes_with_the_first_failure_mode_that_leads_to_it():

@@ -2,6 +2,7 @@
 
 import pytest
 
+from agentchord.agents.replies import branch_nominal_nodes, branch_owners, streamed_tokens
 from agentchord.execution.planning import composer_call, pipelined_schedule, sequential_calls
 from agentchord.execution.reasoning import LatencyModel, TokenLatencyModel
 from agentchord.graph.progress import forward_filter, nominal_path
@@ -12,6 +13,12 @@ TASKS = ["single_arm_pour_water", "dual_arm_pour_water", "rearrange_table", "han
 
 def _graph(task="single_arm_pour_water"):
     return forward_filter(load_task_graph(task)).graph
+
+
+def _streamed_s(graph, model, item):
+    """When ``item`` (a nominal node or edge id) has streamed from the composer's reply."""
+    composer = composer_call(graph)
+    return min(model.first_token_s(composer) + model.decode_s(streamed_tokens(graph)[item]), model.price(composer))
 
 
 def _overlap(calls, moment):
@@ -27,10 +34,18 @@ def test_the_robot_moves_once_the_first_edge_is_grounded_and_parts_arrive_in_the
     composer = model.price(composer_call(graph))
     assert schedule.first_motion_s == schedule.edge_ready_s[path[0]] < composer  # read from the stream
     assert schedule.first_motion_s < sum(model.price(c) for c in sequential_calls(graph)) / 10
+    starts = {c.call.part: c.start_s for c in schedule.calls}
+    assert schedule.modes_listed_s[path[0]] < composer  # the arranger starts on the first edge while the composer writes
     for edge_id in path:
         listed = schedule.modes_listed_s[edge_id]
-        assert listed >= composer  # the arranger reads the whole nominal graph
         assert all(schedule.mode_ready_s[(edge_id, f.name)] > listed for f in graph.edge(edge_id).failures)
+        # Each call starts only once what it reads has streamed: an edge's modes its nodes, a branch its merge nodes.
+        target = graph.edge(edge_id).target
+        assert starts[f"{edge_id} failure modes"] >= _streamed_s(graph, model, target) - 1e-9
+        for failure in graph.edge(edge_id).failures:
+            merges = branch_nominal_nodes(graph, edge_id, failure.name, branch_owners(graph))
+            branch = starts[f"{edge_id}/{failure.name} branch"]
+            assert branch >= max([listed, *(_streamed_s(graph, model, n) for n in merges)]) - 1e-9
     # Never more calls in flight than the model serves.
     for call in schedule.calls:
         assert _overlap(schedule.calls, call.start_s) <= model.concurrency

@@ -7,10 +7,11 @@ characters / 4, no tokenizer being shipped; against GPT-4o's ``o200k_base`` it c
 replies' real tokens on the mean, 0.57 of the conductor's numbers (``benchmarks/bench_token_count.py``).
 
 The pipelined plan splits the agents' work (:mod:`agentchord.execution.planning`): the composer's
-nominal graph is written edges first, so that the first edge can be read from the stream before the
-nodes arrive; the arranger writes each edge's failure modes, then each mode's branch; the conductor
-grounds each edge and each branch (:func:`branch_owners` says which mode's branch brings which
-recovery edge).
+nominal graph is written in execution order -- the start node, then each edge followed by the node it
+reaches (:func:`stream_order`) -- so that an edge and both its nodes can be read from the stream
+long before the reply ends; the arranger writes each edge's failure modes, then each mode's branch;
+the conductor grounds each edge and each branch (:func:`branch_owners` says which mode's branch
+brings which recovery edge).
 """
 
 from __future__ import annotations
@@ -24,8 +25,8 @@ from agentchord.graph.progress import nominal_path, recovery_reach, with_alterna
 
 #: Characters per token: the usual rule of thumb (o200k_base measures 2.8 on these compact JSON replies).
 CHARS_PER_TOKEN = 4.0
-#: The order a streamed nominal graph is written in: the header, then the edges in execution order, then the nodes.
-STREAM_ORDER = ("task", "instruction", "objects", "start", "goal", "edges", "nodes")
+#: What a streamed nominal graph opens with, before its nodes and edges (:func:`stream_order`).
+STREAM_HEADER = ("task", "instruction", "objects", "start", "goal")
 
 
 def count_tokens(value: Any) -> int:
@@ -38,24 +39,48 @@ def _dump(model) -> dict[str, Any]:
     return model.model_dump(mode="json", exclude_defaults=True)
 
 
+def stream_order(graph: TaskGraph) -> list[str]:
+    """The nominal graph's node and edge ids in the order the composer writes them: as they execute.
+
+    Each edge of the nominal path followed by the node it reaches (the first edge by the start node
+    too, which it leaves); nominal nodes and edges off the path (none in a well-formed graph) close
+    the list. The first edge is written before any node -- the conductor grounds its actions from
+    the edge alone -- and a reader of the stream has every edge with both its nodes one node later.
+    """
+    order: list[str] = []
+    for edge_id in nominal_path(graph):
+        edge = graph.edge(edge_id)
+        order += [edge_id, *(node for node in (edge.source, edge.target) if node not in order)]
+    seen = set(order)
+    order += [n.id for n in graph.nodes if not n.is_recovery and n.id not in seen]
+    order += [e.id for e in graph.edges if not e.is_recovery and e.id not in seen]
+    return order
+
+
 def nominal_reply(graph: TaskGraph) -> dict[str, Any]:
-    """The composer's reply: the nominal graph (no failure modes, no recovery), in :data:`STREAM_ORDER`."""
+    """The composer's reply: the nominal graph (no failure modes, no recovery) as it streams.
+
+    The header (:data:`STREAM_HEADER`), then ``graph``: its nodes and edges in :func:`stream_order`
+    (an edge is the item with a ``source``).
+    """
     data = _dump(graph)
-    data["nodes"] = [_dump(n) for n in graph.nodes if not n.is_recovery]
-    data["edges"] = [_dump(e.model_copy(update={"failures": []})) for e in graph.edges if not e.is_recovery]
-    return {key: data[key] for key in STREAM_ORDER if key in data}
+    items = {n.id: _dump(n) for n in graph.nodes if not n.is_recovery}
+    items |= {e.id: _dump(e.model_copy(update={"failures": []})) for e in graph.edges if not e.is_recovery}
+    reply = {key: data[key] for key in STREAM_HEADER if key in data}
+    reply["graph"] = [items[item] for item in stream_order(graph)]
+    return reply
 
 
-def streamed_edge_tokens(graph: TaskGraph) -> dict[str, int]:
-    """Per nominal edge, the composer's output tokens up to the end of that edge in its streamed reply."""
+def streamed_tokens(graph: TaskGraph) -> dict[str, int]:
+    """Per nominal node and edge, the composer's output tokens up to the end of it in its streamed reply."""
     reply = nominal_reply(graph)
     text = json.dumps(reply, separators=(",", ":"), ensure_ascii=False)
     ends: dict[str, int] = {}
-    cursor = text.index('"edges":')
-    for edge in reply.get("edges", []):
-        piece = json.dumps(edge, separators=(",", ":"), ensure_ascii=False)
+    cursor = text.index('"graph":')
+    for item in reply["graph"]:
+        piece = json.dumps(item, separators=(",", ":"), ensure_ascii=False)
         cursor = text.index(piece, cursor) + len(piece)
-        ends[edge["id"]] = math.ceil(cursor / CHARS_PER_TOKEN)
+        ends[item["id"]] = math.ceil(cursor / CHARS_PER_TOKEN)
     return ends
 
 
@@ -149,6 +174,13 @@ def branch_reply(graph: TaskGraph, edge_id: str, failure: str, owners: dict[str,
 def branch_edges(graph: TaskGraph, edge_id: str, failure: str, owners: dict[str, tuple[str, str]]) -> list[Edge]:
     """The recovery edges one failure mode's branch brings (the conductor grounds them)."""
     return [e for e in graph.recovery_edges() if owners.get(e.id) == (edge_id, failure)]
+
+
+def branch_nominal_nodes(graph: TaskGraph, edge_id: str, failure: str, owners: dict[str, tuple[str, str]]) -> set[str]:
+    """The nominal nodes one failure mode's branch names (where it leaves and merges): the arranger reads them first."""
+    nominal = {n.id for n in graph.nodes if not n.is_recovery}
+    edges = branch_edges(graph, edge_id, failure, owners)
+    return {end for e in edges for end in (e.source, e.target) if end in nominal}
 
 
 def augmentation_reply(graph: TaskGraph) -> dict[str, Any]:

@@ -5,10 +5,11 @@ the arranger its failure modes and recovery branches, the conductor grounds all 
 waits for all three before it moves.
 
 Pipelined (``agentchord``): a robot does not need the branches of its third edge before it starts
-its first. The composer's reply streams, edges first (:data:`~agentchord.agents.replies.STREAM_ORDER`);
-as soon as an edge has streamed, the conductor grounds it. Once the nominal graph is whole, the
-arranger is asked per edge for its failure modes, then per mode for its recovery branch, and the
-conductor grounds each branch as it comes. The calls are served as the model allows
+its first. The composer's reply streams in execution order (:func:`~agentchord.agents.replies.stream_order`);
+as soon as an edge has streamed, the conductor grounds it, and once the node it reaches has too, the
+arranger is asked for its failure modes; per mode the arranger then writes its recovery branch, once
+the nominal nodes the branch leaves from and merges at have streamed too, and the conductor grounds
+each branch as it comes. The calls are served as the model allows
 (``concurrency`` at once), in the order the robot needs them: the edges' groundings, then edge
 k's modes and their branches before edge k+1's. The robot moves once the first edge is grounded; every other part
 arrives while it moves, as an event on the episode's clock (:class:`PlanSchedule`). An edge's
@@ -26,6 +27,7 @@ from dataclasses import dataclass, field
 from agentchord.agents.replies import (
     augmentation_reply,
     branch_edges,
+    branch_nominal_nodes,
     branch_owners,
     branch_reply,
     count_tokens,
@@ -34,7 +36,7 @@ from agentchord.agents.replies import (
     modes_reply,
     nominal_failures,
     nominal_reply,
-    streamed_edge_tokens,
+    streamed_tokens,
 )
 from agentchord.execution.reasoning import AnyLatencyModel, ModelledCall
 from agentchord.graph.models import TaskGraph
@@ -106,6 +108,7 @@ class _Job:
     key: str
     after: str | None = None  # the job whose end releases this one (None: ``release_s``)
     release_s: float | None = None
+    not_before_s: float = 0.0  # with ``after``: what it also reads arrives then
     start_s: float = 0.0
     end_s: float = 0.0
 
@@ -115,29 +118,39 @@ def pipelined_schedule(graph: TaskGraph, latency: AnyLatencyModel) -> PlanSchedu
 
     Calls, in the order the robot needs them: the nominal edges' groundings first (without them the
     robot cannot go on; without a branch it can), then edge by edge the list of its failure modes,
-    per mode its branch and the branch's grounding. A call starts when what it
-    reads has arrived and the model has a free slot (``latency.concurrency`` at once; the composer
+    per mode its branch and the branch's grounding. A call starts when what it reads has arrived
+    (an edge's grounding the edge from the composer's stream; its modes the edge and its nodes; a
+    branch also the nominal nodes it leaves from and merges at) and the model has a free slot (``latency.concurrency`` at once; the composer
     holds one while it streams); among the calls ready, the first in need goes first. A flat latency
-    model does not stream: every edge arrives with the whole nominal graph.
+    model does not stream: everything arrives with the whole nominal graph.
     """
     path = nominal_path(graph)
     composer = composer_call(graph)
     composer_end = latency.price(composer)
-    streamed = streamed_edge_tokens(graph)
+    streamed = streamed_tokens(graph)
     owners = branch_owners(graph)
+
+    def streamed_s(*ids: str) -> float:
+        if not latency.streams:
+            return composer_end
+        tokens = max((streamed[i] for i in ids if i in streamed), default=0)
+        return min(latency.first_token_s(composer) + latency.decode_s(tokens), composer_end)
+
     jobs: list[_Job] = []
     for k, edge_id in enumerate(path):
-        at = (latency.first_token_s(composer) + latency.decode_s(streamed[edge_id])) if latency.streams else composer_end
         edge = graph.edge(edge_id)
         nominal = edge.model_copy(update={"failures": []})
+        # The conductor grounds an edge's actions from the edge; the arranger's modes read what its nodes keep.
         jobs.append(_Job(ModelledCall("conductor", "plan", count_tokens(grounding_patch([nominal])), part=f"{edge_id} grounded"),
-                         (0, k), f"edge:{edge_id}", release_s=min(at, composer_end)))
+                         (0, k), f"edge:{edge_id}", release_s=streamed_s(edge_id)))
         jobs.append(_Job(ModelledCall("arranger", "plan", count_tokens(modes_reply(edge)), part=f"{edge_id} failure modes"),
-                         (1, k, 0), f"modes:{edge_id}", release_s=composer_end))
+                         (1, k, 0), f"modes:{edge_id}", release_s=streamed_s(edge_id, edge.source, edge.target)))
         for j, failure in enumerate(edge.failures):
             mode = f"{edge_id}/{failure.name}"
+            reads = branch_nominal_nodes(graph, edge_id, failure.name, owners)
             jobs.append(_Job(ModelledCall("arranger", "plan", count_tokens(branch_reply(graph, edge_id, failure.name, owners)),
-                                          part=f"{mode} branch"), (1, k, 1, j), f"branch:{mode}", after=f"modes:{edge_id}"))
+                                          part=f"{mode} branch"), (1, k, 1, j), f"branch:{mode}", after=f"modes:{edge_id}",
+                             not_before_s=streamed_s(edge_id, edge.target, *reads)))
             patch = grounding_patch([edge.model_copy(update={"failures": [failure]}),
                                      *branch_edges(graph, edge_id, failure.name, owners)])
             jobs.append(_Job(ModelledCall("conductor", "plan", count_tokens(patch), part=f"{mode} branch grounded"),
@@ -172,7 +185,7 @@ def _serve(jobs: list[_Job], latency: AnyLatencyModel, busy_until: list[float]) 
     while pending:
         for job in pending:
             if job.release_s is None and job.after in ended:
-                job.release_s = ended[job.after]
+                job.release_s = max(ended[job.after], job.not_before_s)
         released = [j for j in pending if j.release_s is not None]
         slot = min(range(len(slots)), key=lambda i: slots[i])
         now = max(slots[slot], min(j.release_s for j in released))
