@@ -51,13 +51,21 @@ def test_the_robot_moves_once_the_first_edge_is_grounded_and_parts_arrive_in_the
         assert _overlap(schedule.calls, call.start_s) <= model.concurrency
 
 
-def test_a_mode_is_ready_only_when_everything_its_branch_reaches_has_arrived():
+def test_a_mode_is_ready_once_its_entry_has_arrived_and_the_rest_of_its_branch_is_waited_for_where_needed():
     graph = _graph()
     schedule = pipelined_schedule(graph, TokenLatencyModel())
-    ends = {c.call.part: c.end_s for c in schedule.calls}
-    assert schedule.mode_ready_s[("e2", "bottle_dropped")] >= ends["e2/bottle_dropped branch grounded"]
-    # The regrasp's second drop recovers within the branch that brought it.
-    assert schedule.mode_ready_s[("r_bottle_regrasped_again", "bottle_dropped")] == schedule.mode_ready_s[("e2", "bottle_dropped")]
+    calls = {c.call.part: c for c in schedule.calls}
+    entry, rest, branch = (calls[f"e2/bottle_dropped {part}"] for part in ("entry grounded", "rest grounded", "branch"))
+    # The entry is grounded while the arranger still writes the rest of the branch ...
+    assert branch.start_s < entry.start_s < branch.end_s <= rest.start_s
+    assert schedule.mode_ready_s[("e2", "bottle_dropped")] == entry.end_s < rest.end_s
+    assert schedule.edge_ready_s["e2_r_bottle_dropped"] == entry.end_s
+    # ... and the edges further on arrive with the rest: the robot waits at their source if it gets there first.
+    assert schedule.edge_ready_s["r_bottle_regrasped_again"] == rest.end_s
+    # A second drop during the regrasp recovers through an edge of the same branch's rest.
+    again = schedule.mode_ready_s[("r_bottle_regrasped_again", "bottle_dropped")]
+    assert again >= rest.end_s
+    assert set(schedule.edge_ready_s) == {e.id for e in graph.edges}
 
 
 def test_fewer_calls_at_once_or_a_slower_model_delay_the_branches_not_the_order():

@@ -160,15 +160,43 @@ def modes_reply(edge: Edge) -> list[dict[str, Any]]:
     return [_dump(f.model_copy(update={"recovery": ""})) for f in edge.failures]
 
 
-def branch_reply(graph: TaskGraph, edge_id: str, failure: str, owners: dict[str, tuple[str, str]]) -> dict[str, Any]:
-    """What the arranger writes for one failure mode's branch: its entry, the recovery nodes and edges it brings."""
+def branch_entry(graph: TaskGraph, edge_id: str, failure: str, owners: dict[str, tuple[str, str]]) -> list[str]:
+    """The part of one failure mode's branch the robot needs the moment the mode fires: its recovery
+    entry and the entry's alternatives (the other arm's way), with the recovery nodes they reach."""
     key = (edge_id, failure)
+    entry = next(f.recovery for f in graph.edge(edge_id).failures if f.name == failure)
+    edges = [e for e in with_alternatives(graph, [entry]) if owners.get(e) == key]
+    nodes = [graph.edge(e).target for e in edges]
+    return edges + [n for n in dict.fromkeys(nodes) if owners.get(n) == key]
+
+
+def branch_reply(graph: TaskGraph, edge_id: str, failure: str, owners: dict[str, tuple[str, str]]) -> dict[str, Any]:
+    """What the arranger writes for one failure mode's branch: its entry, the recovery nodes and edges it brings.
+
+    Written entry first (:func:`branch_entry`: the entry edges, then the nodes they reach), then the
+    rest, so that the conductor can ground the entry while the rest streams.
+    """
+    key = (edge_id, failure)
+    first = branch_entry(graph, edge_id, failure, owners)
+    rank = {item: k for k, item in enumerate(first)}
+    edges = sorted((e for e in graph.recovery_edges() if owners.get(e.id) == key), key=lambda e: rank.get(e.id, len(rank)))
+    nodes = sorted((n for n in graph.recovery_nodes() if owners.get(n.id) == key), key=lambda n: rank.get(n.id, len(rank)))
+    entry_edges = [e for e in edges if e.id in rank]
+    entry_nodes = [n for n in nodes if n.id in rank]
     return {
         "failure": failure,
         "recovery": next(f.recovery for f in graph.edge(edge_id).failures if f.name == failure),
-        "nodes": [_dump(n) for n in graph.recovery_nodes() if owners.get(n.id) == key],
-        "edges": [_dump(e) for e in graph.recovery_edges() if owners.get(e.id) == key],
+        "entry": [_dump(e) for e in entry_edges] + [_dump(n) for n in entry_nodes],
+        "nodes": [_dump(n) for n in nodes if n.id not in rank],
+        "edges": [_dump(e) for e in edges if e.id not in rank],
     }
+
+
+def branch_entry_tokens(graph: TaskGraph, edge_id: str, failure: str, owners: dict[str, tuple[str, str]]) -> int:
+    """The arranger's output tokens up to the end of a branch's entry part (:func:`branch_reply`)."""
+    reply = branch_reply(graph, edge_id, failure, owners)
+    head = {key: reply[key] for key in ("failure", "recovery", "entry")}
+    return count_tokens(head)
 
 
 def branch_edges(graph: TaskGraph, edge_id: str, failure: str, owners: dict[str, tuple[str, str]]) -> list[Edge]:

@@ -331,7 +331,7 @@ class PlanArrivals:
         return True
 
     def _wait_for_grounding(self, program: EdgeProgram) -> bool:
-        """Wait for a nominal edge's grounding if the robot reached its source first (True when it waits)."""
+        """Wait for an edge's grounding (nominal, or further on in a branch) if the robot reached its source first (True when it waits)."""
         until = self._tick_at(self.schedule.edge_ready_s.get(program.edge_id)) if self.schedule is not None else None
         if until is None:
             return False

@@ -492,7 +492,9 @@ class Executor(RecoverySwitching, PlanArrivals):
             exits = self.recovery_map.exit_edges(target.id)
             if not exits:
                 return False, f"recovery node {target.id} has no exit edge"
-            self._start(EdgeProgram.from_edge(exits[0]))
+            following = EdgeProgram.from_edge(exits[0])
+            if not self._wait_for_grounding(following):  # a pipelined plan's rest of a branch may not be here yet
+                self._start(following)
             return None
         return self._arrive(program.target)
 

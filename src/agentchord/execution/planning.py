@@ -8,13 +8,15 @@ Pipelined (``agentchord``): a robot does not need the branches of its third edge
 its first. The composer's reply streams in execution order (:func:`~agentchord.agents.replies.stream_order`);
 as soon as an edge has streamed, the conductor grounds it, and once the node it reaches has too, the
 arranger is asked for its failure modes; per mode the arranger then writes its recovery branch, once
-the nominal nodes the branch leaves from and merges at have streamed too, and the conductor grounds
-each branch as it comes. The calls are served as the model allows
-(``concurrency`` at once), in the order the robot needs them: the edges' groundings, then edge
-k's modes and their branches before edge k+1's. The robot moves once the first edge is grounded; every other part
+the nominal nodes the branch leaves from and merges at have streamed too. The branch streams entry
+first: the conductor grounds the entry (and the other arm's way) as soon as it has streamed, the
+rest of the branch when the reply ends. The calls are served as the model allows (``concurrency`` at
+once), in the order the robot needs them: the edges' groundings, then edge k's modes and their
+branches before edge k+1's. The robot moves once the first edge is grounded; every other part
 arrives while it moves, as an event on the episode's clock (:class:`PlanSchedule`). An edge's
 monitors are armed once the arranger's list of its modes has arrived; a mode can be recovered from
-once what its recovery runs has arrived grounded.
+once its recovery entry has arrived grounded; an edge further on in a branch, like a nominal one, is
+waited for if the robot reaches it first.
 
 Pure functions of a graph and a latency model: the same graph and model give the same schedule.
 """
@@ -27,6 +29,8 @@ from dataclasses import dataclass, field
 from agentchord.agents.replies import (
     augmentation_reply,
     branch_edges,
+    branch_entry,
+    branch_entry_tokens,
     branch_nominal_nodes,
     branch_owners,
     branch_reply,
@@ -34,13 +38,12 @@ from agentchord.agents.replies import (
     grounded_reply,
     grounding_patch,
     modes_reply,
-    nominal_failures,
     nominal_reply,
     streamed_tokens,
 )
 from agentchord.execution.reasoning import AnyLatencyModel, ModelledCall
 from agentchord.graph.models import TaskGraph
-from agentchord.graph.progress import nominal_path, recovery_reach, with_alternatives
+from agentchord.graph.progress import nominal_path, with_alternatives
 from agentchord.worlds.protocol import CONTROL_HZ
 
 
@@ -74,9 +77,10 @@ class PlanSchedule:
     Attributes:
         calls: Every call, in the order they started.
         first_motion_s: When the first edge is grounded: the robot moves from then on.
-        edge_ready_s: Nominal edge id -> when its grounding has arrived.
-        mode_ready_s: (edge id, failure mode name) -> when the mode can be recovered from: what its
-            recovery runs (entry, alternatives, the way on from the recovery nodes) has arrived grounded.
+        edge_ready_s: Edge id (nominal or recovery) -> when its grounding has arrived: the robot waits
+            at the edge's source until then.
+        mode_ready_s: (edge id, failure mode name) -> when the mode can be recovered from: its trigger
+            and its recovery entry, with the entry's alternatives, have arrived grounded.
         modes_listed_s: Nominal edge id -> when the arranger's list of its failure modes (their monitors)
             has arrived: the monitors are armed from then on. A recovery edge's come with it.
         owners: Recovery edge or node id -> the (nominal edge, failure mode) whose branch brings it.
@@ -109,6 +113,8 @@ class _Job:
     after: str | None = None  # the job whose end releases this one (None: ``release_s``)
     release_s: float | None = None
     not_before_s: float = 0.0  # with ``after``: what it also reads arrives then
+    after_start: str | None = None  # the streaming job whose start, plus ``offset_s``, releases this one
+    offset_s: float = 0.0
     start_s: float = 0.0
     end_s: float = 0.0
 
@@ -137,6 +143,7 @@ def pipelined_schedule(graph: TaskGraph, latency: AnyLatencyModel) -> PlanSchedu
         return min(latency.first_token_s(composer) + latency.decode_s(tokens), composer_end)
 
     jobs: list[_Job] = []
+    ground_key: dict[str, str] = {}  # recovery edge id, or "edge/mode" (its trigger), -> the job that grounds it
     for k, edge_id in enumerate(path):
         edge = graph.edge(edge_id)
         nominal = edge.model_copy(update={"failures": []})
@@ -148,28 +155,45 @@ def pipelined_schedule(graph: TaskGraph, latency: AnyLatencyModel) -> PlanSchedu
         for j, failure in enumerate(edge.failures):
             mode = f"{edge_id}/{failure.name}"
             reads = branch_nominal_nodes(graph, edge_id, failure.name, owners)
-            jobs.append(_Job(ModelledCall("arranger", "plan", count_tokens(branch_reply(graph, edge_id, failure.name, owners)),
-                                          part=f"{mode} branch"), (1, k, 1, j), f"branch:{mode}", after=f"modes:{edge_id}",
-                             not_before_s=streamed_s(edge_id, edge.target, *reads)))
-            patch = grounding_patch([edge.model_copy(update={"failures": [failure]}),
-                                     *branch_edges(graph, edge_id, failure.name, owners)])
-            jobs.append(_Job(ModelledCall("conductor", "plan", count_tokens(patch), part=f"{mode} branch grounded"),
-                             (1, k, 2, j), f"ground:{mode}", after=f"branch:{mode}"))
+            branch = branch_reply(graph, edge_id, failure.name, owners)
+            jobs.append(_Job(ModelledCall("arranger", "plan", count_tokens(branch), part=f"{mode} branch"), (1, k, 1, j),
+                             f"branch:{mode}", after=f"modes:{edge_id}", not_before_s=streamed_s(edge_id, edge.target, *reads)))
+            # The conductor grounds the branch's entry as soon as it has streamed (the robot needs it when the mode
+            # fires), the rest of the branch once the arranger's reply ends.
+            entry = set(branch_entry(graph, edge_id, failure.name, owners))
+            edges = branch_edges(graph, edge_id, failure.name, owners)
+            first = [e for e in edges if e.id in entry]
+            patch = grounding_patch([edge.model_copy(update={"failures": [failure]}), *first])
+            entry_job = _Job(ModelledCall("conductor", "plan", count_tokens(patch), part=f"{mode} entry grounded"),
+                             (1, k, 2, j), f"entry:{mode}", after=f"branch:{mode}")
+            if latency.streams:
+                tokens = branch_entry_tokens(graph, edge_id, failure.name, owners)
+                entry_job.after, entry_job.after_start = None, f"branch:{mode}"
+                entry_job.offset_s = latency.first_token_s(jobs[-1].call) + latency.decode_s(tokens)
+            jobs.append(entry_job)
+            rest = [e for e in edges if e.id not in entry]
+            if rest:
+                jobs.append(_Job(ModelledCall("conductor", "plan", count_tokens(grounding_patch(rest)), part=f"{mode} rest grounded"),
+                                 (1, k, 3, j), f"rest:{mode}", after=f"branch:{mode}"))
+                ground_key.update({e.id: f"rest:{mode}" for e in rest})
+            ground_key.update({e.id: f"entry:{mode}" for e in first})
+            ground_key[f"{edge_id}/{failure.name}"] = f"entry:{mode}"
     done = _serve(jobs, latency, busy_until=[composer_end])
     ends = {job.key: job.end_s for job in done}
-    grounded = {(e, f): ends[f"ground:{e}/{f}"] for e, f in nominal_failures(graph)}
+    recovery_ready = {item: ends[key] for item, key in ground_key.items() if "/" not in item}
+    for recovery in graph.recovery_edges():  # owned by no nominal edge's mode: with the last branch's rest
+        recovery_ready.setdefault(recovery.id, max(ends.values(), default=composer_end))
     modes: dict[tuple[str, str], float] = {}
     for edge, failure in graph.failures():
-        # A mode can be recovered from once what its recovery runs has arrived grounded: the entry, its
-        # alternatives, the way on from the recovery nodes they reach (a second failure on the way has
-        # its own mode, checked when it fires), whichever mode's branch brought each.
-        items = [*recovery_reach(graph, with_alternatives(graph, [failure.recovery]))[0], failure.recovery]
-        owned = [grounded[owners[item]] for item in items if item in owners]
-        own = grounded.get((edge.id, failure.name), composer_end)
-        modes[(edge.id, failure.name)] = max([own, *owned])
+        # A mode can be recovered from once its trigger and its recovery entry (with the entry's alternatives)
+        # have arrived grounded; an edge further on in the branch is waited for when the robot reaches it.
+        key = ground_key.get(f"{edge.id}/{failure.name}")
+        own = ends[key] if key is not None else recovery_ready.get(edge.id, composer_end)
+        entries = [recovery_ready[e] for e in with_alternatives(graph, [failure.recovery]) if e in recovery_ready]
+        modes[(edge.id, failure.name)] = max([own, *entries])
     calls = [ScheduledCall(composer, 0.0, composer_end)]
     calls += [ScheduledCall(job.call, job.start_s, job.end_s) for job in sorted(done, key=lambda j: (j.start_s, j.priority))]
-    edge_ready = {edge_id: ends[f"edge:{edge_id}"] for edge_id in path}
+    edge_ready = {edge_id: ends[f"edge:{edge_id}"] for edge_id in path} | recovery_ready
     first = edge_ready[path[0]] if path else composer_end
     listed = {edge_id: ends[f"modes:{edge_id}"] for edge_id in path}
     critical = (composer.part, f"{path[0]} grounded") if path else (composer.part,)
@@ -181,11 +205,14 @@ def _serve(jobs: list[_Job], latency: AnyLatencyModel, busy_until: list[float]) 
     slots = list(busy_until) + [0.0] * (latency.concurrency - len(busy_until))
     pending = list(jobs)
     ended: dict[str, float] = {}
+    started: dict[str, float] = {}
     done: list[_Job] = []
     while pending:
         for job in pending:
             if job.release_s is None and job.after in ended:
                 job.release_s = max(ended[job.after], job.not_before_s)
+            if job.release_s is None and job.after_start in started:
+                job.release_s = max(started[job.after_start] + job.offset_s, job.not_before_s)
         released = [j for j in pending if j.release_s is not None]
         slot = min(range(len(slots)), key=lambda i: slots[i])
         now = max(slots[slot], min(j.release_s for j in released))
@@ -193,6 +220,7 @@ def _serve(jobs: list[_Job], latency: AnyLatencyModel, busy_until: list[float]) 
         job.start_s, job.end_s = now, now + latency.price(job.call)
         slots[slot] = job.end_s
         ended[job.key] = job.end_s
+        started[job.key] = job.start_s
         pending.remove(job)
         done.append(job)
     return done
