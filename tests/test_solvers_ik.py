@@ -1,9 +1,10 @@
 """Bimanual IK with mink: reaches targets, and keeps the two arms apart."""
 
+import mink
 import mujoco
 import numpy as np
 
-from agentchord.solvers.ik import BimanualIK, PoseTarget
+from agentchord.solvers.ik import DAMPING, BimanualIK, PoseTarget
 
 
 def _min_arm_distance(ik: BimanualIK) -> float:
@@ -25,6 +26,30 @@ def test_reaches_a_reachable_target():
     goal = ik.tcp_pose("right").pos + np.array([-0.1, 0.05, -0.1])
     _drive(ik, {"right": goal})
     assert np.linalg.norm(ik.tcp_pose("right").pos - goal) < 0.003
+
+
+class _MinkStep(BimanualIK):
+    """The solver with each QP step taken by mink's own ``solve_ik``: the reference of the lean step."""
+
+    def _qp_velocity(self, tasks, guarded):
+        limits = [*self.limits, self.arm_collision_limit] if guarded else self.limits
+        return mink.solve_ik(self.configuration, tasks, self.dt, solver="daqp", damping=DAMPING, limits=limits)
+
+
+def test_the_lean_qp_step_moves_the_arms_as_mink_solve_ik_does_bit_for_bit():
+    lean, reference = BimanualIK(), _MinkStep()
+    start = {arm: lean.tcp_pose(arm) for arm in ("left", "right")}
+    goals = {"left": np.array([0.05, 0.5, 0.2]), "right": np.array([-0.05, 0.5, 0.2])}  # through each other
+    guarded = 0
+    for k in range(60):
+        s = min(1.0, (k + 1) / 30)
+        targets = {arm: PoseTarget(start[arm].pos + s * (goal - start[arm].pos), start[arm].quat) for arm, goal in goals.items()}
+        if k % 7 == 3:
+            del targets["left"]  # an arm without a target holds where it is
+        guarded += lean.arms_close()
+        assert all(np.array_equal(a, b) for a, b in zip(lean.solve(targets).values(), reference.solve(targets).values()))
+        assert np.array_equal(lean.configuration.q, reference.configuration.q)
+    assert 0 < guarded < 60  # both QPs were compared: with and without the arms' clearance rows
 
 
 def test_arms_sent_through_each_other_stop_short_of_colliding():

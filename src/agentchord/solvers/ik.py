@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import daqp
 import mink
 import mujoco
 import numpy as np
@@ -32,6 +33,10 @@ class PoseTarget:
 ARM_PROXIMITY = 0.35
 #: Clearance (m) the collision-avoidance limit keeps between the arms.
 ARM_CLEARANCE = 0.02
+#: Levenberg-Marquardt damping of every QP (mink's ``damping``).
+DAMPING = 1e-4
+#: DAQP's "no lower bound" on a constraint row (what qpsolvers passes for ``G x <= h``).
+NO_LOWER_BOUND = -1e30
 
 
 class BimanualIK:
@@ -75,6 +80,13 @@ class BimanualIK:
             arm: np.array([self.model.joint(f"{prefix}/{name}").qposadr[0] for name in ARM_JOINTS])
             for arm, prefix in ARM_PREFIX.items()
         }
+        self._tcp_site = {arm: self.model.site(f"{arm}_tcp").id for arm in ARM_PREFIX}
+        # What every QP shares (see _qp_velocity): the posture task's weighted Jacobian (its Jacobian
+        # is the identity) and the joint limits' constraint rows, built as mink builds them.
+        nv = self.model.nv
+        self._posture_jacobian = self.posture.cost[:, None] * np.eye(nv)
+        joint_limit = self.limits[0]
+        self._limit_rows = np.vstack([joint_limit.projection_matrix, -joint_limit.projection_matrix])
         q0 = self.configuration.q.copy()
         for arm in ARM_PREFIX:
             q0[self._arm_qadr[arm]] = HOME_Q
@@ -134,13 +146,11 @@ class BimanualIK:
                 task.set_target(mink.SE3.from_rotation_and_translation(mink.SO3(np.asarray(target.quat)), np.asarray(target.pos)))
             tasks.append(task)
         self.posture.set_target(self.configuration.q)
-        limits = self.limits
         guarded = self.arm_collision_limit is not None and self.arms_close()
         if guarded:
-            limits = [*self.limits, self.arm_collision_limit]
             previous = self.configuration.q.copy()
         for _ in range(self.iterations):
-            velocity = mink.solve_ik(self.configuration, tasks, self.dt, solver="daqp", damping=1e-4, limits=limits)
+            velocity = self._qp_velocity(tasks, guarded)
             self.configuration.integrate_inplace(velocity, self.dt)
             if self.converged_step is not None and float(np.max(np.abs(velocity))) * self.dt < self.converged_step:
                 break
@@ -149,6 +159,53 @@ class BimanualIK:
             # arms hold their last configuration rather than collide.
             self.configuration.update(previous)
         return {arm: self.arm_q(arm) for arm in ARM_PREFIX}
+
+    def _qp_velocity(self, tasks: list[mink.Task], guarded: bool) -> np.ndarray:
+        """One differential-IK step: what ``mink.solve_ik(configuration, tasks, dt, solver="daqp",
+        damping=DAMPING, limits=...)`` returns, bit for bit.
+
+        mink assembles each QP through generic layers (a limits check that only logs, a
+        ``qpsolvers`` problem and its dispatch), twice per tick and more than the physics costs;
+        here the parts that never change are built once (``__init__``) and the rest by the same
+        operations in the same order, then DAQP is called as ``qpsolvers`` calls it.
+        ``tests/test_solvers_ik.py`` holds it to mink's own solve.
+
+        Args:
+            tasks: The posture task, then the frame tasks, targets set.
+            guarded: Whether the arm-collision limit joins the joint limits.
+
+        Raises:
+            mink.NoSolutionFound: DAQP found no solution.
+        """
+        configuration, posture = self.configuration, self.posture
+        # The objective: mink's _compute_qp_objective with the posture task's constant Jacobian.
+        error = posture.cost * (-posture.gain * posture.compute_error(configuration))
+        mu_total = 0.0 + posture.lm_damping * float(error @ error)
+        jacobians, errors = [self._posture_jacobian], [error]
+        for task in tasks[1:]:
+            jacobian, error, mu = task.compute_qp_residual(configuration)
+            jacobians.append(jacobian)
+            errors.append(error)
+            mu_total += mu
+        stacked = np.vstack(jacobians)
+        hessian = stacked.T @ stacked
+        gradient = -(np.concatenate(errors) @ stacked)
+        hessian.flat[:: self.model.nv + 1] += DAMPING + mu_total
+        # The inequalities: the joint limits' (ConfigurationLimit), then the arms' clearance.
+        joint_limit, q, nv = self.limits[0], configuration.q, self.model.nv
+        to_upper, from_lower = np.empty(nv), np.empty(nv)
+        mujoco.mj_differentiatePos(m=self.model, qvel=to_upper, dt=1.0, qpos1=q, qpos2=joint_limit.upper)
+        mujoco.mj_differentiatePos(m=self.model, qvel=from_lower, dt=1.0, qpos1=joint_limit.lower, qpos2=q)
+        rows = self._limit_rows
+        bounds = np.hstack([joint_limit.gain * to_upper[joint_limit.indices], joint_limit.gain * from_lower[joint_limit.indices]])
+        if guarded:
+            clearance = self.arm_collision_limit.compute_qp_inequalities(configuration, self.dt)
+            rows, bounds = np.vstack([rows, clearance.G]), np.hstack([bounds, clearance.h])
+        step, _, exitflag, _ = daqp.solve(hessian, gradient, rows, bounds, np.full(bounds.size, NO_LOWER_BOUND),
+                                          np.zeros(bounds.size, dtype=np.intc), primal_start=None)
+        if exitflag <= 0:
+            raise mink.NoSolutionFound("daqp")
+        return step / self.dt
 
     def arm_clearance(self) -> float:
         """Smallest distance (m) between the two arms' collision proxies (negative: overlap)."""
@@ -159,7 +216,8 @@ class BimanualIK:
 
     def arms_close(self) -> bool:
         """Whether the two tools are near enough for the arms to touch."""
-        return float(np.linalg.norm(self.tcp_pose("left").pos - self.tcp_pose("right").pos)) < ARM_PROXIMITY
+        xpos = self.configuration.data.site_xpos  # what tcp_pose reads, without building two poses
+        return float(np.linalg.norm(xpos[self._tcp_site["left"]] - xpos[self._tcp_site["right"]])) < ARM_PROXIMITY
 
     def residual(self, arm: str, target: PoseTarget) -> float:
         """Position error (m) of the current solution to a target."""
