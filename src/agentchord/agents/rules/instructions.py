@@ -29,7 +29,8 @@ from agentchord.agents.observe import COLOURS
 from agentchord.agents.scene import Scene
 from agentchord.agents.rules import knowledge as kb
 from agentchord.agents.rules.goals import Folded, Goal, GoalSpec, HandedOver, Inside, On, Placed, Poured
-from agentchord.agents.rules.language import Clause, NounPhrase, ParseError, Where, parse
+from agentchord.agents.rules.language import Clause, NounPhrase, ParseError, Where, grammar_words, parse_prepared, prepare
+from agentchord.agents.rules.phrasing import Rewritten, known_words as phrasing_words
 from agentchord.robot.aloha import other_arm
 
 #: Size words: the candidate with the largest (True) or smallest (False) measure.
@@ -42,16 +43,46 @@ _SIZE_WORDS = {
     "tiny": ("volume", False),
 }
 #: Words a noun phrase may carry that name nothing (``the bottle of water``, ``the empty cup``).
-_FILLER = frozenset({"water", "empty", "full", "coffee", "object", "thing", "item", "same", "original"})
+_FILLER = frozenset({"water", "empty", "full", "coffee", "object", "thing", "item", "same", "original", "two"})
+#: Words for a group of scene objects (``the cutlery``): the category words they stand for.
+_GROUPS = {"cutlery": {"fork", "spoon", "knife"}, "utensils": {"fork", "spoon", "knife"}, "silverware": {"fork", "spoon", "knife"},
+           "flatware": {"fork", "spoon", "knife"}}
+#: Position words among several candidates: (axis, largest) -> the one furthest that way.
+_POSITION_WORDS = {"left": (0, False), "right": (0, True), "front": (1, False), "near": (1, False), "nearer": (1, False),
+                   "closer": (1, False), "back": (1, True), "far": (1, True), "farther": (1, True), "rear": (1, True)}
+#: Words for a part of a cloth (``the bottom corners of the towel``, ``its far edge``).
+_CLOTH_PART = frozenset({"corner", "corners", "edge", "edges", "side", "end", "half", "hem"})
+_CLOTH_SIDE = frozenset({"bottom", "top", "near", "far", "front", "back", "lower", "upper", "two", "both", "left", "right", "closest", "furthest"})
+
+
+def lemma_noun(word: str) -> str:
+    """The singular of a plural noun (``blocks`` -> ``block``), or the word."""
+    if word.endswith("ies") and len(word) > 4:
+        return word[:-3] + "y"
+    if word.endswith("es") and word[:-2].endswith(("ss", "sh", "ch", "x")):
+        return word[:-2]
+    if word.endswith("s") and not word.endswith("ss") and len(word) > 3:
+        return word[:-1]
+    return word
 
 
 @dataclass
 class Reading:
-    """What the composer read: the clauses and the goal predicates each one states."""
+    """What the composer read: the clauses, the goal predicates each one states, and how each phrase was read.
+
+    Attributes:
+        instruction: The words as written.
+        clauses: The grammar's clauses (a last one puts back down what is still in hand).
+        goals: The goal predicates of each clause.
+        prepared: The text the grammar parsed and what was rewritten on the way.
+        words: How each phrase was read: (words, role, what): role is ``object``, ``place``, ``arm`` or ``verb``.
+    """
 
     instruction: str
     clauses: list[Clause]
     goals: list[list[Goal]] = field(default_factory=list)
+    prepared: Rewritten | None = None
+    words: list[tuple[str, str, str]] = field(default_factory=list)
 
     @property
     def goal(self) -> GoalSpec:
@@ -74,6 +105,16 @@ class _Context:
         self.in_hand: list[str] = []
         #: The head noun last named (``block``): what ``the big one`` is one of.
         self.last_kind: str | None = None
+        #: How each phrase was read, for ``plan --explain``.
+        self.read: list[tuple[str, str, str]] = []
+        #: A cloth whose part was taken (``take the near corners of the towel``): a place of it on its other part folds it.
+        self.cloth_taken: str | None = None
+        #: The object last placed beside (``on the right`` later in the instruction is its right).
+        self.last_anchor: str | None = None
+
+    def note(self, words: str, role: str, what: str) -> None:
+        if (words, role, what) not in self.read:
+            self.read.append((words, role, what))
 
     def error(self, words: str, problem: str) -> InstructionNotGroundedError:
         return InstructionNotGroundedError(self.instruction, f"{words.strip()!r} {problem}")
@@ -103,7 +144,26 @@ class _Context:
                 raise self.error(np.text, "has nothing to refer to (name the objects)")
             group = list(self.mentioned) if np.pronoun == "all" else self.mentioned[-2:]
             return sorted(group, key=self.mentioned.index)
+        if group := self.group(np):
+            return group
         return [self.resolve(np)]
+
+    def group(self, np: NounPhrase) -> list[str]:
+        """The objects a plural or collective noun names (``both blocks``, ``the cutlery``), else none."""
+        if not np.words or np.of is not None:
+            return []
+        head = np.words[-1]
+        kinds = _GROUPS.get(head) or ({lemma_noun(head)} if lemma_noun(head) != head else set())
+        if not kinds:
+            return []
+        modifiers = [w for w in np.words[:-1] if w not in ("both", "all", "two", "the")]
+        pool = [o for o in self.scene.objects if o.name not in self.corners and kb.words(o) & {kb.SYNONYMS.get(k, k) for k in kinds}
+                and all(w in kb.words(o) for w in modifiers)]
+        if len(pool) < 2:
+            return []
+        names = [self.mention(o.name) for o in sorted(pool, key=lambda o: o.pos[0])]
+        self.note(np.text, "object", " and ".join(names))
+        return names
 
     def resolve(self, np: NounPhrase, exclude: tuple[str, ...] = ()) -> str:
         """The one scene object a noun phrase names (a pronoun: the last one mentioned, not in ``exclude``)."""
@@ -125,11 +185,20 @@ class _Context:
             return self.resolve(np.of)
         joined = "_".join(np.words)
         if joined in self.objects:
+            if sum(np.words[-1] in kb.words(o) for o in self.scene.objects) > 1:  # a kind with several members: "the red one"
+                self.last_kind = np.words[-1]
+            self.note(np.text, "object", joined)
             return self.mention(joined)
         sizes = [w for w in words if w in _SIZE_WORDS]
-        plain = [w for w in words if w not in _SIZE_WORDS]
-        pool = [o for o in self.scene.objects if o.name not in self.corners]
+        pool = [o for o in self.scene.objects if o.name not in self.corners and o.name not in exclude]
+        # A position word picks among several of a kind ("the left block"); of one object it is no modifier.
+        positions = [w for w in words if w in _POSITION_WORDS and not any(w in kb.words(o) for o in pool)]
+        plain = [w for w in words if w not in _SIZE_WORDS and w not in positions]
         candidates = [o for o in pool if all(w in kb.words(o) for w in plain)]
+        for word in positions:
+            if len(candidates) > 1:
+                axis, largest = _POSITION_WORDS[word]
+                candidates = [(max if largest else min)(candidates, key=lambda o, axis=axis: o.pos[axis])]
         if not candidates and plain:
             # The head noun alone may still be unique ("coffee capsule" -> capsule); a colour that
             # does not match is a contradiction, not a modifier to ignore.
@@ -151,6 +220,7 @@ class _Context:
             raise self.error(np.text, f"is ambiguous: it could be {names}; name one by colour, size or name")
         if plain:
             self.last_kind = plain[-1]
+        self.note(np.text, "object", candidates[0].name)
         return self.mention(candidates[0].name)
 
     def table_place(self, np: NounPhrase) -> tuple[float, float] | None | bool:
@@ -201,12 +271,29 @@ def _pour(c: Clause, ctx: _Context) -> list[Goal]:
         ctx.mention(target)
     hold_target = c.arm == "both" or target in ctx.held_by
     arm = ctx.arm_of(c.arm, source)
+    if hold_target and target not in ctx.in_hand:
+        ctx.take(target)  # the other arm holds it: it is put down too
     ctx.take(source)
     return [Poured(source=source, target=target, arm=arm, hold_target=hold_target)]
 
 
+def _cloth_of(np: NounPhrase, ctx: _Context) -> str | None:
+    """The cloth a phrase names a part of (``the bottom corners of the towel``, ``its top corners``), if any."""
+    words = [kb.SYNONYMS.get(w, w) for w in np.words]
+    if not words or words[-1] not in _CLOTH_PART or not set(words[:-1]) <= _CLOTH_SIDE:
+        return None
+    if np.of is not None:
+        of = [kb.SYNONYMS.get(w, w) for w in np.of.words]
+        return next((c for c in ctx.cloths if c in of), ctx.cloths[0] if np.of.pronoun and len(ctx.cloths) == 1 else None)
+    return ctx.cloths[0] if len(ctx.cloths) == 1 else None
+
+
 def _pick(c: Clause, ctx: _Context) -> list[Goal]:
     for np, arm in zip(c.objects, c.arms or [c.arm] * len(c.objects), strict=False):
+        if (cloth := _cloth_of(np, ctx)) is not None:
+            ctx.cloth_taken = cloth
+            ctx.note(np.text, "object", f"a part of the {cloth}")
+            continue
         for name in ctx.resolve_all(np):
             if arm in ("left", "right"):
                 ctx.held_by[name] = arm
@@ -272,6 +359,10 @@ def _relation(where: Where | None, ctx: _Context) -> Where | None:
 
 def _place_at(names: list[str], where: Where | None, c: Clause, ctx: _Context) -> list[Goal]:
     where = _relation(where, ctx)
+    # "... the fork to the left of the plate and the spoon on the right": a bare side after an anchor is the anchor's side.
+    if where is not None and where.relation == "at" and ctx.last_anchor and where.phrases[0].of is None \
+            and where.phrases[0].words in (("left",), ("right",), ("left", "side"), ("right", "side")):
+        where = Where("side_of", (NounPhrase(words=tuple(ctx.last_anchor.split("_"))),), side=where.phrases[0].words[0])
     arms = {n: ctx.arm_of(c.arm, n) for n in names}
     if where is None or where.relation == "back":
         return [Placed(obj=n, arm=arms[n]) for n in names]
@@ -281,6 +372,7 @@ def _place_at(names: list[str], where: Where | None, c: Clause, ctx: _Context) -
             point = kb.table_point([where.side])
             return [Placed(obj=n, at=point, arm=arms[n]) for n in names]
         anchor = ctx.resolve(anchor_np, exclude=tuple(names))
+        ctx.last_anchor = anchor
         if where.relation == "side_of":
             directions = [kb.DIRECTION_WORDS[where.side]] * len(names)
         elif where.relation == "front_of":
@@ -288,7 +380,9 @@ def _place_at(names: list[str], where: Where | None, c: Clause, ctx: _Context) -
         elif where.relation == "behind":
             directions = [(0.0, 1.0)] * len(names)
         elif len(names) == 2:
-            directions = [(-1.0, 0.0), (1.0, 0.0)]  # table setting: the first named on the anchor's left
+            # Table setting: each on its own side of the anchor where they lie on opposite sides, else the first named on the left.
+            sides = [-1.0 if ctx.objects[n].pos[0] < ctx.objects[anchor].pos[0] else 1.0 for n in names]
+            directions = [(sides[0], 0.0), (sides[1], 0.0)] if sides[0] != sides[1] else [(-1.0, 0.0), (1.0, 0.0)]
         else:
             side = -1.0 if ctx.objects[names[0]].pos[0] < ctx.objects[anchor].pos[0] else 1.0
             directions = [(side, 0.0)] * len(names)
@@ -326,13 +420,32 @@ def _place_at(names: list[str], where: Where | None, c: Clause, ctx: _Context) -
     return [_beside(n, host, (-1.0 if ctx.objects[n].pos[0] < ctx.objects[host].pos[0] else 1.0, 0.0), ctx, arms[n]) for n in names]
 
 
+def _folds(c: Clause, ctx: _Context) -> str | None:
+    """The cloth a clause folds by laying one part of it on another (``lay the bottom corners of the towel on its top corners``)."""
+    if c.where is None or not c.where.phrases:
+        return None
+    target = c.where.phrases[0]
+    if c.where.relation == "on_top" and target.of is not None and target.words == ("top",):
+        target = target.of
+    moved = [_cloth_of(np, ctx) if not np.pronoun else ctx.cloth_taken for np in c.objects]
+    cloth = moved[0] if moved and len(set(moved)) == 1 else None
+    if cloth is None or _cloth_of(target, ctx) != cloth:
+        return None
+    return cloth
+
+
 def _place(c: Clause, ctx: _Context) -> list[Goal]:
+    if (cloth := _folds(c, ctx)) is not None:
+        ctx.note(c.text, "verb", f"fold the {cloth} (one part laid on another)")
+        return [Folded(cloth=cloth)]
     names = list(dict.fromkeys(n for np in c.objects for n in ctx.resolve_put_down(np)))
     ctx.in_hand = [n for n in ctx.in_hand if n not in names]
     return _place_at(names, c.where, c, ctx)
 
 
 def _move(c: Clause, ctx: _Context) -> list[Goal]:
+    if (cloth := _folds(c, ctx)) is not None:
+        return [Folded(cloth=cloth)]
     names = [n for np in c.objects for n in ctx.resolve_put_down(np)]
     ctx.in_hand = [n for n in ctx.in_hand if n not in names]
     if c.where is not None or not c.direction:
@@ -362,17 +475,47 @@ def read_instruction(instruction: str, scene: Scene) -> Reading:
             names no scene object (or several); the message names the words, the closest
             instructions understood in this scene, and the goal-spec alternative.
     """
+    vocabulary, objects = _vocabulary(scene)
+    prepared = prepare(instruction, vocabulary, objects)
     try:
-        clauses = parse(instruction)
+        clauses = parse_prepared(prepared.text)
     except ParseError as exc:
         raise InstructionNotGroundedError(instruction, _not_understood(exc, scene)) from None
     ctx = _Context(scene, instruction)
-    reading = Reading(instruction, clauses)
+    reading = Reading(instruction, clauses, prepared=prepared, words=ctx.read)
     for clause in clauses:
         reading.goals.append(_BUILD[clause.verb](clause, ctx))
+        if clause.arm or clause.giver or clause.receiver:
+            for role, arm in (("arm", clause.arm), ("from", clause.giver), ("to", clause.receiver)):
+                if arm:
+                    ctx.note(f"{role} arm", "arm", arm)
     if not any(reading.goals):
         raise InstructionNotGroundedError(instruction, "it states no goal (what should be true at the end? e.g. where to put what is picked up)")
+    # What is still in hand is put back where it was: the arms end at home, empty.
+    rest = [Placed(obj=n, arm=ctx.held_by.get(n)) for n in ctx.in_hand if n in ctx.objects and not kb.is_cloth_corner(n)]
+    if rest:
+        reading.clauses.append(Clause(verb="place", text="(still in hand: put back where it was)", objects=[NounPhrase(words=(g.obj,)) for g in rest]))
+        reading.goals.append(rest)
     return reading
+
+
+_VOCABULARY: dict[tuple[str, ...], tuple[frozenset[str], frozenset[str]]] = {}
+
+
+def _vocabulary(scene: Scene) -> tuple[frozenset[str], frozenset[str]]:
+    """The words the rules and ``scene`` know (spelling is corrected towards them), and the words naming its objects."""
+    key = tuple(sorted(f"{o.name}:{o.description}" for o in scene.objects) + sorted(f"{r.name}:{r.description}" for r in scene.regions))
+    if key not in _VOCABULARY:
+        names = {w for o in scene.objects for w in kb.words(o)} | {o.name for o in scene.objects}
+        regions = {w for r in scene.regions for w in f"{r.name} {r.description}".lower().replace("_", " ").split()}
+        objects = {w for w in names if w not in COLOURS and w not in _SIZE_WORDS and not kb.is_cloth_corner(f"x_{w}")}
+        objects |= {k for k, v in kb.SYNONYMS.items() if v in objects} | {g for g, kinds in _GROUPS.items() if kinds & objects}
+        objects |= {w + "s" for w in objects}
+        known = (names | regions | objects | set(COLOURS) | set(_SIZE_WORDS) | _FILLER | kb.TABLE_WORDS | kb.PART_WORDS
+                 | set(kb.DIRECTION_WORDS) | set(kb.SYNONYMS) | _CLOTH_PART | _CLOTH_SIDE | set(_POSITION_WORDS) | grammar_words()
+                 | set(kb.CONTAINER_WORDS) | set(kb.POURABLE_WORDS) | set(_GROUPS))
+        _VOCABULARY[key] = (frozenset(known | phrasing_words()), frozenset(objects))
+    return _VOCABULARY[key]
 
 
 def ground_instruction(instruction: str, scene: Scene) -> GoalSpec:

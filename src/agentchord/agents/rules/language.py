@@ -33,6 +33,8 @@ from pathlib import Path
 from lark import Lark, Transformer
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
+from agentchord.agents.rules.phrasing import Rewritten, rewrite
+
 #: The grammar (``instructions.lark`` beside this module).
 GRAMMAR = (Path(__file__).parent / "instructions.lark").read_text(encoding="utf-8")
 
@@ -106,7 +108,7 @@ def normalise(instruction: str) -> str:
     text = re.sub(r"(?:^|(?<=\s))(?:step\s*)?\d+\s*[.):]\s+", " ; ", text)  # "1. pick ...", "step 2) ..."
     text = re.sub(r"'s\b", "", text)
     text = re.sub(r"\bcentre\b", "center", text)
-    text = re.sub(r",?\s*(?:bringing|laying|so that|so|matching|with its|putting its)\b[^,;.]*", "", text)  # fold_towel's how
+    text = re.sub(r",?\s*\b(?:bringing|laying|so that (?=the|its)|so (?=the|its)|matching|with its(?! (?:left|right|other|both) )|putting its)\b[^,;.]*", "", text)  # fold_towel's how
     # "Set the table: fork left of the plate, ...": the title is the verb of the steps that follow.
     text = re.sub(r"^(?:set|lay) the table\s*[:,;-]\s*(?=(\w+))", lambda m: "" if _VERB_FORMS.match(m[1] + "s") else "put ", text.strip())
     text = _VERB_FORMS.sub(r"\1", text)
@@ -370,16 +372,37 @@ class _ToClauses(Transformer):
         return out
 
 
-def parse(instruction: str) -> list[Clause]:
+@lru_cache(maxsize=1)
+def grammar_words() -> frozenset[str]:
+    """The words the grammar spells out (its keywords), for spelling correction."""
+    return frozenset(re.findall(r'"([a-z]+)"', GRAMMAR))
+
+
+def prepare(instruction: str, vocabulary: frozenset[str] = frozenset(), objects: frozenset[str] = frozenset()) -> Rewritten:
+    """The instruction normalised and rewritten into the grammar's phrasing (:mod:`~agentchord.agents.rules.phrasing`)."""
+    return rewrite(normalise(instruction), vocabulary, objects)
+
+
+def parse(instruction: str, vocabulary: frozenset[str] = frozenset(), objects: frozenset[str] = frozenset()) -> list[Clause]:
     """The clauses of an instruction, in order.
+
+    Args:
+        instruction: The words as written.
+        vocabulary: Words known in the scene and to the rules (typos are corrected towards them).
+        objects: Words that name scene objects (for ellipsis and declaratives).
 
     Raises:
         ParseError: Words the grammar cannot read (``words``) and what it expected there.
     """
+    return parse_prepared(prepare(instruction, vocabulary, objects).text)
+
+
+def parse_prepared(text: str) -> list[Clause]:
+    """The clauses of an instruction already rewritten by :func:`prepare`."""
     clauses: list[Clause] = []
     # Sentences, and the steps a "then" starts, are parsed one at a time: Earley parsing
     # costs more than linearly in the length, and "then" never joins anything else.
-    for sentence in normalise(instruction).split(" ; "):
+    for sentence in text.split(" ; "):
         for piece in re.split(r"(?:\s*,)?(?:\s+and)?\s+then\s+(?:,\s*)?", f" {sentence} "):
             piece = re.sub(r"^(?:\s*,|\s*(?:and|then)\b)+|(?:\s*,|\s+and)+\s*$", "", f" {piece.strip()}").strip()
             if piece:
