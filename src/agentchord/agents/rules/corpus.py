@@ -16,7 +16,6 @@ from __future__ import annotations
 import time
 from collections.abc import Iterable
 from dataclasses import dataclass
-from functools import cache
 from pathlib import Path
 
 import yaml
@@ -58,19 +57,6 @@ def load(path: Path) -> list[dict]:
     return yaml.safe_load(path.read_text(encoding="utf-8"))["entries"]
 
 
-@cache
-def scene(task: str, seed: int = 0) -> Scene:
-    """The task's seeded scene under oracle perception (the corpus is labelled in these)."""
-    import numpy as np  # noqa: PLC0415
-
-    from agentchord.agents.observe import observe, task_regions  # noqa: PLC0415
-    from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: PLC0415
-    from agentchord.worlds.sim.world import SimWorld  # noqa: PLC0415
-
-    sim = SIM_TASKS[task]
-    return observe(SimWorld(sim.sample_scene(np.random.default_rng([seed, 0x5CE7E]))), task_regions(sim))
-
-
 def _key(goal) -> tuple:
     fields = goal.model_dump()
     return tuple(sorted((k, round(v, 2) if isinstance(v, float) else tuple(round(x, 2) for x in v) if isinstance(v, (tuple, list)) else v)
@@ -95,9 +81,14 @@ def canonical(spec: GoalSpec) -> list:
     return out + sorted(run, key=repr)
 
 
-def evaluate(entry: dict, plan: bool = True) -> Outcome:
-    """Read (and, with ``plan``, compose) one entry and judge the result against its label."""
-    where = scene(entry["task"])
+def evaluate(entry: dict, where: Scene, plan: bool = True) -> Outcome:
+    """Read (and, with ``plan``, compose) one entry in its scene and judge the result against its label.
+
+    Args:
+        entry: The corpus entry.
+        where: The entry's task's scene (seed 0, oracle perception: the corpus is labelled in these).
+        plan: Also compose the nominal graph (else the goal alone is judged).
+    """
     expected = GoalSpec(goals=entry["goal"]) if "goal" in entry else None
     start = time.perf_counter()
     try:

@@ -12,8 +12,8 @@ from agentchord.agents.exceptions import ReasonerError
 from agentchord.agents.scene import Scene
 from agentchord.agents.rules.composer import compose
 from agentchord.agents.rules.goals import GoalSpec
-from agentchord.agents.rules.instructions import read_instruction
-from agentchord.agents.rules.language import Clause, ParseError, normalise, parse
+from agentchord.agents.rules.instructions import Reading, read_instruction, vocabulary
+from agentchord.agents.rules.language import Clause, ParseError, normalise, parse_prepared, prepare
 
 
 def _goal_text(goal) -> str:
@@ -48,14 +48,41 @@ def _clause_text(clause: Clause) -> str:
     return " ".join(parts)
 
 
+def _words(reading: Reading) -> list[str]:
+    """How each word was read: the rewrites, the typos corrected, then verb, object, arm and place of each phrase."""
+    lines = ["words:"]
+    if reading.prepared is not None:
+        for typo, word in reading.prepared.corrected.items():
+            lines.append(f"  {typo!r} -> typo of {word!r}")
+        if reading.prepared.steps:
+            lines.append(f"  rewritten ({', '.join(dict.fromkeys(reading.prepared.steps))}): {reading.prepared.text!r}")
+    for clause in reading.clauses:
+        if clause.text and not clause.text.startswith("("):
+            lines.append(f"  {clause.text.split()[0]!r} -> verb {clause.verb}")
+        if clause.where is not None:
+            phrases = " & ".join(repr(p.text) for p in clause.where.phrases)
+            lines.append(f"  {phrases or repr(clause.where.relation)} -> place ({clause.where.relation}{' ' + clause.where.side if clause.where.side else ''})")
+        for arm in {a for a in (clause.arm, clause.giver, clause.receiver, *clause.arms) if a}:
+            lines.append(f"  {arm + ' arm'!r} -> arm {arm}")
+        if clause.direction:
+            lines.append(f"  {clause.direction!r} -> place (direction)")
+    for words, role, what in reading.words:
+        lines.append(f"  {words!r} -> {role} {what}")
+    return lines
+
+
 def explain_plan(instruction: str, scene: Scene, goal: GoalSpec | None = None) -> str:
     """The parse of ``instruction`` in ``scene`` as lines of text: clauses -> goal predicates -> skills -> graph."""
     lines: list[str] = []
     if goal is None:
         lines.append(f"instruction: {instruction!r}")
         lines.append(f"normalised:  {normalise(instruction)!r}")
+        known, objects = vocabulary(scene)
+        prepared = prepare(instruction, known, objects)
+        if prepared.text != normalise(instruction):
+            lines.append(f"rewritten:   {prepared.text!r}" + (f" (typos: {prepared.corrected})" if prepared.corrected else ""))
         try:
-            clauses = parse(instruction)
+            clauses = parse_prepared(prepared.text)
         except ParseError as error:
             lines.append(f"clauses: the grammar stops at {error.words!r}")
             return "\n".join(lines)
@@ -70,6 +97,7 @@ def explain_plan(instruction: str, scene: Scene, goal: GoalSpec | None = None) -
         for i, (clause, goals) in enumerate(zip(reading.clauses, reading.goals, strict=True), start=1):
             lines.append(f"  {i}. {clause.text!r}: {_clause_text(clause)}")
             lines.append("       -> " + ("; ".join(_goal_text(g) for g in goals) if goals else "(no goal: who holds what, for later clauses)"))
+        lines += _words(reading)
         goal = reading.goal
     else:
         lines.append("goal spec (given):")

@@ -127,6 +127,7 @@ class _Context:
     def resolve_put_down(self, np: NounPhrase) -> list[str]:
         """What a place clause names: ``it`` is the object last taken in hand, else as :meth:`resolve_all`."""
         if np.pronoun == "it" and self.in_hand:
+            self.note(np.text, "object", self.in_hand[-1])
             return [self.mention(self.in_hand[-1])]
         return self.resolve_all(np)
 
@@ -173,6 +174,7 @@ class _Context:
             earlier = [m for m in self.mentioned if m not in exclude]
             if not earlier:
                 raise self.error(np.text, "has nothing to refer to (no object was named before it)")
+            self.note(np.text, "object", earlier[-1])
             return earlier[-1]
         if len(np.words) > 1 and np.words[-1] in ("back", "down"):  # "put the bottle back" read as one phrase
             np = NounPhrase(words=np.words[:-1], of=np.of)
@@ -475,8 +477,8 @@ def read_instruction(instruction: str, scene: Scene) -> Reading:
             names no scene object (or several); the message names the words, the closest
             instructions understood in this scene, and the goal-spec alternative.
     """
-    vocabulary, objects = _vocabulary(scene)
-    prepared = prepare(instruction, vocabulary, objects)
+    known, objects = vocabulary(scene)
+    prepared = prepare(instruction, known, objects)
     try:
         clauses = parse_prepared(prepared.text)
     except ParseError as exc:
@@ -502,7 +504,7 @@ def read_instruction(instruction: str, scene: Scene) -> Reading:
 _VOCABULARY: dict[tuple[str, ...], tuple[frozenset[str], frozenset[str]]] = {}
 
 
-def _vocabulary(scene: Scene) -> tuple[frozenset[str], frozenset[str]]:
+def vocabulary(scene: Scene) -> tuple[frozenset[str], frozenset[str]]:
     """The words the rules and ``scene`` know (spelling is corrected towards them), and the words naming its objects."""
     key = tuple(sorted(f"{o.name}:{o.description}" for o in scene.objects) + sorted(f"{r.name}:{r.description}" for r in scene.regions))
     if key not in _VOCABULARY:
