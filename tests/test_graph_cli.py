@@ -136,3 +136,12 @@ def test_filter_of_graph_with_dangling_reference(runner: CliRunner, tmp_path: Pa
     result = runner.invoke(main, ["graph", "filter", str(path)])
     assert result.exit_code == 2
     assert "unknown edge 'missing'" in result.output and f"agentchord graph check {path}" in result.output
+
+
+def test_render_style_full_keeps_every_detail_on_the_arcs(runner: CliRunner, tmp_path: Path) -> None:
+    readable, full = tmp_path / "r.dot", tmp_path / "f.dot"
+    assert runner.invoke(main, ["graph", "render", str(POUR), "-o", str(readable)]).exit_code == 0
+    result = runner.invoke(main, ["graph", "render", str(POUR), "-o", str(full), "--style", "full"])
+    assert result.exit_code == 0, result.output
+    assert "rankdir=TB" in readable.read_text() and "rankdir=LR" in full.read_text()
+    assert "when bottle_dropped on e2" in full.read_text()

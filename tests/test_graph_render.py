@@ -124,3 +124,89 @@ def test_an_arm_switching_alternative_is_drawn_dotted_and_says_what_it_replaces(
     dot = to_dot(load_task_graph("single_arm_pour_water"))
     line = next(line for line in dot.splitlines() if "e2_r_bottle_dropped_via_left\\n" in line)
     assert 'style="dotted"' in line and "instead of e2_r_bottle_dropped when its arm cannot reach" in line
+
+
+# ------------------------------------------------------------------ the readable figure (issue 49)
+LIBRARY = sorted((Path(__file__).parent.parent / "src" / "agentchord" / "tasks" / "library").glob("*.yaml"))
+needs_dot = pytest.mark.skipif(shutil.which("dot") is None, reason="Graphviz `dot` not installed (apt-get install graphviz)")
+
+
+def _svg_text(svg: str) -> str:
+    import html
+    import re
+
+    return "\n".join(html.unescape(t) for t in re.findall(r"<text[^>]*>([^<]*)</text>", svg))
+
+
+@needs_dot
+@pytest.mark.parametrize("path", LIBRARY, ids=[p.stem for p in LIBRARY])
+def test_each_library_graph_renders_within_a_page_with_its_names(path: Path, tmp_path: Path) -> None:
+    from PIL import Image
+
+    graph = load_graph(path)
+    png = render(graph, tmp_path / "g.png")
+    width, height = Image.open(png).size
+    assert width <= 1600 and height <= 2000, (width, height)  # legible at 1:1 on a 1600 px wide page
+    text = _svg_text(render(graph, tmp_path / "g.svg").read_text())
+    for node in graph.nodes:
+        assert node.id in text
+    for edge, failure in graph.failures():
+        assert failure.name in text, f"{failure.name} on {edge.id}"
+    # Monitors stay out of the picture (they are the hover text and the page's tables).
+    assert not any(failure.monitor in text for _, failure in graph.failures())
+
+
+def test_readable_dot_names_each_branch_and_folds_the_other_arm() -> None:
+    from agentchord.graph.figure import to_figure_dot
+    from agentchord.tasks import load_task_graph
+
+    dot = to_figure_dot(load_task_graph("handover_block"))
+    assert "rankdir=TB" in dot
+    entry = _dot_line(dot, '"v0" -> "v1" [label=<block_dropped')
+    assert "block_dropped \u2192 regrasp" in entry and "e1_r_block_dropped (or right arm)" in entry
+    assert "e1_r_block_dropped_via_right" not in entry.split("tooltip")[0]  # folded: in the hover text only
+    assert "open_gripper(L); grasp(R)" in entry  # ... where the other arm's calls are
+    # Retries (leave and merge at the same node) share one box beside it, out and back.
+    assert '"retry v1" [label=<<b>\u21bb retry at v1</b>' in dot
+    assert '"v1" -> "retry v1"' in dot and '"retry v1" -> "v1"' in dot
+    assert "grip_low \u2192 regrip high" in _dot_line(dot, '"retry v1" [')
+
+
+def test_readable_figure_keeps_a_retry_box_clear_of_a_node_of_its_name() -> None:
+    from agentchord.graph.figure import to_figure_dot
+
+    graph = TaskGraph.model_validate({
+        "task": "t", "start": "a", "goal": "retry a",
+        "nodes": [{"id": "a", "semantic": "s"}, {"id": "retry a", "semantic": "g"}],
+        "edges": [
+            {"id": "e", "source": "a", "target": "retry a", "actions": {"right": {"fn": "back"}},
+             "failures": [{"name": "f", "monitor": "1", "intent": "again", "recovery": "r"}]},
+            {"id": "r", "kind": "recovery", "source": "a", "target": "a", "actions": {"right": {"fn": "back"}}},
+        ],
+    })
+    dot = to_figure_dot(graph)
+    assert "\"retry a'\" [label=" in dot and '"a" -> "retry a\'"' in dot
+
+
+def test_html_page_has_the_figure_and_every_detail(pour: TaskGraph, tmp_path: Path) -> None:
+    if shutil.which("dot") is None:
+        pytest.skip("Graphviz `dot` not installed")
+    page = render(pour, tmp_path / "g.html").read_text()
+    assert page.startswith("<!DOCTYPE html>") and "<svg" in page and "<?xml" not in page
+    assert "Nominal chain" in page and "Recovery branches" in page
+    for _, failure in pour.failures():
+        assert html_escape(failure.monitor) in page
+    assert "grasp(R, obj=bottle" in page  # full calls, with their arguments
+
+
+def html_escape(text: str) -> str:
+    import html
+
+    return html.escape(text)
+
+
+def test_full_style_keeps_the_old_view(pour: TaskGraph, tmp_path: Path) -> None:
+    assert render(pour, tmp_path / "g.dot", style="full").read_text() == to_dot(pour)
+    assert "rankdir=TB" in render(pour, tmp_path / "r.dot").read_text()  # readable is the default
+    with pytest.raises(RenderError, match="unknown style 'tiny'; use readable, full"):
+        render(pour, tmp_path / "g.dot", style="tiny")

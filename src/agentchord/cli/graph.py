@@ -18,7 +18,7 @@ from agentchord.graph.grounding import check_scene
 from agentchord.graph.loader import JSON_SUFFIXES, YAML_SUFFIXES, dump_graph, load_graph
 from agentchord.graph.models import TaskGraph
 from agentchord.graph.progress import forward_filter
-from agentchord.graph.render import FORMATS, render
+from agentchord.graph.render import FORMATS, STYLES, render
 from agentchord.graph.validation import check_graph
 from agentchord.guard.outputs import atomic_write_text
 
@@ -100,12 +100,25 @@ def _scene_objects(task: str) -> list[str]:
     type=click.Path(dir_okay=False, path_type=Path),
     help=f"Output file; its suffix picks the format ({', '.join(FORMATS)}).",
 )
-def render_command(file: Path, output: Path) -> None:
-    """Draw graph FILE: nominal edges blue, recovery edges pink."""
+@click.option(
+    "--style",
+    type=click.Choice(STYLES),
+    default="readable",
+    show_default=True,
+    help="readable: the nominal chain top to bottom, each recovery branch an arc named 'failure -> intent', "
+    "details on hover (.svg, .html) and in tables (.html); full: every action list and monitor on the arcs.",
+)
+def render_command(file: Path, output: Path, style: str) -> None:
+    """Draw graph FILE: nominal chain blue, recovery branches pink.
+
+    ``.html`` writes one page: the figure, and tables of every node's constraints, every
+    edge's actions and failure modes, and every recovery branch (where it leaves and merges,
+    what fires it, the other arm's way).
+    """
     check_outputs(("-o", output, FORMATS))
     graph = _load_or_exit(file)
     try:
-        render(graph, output)
+        render(graph, output, style=style)
     except GraphError as error:
         raise BadInput(str(error)) from None
     click.echo(f"wrote {output}")

@@ -1,11 +1,15 @@
-"""Pure renderers of a task graph: Graphviz DOT, Mermaid, and SVG/PNG through Graphviz.
+"""Renderers of a task graph: Graphviz DOT, Mermaid, SVG/PNG/PDF through Graphviz, an HTML page.
 
-Colours follow the paper's Fig. 3: nominal edges blue, recovery edges pink.
+Two styles. ``readable`` (the default of :func:`render`) is the figure for people of
+:mod:`agentchord.graph.figure`: the nominal chain top to bottom, each recovery branch a short
+arc named ``failure -> intent``, the details on hover and, in ``.html``, in tables beside it
+(:mod:`agentchord.graph.page`). ``full`` (:func:`to_dot`) writes every detail on the arcs, left
+to right: colours follow the paper's Fig. 3, nominal edges blue, recovery edges pink.
 Recovery nodes are outlined pink, the start node is bold and the goal doubly
 outlined. A recovery entry edge is dashed and labelled with the failure modes
 that fire it (``when mode on edge``); a nominal edge lists its failure
 modes with their entry edges (``! mode -> entry``). An arm-switching alternative of an
-entry edge is dotted and says which entry it stands in for.
+entry edge is dotted and says which entry it stands in for. Mermaid (``.mmd``) is the full view.
 """
 
 from __future__ import annotations
@@ -16,26 +20,20 @@ import textwrap
 from pathlib import Path
 
 from agentchord.graph.exceptions import RenderError
+from agentchord.graph.figure import NOMINAL_COLOR, RECOVERY_COLOR, to_figure_dot
+from agentchord.graph.figure import edge_calls as edge_summary
 from agentchord.graph.models import Edge, FailureMode, Node, TaskGraph
+from agentchord.graph.page import to_html
 from agentchord.guard.outputs import atomic_write_bytes, atomic_write_text
 
-NOMINAL_COLOR = "#1f77b4"
-RECOVERY_COLOR = "#e377c2"
-FORMATS = (".dot", ".gv", ".mmd", ".svg", ".png", ".pdf")
+FORMATS = (".dot", ".gv", ".mmd", ".svg", ".png", ".pdf", ".html")
+#: ``readable``: the figure for people (the default); ``full``: every action list and monitor on the arcs.
+STYLES = ("readable", "full")
 #: Largest graph (nodes + edges) laid out by Graphviz: its time grows faster than the size
 #: (3,000 nodes take ~10 s, 10,000 never end); text formats have no limit.
 MAX_LAYOUT_SIZE = 2500
 
-_ARM_LETTER = {"left": "L", "right": "R"}
-
-
-def edge_summary(edge: Edge) -> str:
-    """The edge's action calls, e.g. ``grasp(R)``, ``grasp(L) + grasp(R)``, ``grasp(R); move_to_obj(R)``."""
-    steps = []
-    for step in edge.steps:
-        calls = [f"{call.fn}({_ARM_LETTER.get(arm, arm)})" for arm, call in step.items() if call is not None]
-        steps.append(" + ".join(calls) or "idle")
-    return "; ".join(steps)
+__all__ = ["FORMATS", "STYLES", "edge_summary", "render", "to_dot", "to_mermaid"]
 
 
 def _entry_failures(graph: TaskGraph) -> dict[str, list[tuple[Edge, FailureMode]]]:
@@ -158,32 +156,45 @@ def to_mermaid(graph: TaskGraph) -> str:
     return "\n".join(out) + "\n"
 
 
-def render(graph: TaskGraph, out_path: str | Path) -> Path:
+def render(graph: TaskGraph, out_path: str | Path, style: str = "readable") -> Path:
     """Write the graph to ``out_path`` in the format its suffix names.
 
     ``.dot``/``.gv`` and ``.mmd`` are text; ``.svg``, ``.png`` and ``.pdf`` are laid out
     by Graphviz (the ``graphviz`` Python package and the ``dot`` binary), up to
-    :data:`MAX_LAYOUT_SIZE` nodes and edges. The file is written atomically.
+    :data:`MAX_LAYOUT_SIZE` nodes and edges; ``.html`` is a page with the SVG figure and
+    tables of every node's, edge's and branch's details. The file is written atomically.
+
+    Args:
+        graph: The task graph.
+        out_path: The file to write.
+        style: One of :data:`STYLES` (``.mmd`` is always the full view).
 
     Returns:
         The path written.
 
     Raises:
-        RenderError: Unknown suffix, a graph too large to lay out, or Graphviz missing or failing.
+        RenderError: Unknown suffix or style, a graph too large to lay out, or Graphviz missing or failing.
     """
     out_path = Path(out_path)
     suffix = out_path.suffix.lower()
+    if style not in STYLES:
+        raise RenderError(f"cannot render to {out_path}: unknown style {style!r}; use {', '.join(STYLES)}")
+    dot = to_figure_dot if style == "readable" else to_dot
     if suffix in (".dot", ".gv"):
-        atomic_write_text(out_path, to_dot(graph))
+        atomic_write_text(out_path, dot(graph))
     elif suffix == ".mmd":
         atomic_write_text(out_path, to_mermaid(graph))
-    elif suffix in (".svg", ".png", ".pdf"):
+    elif suffix in (".svg", ".png", ".pdf", ".html"):
         if (size := len(graph.nodes) + len(graph.edges)) > MAX_LAYOUT_SIZE:
             raise RenderError(
                 f"cannot render to {out_path}: the graph has {size} nodes and edges, more than Graphviz lays out "
                 f"in reasonable time ({MAX_LAYOUT_SIZE}); render to .dot or .mmd instead"
             )
-        atomic_write_bytes(out_path, _graphviz_pipe(to_dot(graph), suffix[1:]))
+        if suffix == ".html":
+            svg = _graphviz_pipe(dot(graph), "svg").decode("utf-8")
+            atomic_write_text(out_path, to_html(graph, svg))
+        else:
+            atomic_write_bytes(out_path, _graphviz_pipe(dot(graph), suffix[1:]))
     else:
         raise RenderError(
             f"cannot render to {out_path}: unknown format {suffix or '(none)'!r}; use {', '.join(FORMATS)}"
