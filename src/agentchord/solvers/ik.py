@@ -81,6 +81,8 @@ class BimanualIK:
             for arm, prefix in ARM_PREFIX.items()
         }
         self._tcp_site = {arm: self.model.site(f"{arm}_tcp").id for arm in ARM_PREFIX}
+        # Per arm, the pose (quaternion and position bytes) its frame task's target was last set to.
+        self._targets_set: dict[str, tuple[bytes, bytes]] = {}
         # What every QP shares (see _qp_velocity): the posture task's weighted Jacobian (its Jacobian
         # is the identity) and the joint limits' constraint rows, built as mink builds them.
         nv = self.model.nv
@@ -142,8 +144,9 @@ class BimanualIK:
             if target is None:
                 # Hold: the current solution is the target.
                 task.set_target_from_configuration(self.configuration)
+                self._targets_set.pop(arm, None)
             else:
-                task.set_target(mink.SE3.from_rotation_and_translation(mink.SO3(np.asarray(target.quat)), np.asarray(target.pos)))
+                self._set_target(arm, task, target)
             tasks.append(task)
         self.posture.set_target(self.configuration.q)
         guarded = self.arm_collision_limit is not None and self.arms_close()
@@ -159,6 +162,14 @@ class BimanualIK:
             # arms hold their last configuration rather than collide.
             self.configuration.update(previous)
         return {arm: self.arm_q(arm) for arm in ARM_PREFIX}
+
+    def _set_target(self, arm: str, task: mink.FrameTask, target: PoseTarget) -> None:
+        """Set a frame task's target, unless it holds the same pose already (an arm holding still)."""
+        quat, pos = np.asarray(target.quat), np.asarray(target.pos)
+        key = (quat.tobytes(), pos.tobytes())
+        if self._targets_set.get(arm) != key:
+            task.set_target(mink.SE3.from_rotation_and_translation(mink.SO3(quat), pos))
+            self._targets_set[arm] = key
 
     def _qp_velocity(self, tasks: list[mink.Task], guarded: bool) -> np.ndarray:
         """One differential-IK step: what ``mink.solve_ik(configuration, tasks, dt, solver="daqp",

@@ -181,8 +181,8 @@ class SimWorld:
             if self.tick >= until:
                 self.data.xfrc_applied[body] = 0.0
                 del self._push_until[body]
-        geoms = self.data.contact.geom[: self.data.ncon]
-        self._contacts = {(int(a), int(b)) for a, b in geoms}
+        # As Python ints in one call (a pair at a time from numpy costs more than the rest of the step's bookkeeping).
+        self._contacts = {(a, b) for a, b in self.data.contact.geom[: self.data.ncon].tolist()}
         if self._cloth_points:
             self._record_cloth_contacts()
 
