@@ -64,7 +64,7 @@ class ObjectFeatures:
     @property
     def is_point(self) -> bool:
         """Whether this is a point feature (a cloth's corner, lying flat in the cloth) rather than a body."""
-        return float(np.max(self.extent)) < POINT_EXTENT
+        return bool(self.extent.max() < POINT_EXTENT)  # the method, not np.max: read for every object every tick
 
     def at(self, fraction: float) -> np.ndarray:
         """Fractional point along the principal axis: 0 = bottom, 1 = top."""
