@@ -97,3 +97,15 @@ def _oracle_recording(tmp_path) -> dict:
     result = CliRunner().invoke(main, ["run", "single_arm_pour_water", "--rerun", str(path)])
     assert result.exit_code == 0, result.output
     return read_recording(path)
+
+
+def test_the_push_is_drawn_and_named_while_it_acts(recording: dict) -> None:
+    # The protocol's shift pushes the cup: a finger, a hand and an arrow at the cup, named as the trace names it.
+    for entity in ("/world/disturbance/cup/hand", "/world/disturbance/cup/fingers", "/world/disturbance/cup/push"):
+        assert entity in recording, entity
+    texts = _column(recording["/disturbance"], "TextLog:text")
+    assert texts[0] == "DISTURBANCE: shift cup (a person pushes it)" and texts[-1] == "disturbance over"
+    ticks, shown = _series(recording, "/status/disturbance")
+    assert 0 < shown.sum() < len(shown)
+    pushes = _column(recording["/world/disturbance/cup/push"], "tick")
+    assert min(pushes) == ticks[shown > 0][0]

@@ -13,7 +13,12 @@ One timeline, ``tick`` (50 Hz; ``time`` alongside in seconds), with:
   frame they were evaluated on;
 - ``graph``: the graph's nodes and edges (static) and ``graph/active``: the active node and edge;
   ``status/recovery``: 1 in a recovery segment;
-- ``events``: disturbances, detected failures, recovery switches and merges, repairs (text log).
+- ``events``: disturbances, detected failures, recovery switches and merges, repairs (text log);
+- ``world/disturbance``: what a disturbance looks like while it acts (and a moment after): a
+  person's hand on a pulled object with the trail of its carry, a finger pushing or knocking one,
+  an arrow along the push (:mod:`agentchord.worlds.sim.markers`), labelled with the disturbance's
+  name; the camera images show them too; ``status/disturbance``: 1 while one shows, and
+  ``disturbance``: its name in a text log when it starts and ends.
 """
 
 from __future__ import annotations
@@ -23,8 +28,9 @@ from pathlib import Path
 import numpy as np
 
 from agentchord.gym.aloha import ARMS, gripper_open
-from agentchord.gym.cameras import RgbCameras
 from agentchord.worlds.protocol import CONTROL_HZ
+from agentchord.worlds.sim.markers import KIND, WHAT, DisturbanceMarkers, Shape
+from agentchord.worlds.sim.render import MarkedCameras
 
 #: Trace events logged to ``events``, with their level.
 EVENT_LEVELS = {
@@ -74,7 +80,9 @@ class RerunLogger:
         self._seen = 0
         self._started = False
         self._active: tuple[str, str] | None = None
-        self._renderer: RgbCameras | None = None
+        self._renderer: MarkedCameras | None = None
+        self._markers: DisturbanceMarkers | None = None
+        self._shown = ""  # the disturbances shown at the last tick, as the text log says them
         self.ticks = 0
 
     # ------------------------------------------------------------------ static
@@ -128,14 +136,40 @@ class RerunLogger:
             if level is not None:
                 rec.log("events", rr.TextLog(_describe(event), level=level))
         self._seen = len(executor.trace.events)
+        shapes = self._log_disturbances(executor)
         if self.cameras and tick % self.image_every == 0:
             if self._renderer is None:
-                self._renderer = RgbCameras(world, self.cameras, self.image_size)
-            for camera, image in self._renderer.render().items():
+                self._renderer = MarkedCameras(world, self.cameras, self.image_size)
+            for camera, image in self._renderer.render(shapes).items():
                 rec.log(f"cameras/{camera}", rr.Image(image).compress(jpeg_quality=80))
         if tick % self.image_every == 0:
             for name, cloud in getattr(executor.extractor, "clouds", {}).items():
                 rec.log(f"world/points/{name}", rr.Points3D(cloud, radii=0.002))
+
+    def _log_disturbances(self, executor) -> list[Shape]:
+        """Log the disturbance markers of this tick; return their shapes (the camera images draw them)."""
+        rr, rec = self.rr, self.rec
+        if self._markers is None:
+            self._markers = DisturbanceMarkers(executor.world)
+        markers = self._markers.update()
+        named = {e["obj"]: e["kind"] for e in executor.trace.events if e["event"] == "disturbance"}
+        names = [f"{named.get(m.obj, KIND[m.kind])} {m.obj}" for m in markers]
+        shown = "; ".join(f"{name} ({WHAT[m.kind]})" for name, m in zip(names, markers, strict=True))
+        rec.log("status/disturbance", rr.Scalars(1.0 if markers else 0.0))
+        if shown != self._shown:
+            rec.log("disturbance", rr.TextLog(f"DISTURBANCE: {shown}" if shown else "disturbance over", level="WARN"))
+            if not markers:
+                rec.log("world/disturbance", rr.Clear(recursive=True))
+            self._shown = shown
+        if not markers:
+            return []
+        for name, marker in zip(names, markers, strict=True):
+            _log_shapes(rr, rec, f"world/disturbance/{marker.obj}", marker.shapes(), name)
+        for obj, trail in self._markers.trails.items():
+            if len(trail) > 1:
+                rec.log(f"world/disturbance/{obj}/carry", rr.LineStrips3D([np.array(trail)], radii=0.003,
+                                                                        colors=[(255, 128, 0)]))
+        return self._markers.shapes()
 
     def _log_monitors(self, executor) -> None:
         armed = executor.armed
@@ -171,6 +205,33 @@ class RerunLogger:
         if disconnect is not None:
             disconnect()
         return self.path
+
+
+def _rgba(shape: Shape) -> tuple[int, int, int, int]:
+    r, g, b, a = (round(255 * c) for c in shape.rgba)
+    return r, g, b, a
+
+
+def _log_shapes(rr, rec, path: str, shapes: list[Shape], label: str) -> None:
+    """A marker's shapes as Rerun's ellipsoids, capsules (along +z, turned onto each segment) and arrows."""
+    from scipy.spatial.transform import Rotation  # noqa: PLC0415
+
+    ellipsoids = [s for s in shapes if s.kind == "ellipsoid"]
+    capsules = [s for s in shapes if s.kind == "capsule"]
+    arrows = [s for s in shapes if s.kind == "arrow"]
+    rec.log(f"{path}/hand", rr.Ellipsoids3D(
+        centers=[s.a for s in ellipsoids], half_sizes=[s.size for s in ellipsoids],
+        quaternions=[rr.Quaternion(xyzw=Rotation.from_matrix(s.rotation).as_quat()) for s in ellipsoids],
+        colors=[_rgba(s) for s in ellipsoids], fill_mode="solid", labels=[label] + [""] * (len(ellipsoids) - 1)))
+    turns = [Rotation.align_vectors([s.b - s.a], [[0.0, 0.0, 1.0]])[0].as_quat() for s in capsules]
+    rec.log(f"{path}/fingers", rr.Capsules3D(
+        lengths=[float(np.linalg.norm(s.b - s.a)) for s in capsules], radii=[float(s.size[0]) for s in capsules],
+        translations=[s.a for s in capsules], quaternions=[rr.Quaternion(xyzw=q) for q in turns],
+        colors=[_rgba(s) for s in capsules]))
+    if arrows:
+        rec.log(f"{path}/push", rr.Arrows3D(origins=[s.a for s in arrows], vectors=[s.b - s.a for s in arrows],
+                                            radii=[float(s.size[0]) / 2 for s in arrows],
+                                            colors=[_rgba(s) for s in arrows]))
 
 
 def read_recording(path: str | Path) -> dict[str, list]:

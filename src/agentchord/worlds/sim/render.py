@@ -1,12 +1,24 @@
-"""Offscreen rendering of episodes to video, with the graph state written on the frames."""
+"""Offscreen rendering of episodes to video, with the graph state and the disturbances shown on the frames.
+
+A disturbance is drawn where it acts (:mod:`agentchord.worlds.sim.markers`: a person's hand
+carrying a pulled object, a finger pushing or knocking one), into the renderer's scene only,
+and named in an orange banner while it acts.
+"""
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
 
+from agentchord.worlds.sim.markers import KIND, WHAT, DisturbanceMarkers, add_to_scene
+from agentchord.worlds.sim.renderers import close_at_exit, closed
 from agentchord.worlds.sim.world import CONTROL_HZ, SimWorld
+
+#: The disturbance announcements of ``agentchord run --video`` (``DISTURBANCE: kind obj``): they name the kind.
+_ANNOUNCED = re.compile(r"DISTURBANCE: (?P<kind>\S+) (?P<obj>\S+)")
+DISTURBANCE_RGBA = (255, 140, 0)
 
 
 class VideoRecorder:
@@ -32,19 +44,43 @@ class VideoRecorder:
         self.caption = ""
         self.flash = ""
         self._flash_until = -1
+        self.markers = DisturbanceMarkers(world)
+        self._named: dict[str, str] = {}  # object -> the kind of disturbance announced on it
 
     def capture(self, caption: str = "") -> None:
-        """Render the current state if this tick is filmed."""
+        """Render the current state if this tick is filmed (call every tick: disturbances are followed)."""
+        self.markers.update()
         if self.world.tick % self.every or self.renderer is None:
             return
         self.renderer.update_scene(self.world.data, camera=self.camera)
+        add_to_scene(self.renderer.scene, self.markers.shapes())
         image = self.renderer.render()
         self.frames.append(self._annotate(image, caption))
 
     def announce(self, text: str, ticks: int = 50) -> None:
-        """Show a highlighted message (a failure, a recovery switch) for a while."""
+        """Show a highlighted message (a failure, a recovery switch) for a while.
+
+        A disturbance's announcement (``DISTURBANCE: kind obj``) also names the disturbance
+        whose marker the frames show while it acts.
+        """
         self.flash = text
         self._flash_until = self.world.tick + ticks
+        if match := _ANNOUNCED.match(text):
+            self.disturbed(match["kind"], match["obj"])
+
+    def disturbed(self, kind: str, obj: str) -> None:
+        """Name the disturbance on ``obj`` (``pull``, ``perturb``, ...) for the banner while it acts."""
+        self._named[obj] = kind
+
+    def disturbance_banner(self) -> str:
+        """What the disturbance banner says now ("" when no disturbance is shown).
+
+        As long as its marker shows: while it acts, and the moment after (a push of 0.1 s
+        would be named on two or three frames).
+        """
+        return "   ".join(
+            f"DISTURBANCE: {self._named.get(m.obj, KIND[m.kind])} {m.obj} ({WHAT[m.kind]})" for m in self.markers.markers
+        )
 
     def _annotate(self, image: np.ndarray, caption: str) -> np.ndarray:
         from PIL import Image, ImageDraw  # noqa: PLC0415  (pillow comes with imageio)
@@ -53,6 +89,9 @@ class VideoRecorder:
         draw = ImageDraw.Draw(canvas)
         draw.rectangle([0, 0, canvas.width, 22], fill=(0, 0, 0))
         draw.text((6, 5), f"t={self.world.tick / CONTROL_HZ:5.2f}s  {caption}", fill=(255, 255, 255))
+        if banner := self.disturbance_banner():
+            draw.rectangle([0, 22, canvas.width, 44], fill=DISTURBANCE_RGBA)
+            draw.text((6, 27), banner, fill=(0, 0, 0))
         if self.world.tick < self._flash_until:
             draw.rectangle([0, canvas.height - 24, canvas.width, canvas.height], fill=(227, 119, 194))
             draw.text((6, canvas.height - 19), self.flash, fill=(0, 0, 0))
@@ -79,3 +118,48 @@ class VideoRecorder:
         renderer, self.renderer = self.renderer, None
         if renderer is not None:
             renderer.close()
+
+
+class MarkedCameras:
+    """RGB images of some scene cameras with disturbance markers drawn in (close when done).
+
+    What ``gym.cameras.RgbCameras`` renders, plus the shapes of
+    :meth:`agentchord.worlds.sim.markers.DisturbanceMarkers.shapes` (a Rerun recording's images).
+
+    Args:
+        world: The simulated world.
+        cameras: Camera names of its scene.
+        size: (height, width) in pixels.
+
+    Raises:
+        KeyError: A camera the scene lacks.
+    """
+
+    def __init__(self, world: SimWorld, cameras: tuple[str, ...], size: tuple[int, int] = (240, 320)) -> None:
+        import mujoco  # noqa: PLC0415
+
+        missing = [c for c in cameras if c not in world.camera_names]
+        if missing:
+            raise KeyError(f"no camera {missing[0]!r} in the scene (cameras: {', '.join(world.camera_names)})")
+        self.world = world
+        self.cameras = tuple(cameras)
+        self._renderer = mujoco.Renderer(world.model, height=size[0], width=size[1]) if cameras else None
+        close_at_exit(self)
+
+    def render(self, shapes: list | tuple = ()) -> dict[str, np.ndarray]:
+        """One (H, W, 3) uint8 image per camera of the state now, ``shapes`` drawn in."""
+        out = {}
+        if self._renderer is None:
+            return out
+        for camera in self.cameras:
+            self._renderer.update_scene(self.world.data, camera=camera)
+            add_to_scene(self._renderer.scene, list(shapes))
+            out[camera] = self._renderer.render().copy()
+        return out
+
+    def close(self) -> None:
+        """Free the renderer; a second call does nothing."""
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
+        closed(self)
