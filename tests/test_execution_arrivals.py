@@ -56,6 +56,10 @@ def test_a_failure_before_its_branch_waits_for_it_then_recovers_as_the_sequentia
     assert switch["tick"] == arrived["tick"] and switch["to"] == sequential.trace.of("recovery_switch")[0]["to"]
     # The sequential plan detected it at the same tick and switched at once.
     assert sequential.trace.of("failure_detected")[0]["tick"] == before["tick"]
+    # The arms held still for the branch as a binding holds them for what fell to come to rest: the binding
+    # counts from the failure, so the recovery does not hold still twice.
+    bound = pipelined.trace.of("recovery_bound")[0]
+    assert bound["waited_ticks"] == bound["tick"] - before["tick"] >= early["waited_ticks"]
     # The wait for the branch, and any wait further on for the rest of it (an edge not grounded yet).
     rest = sum(e["waited_ticks"] for e in pipelined.trace.of("edge_grounded"))
     assert pipelined.plan_wait_s == pytest.approx((early["waited_ticks"] + rest) / 50)

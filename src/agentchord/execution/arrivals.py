@@ -112,6 +112,7 @@ class PlanArrivals:
     _early_armed: str | None
     _rearm_tick: int
     _arriving: Waiting | None
+    still_since: int | None
     plan_wait_ticks: int
     _derived: dict[str, EdgeMonitors]
     frame: Any
@@ -281,15 +282,15 @@ class PlanArrivals:
                 if self._early_failure(detection, suspended, since):
                     return None
                 self._arrived(f"recovery for {watching.failure.name}", since)
-                return self._on_failure(detection)
+                return self._recover_after_wait(detection, since)
             if not derived:
                 self._arrived(f"recovery for {detection.failure.name}", since)
-                return self._on_failure(detection)
+                return self._recover_after_wait(detection, since)
             monitors = self.monitors.get(detection.edge_id)
             now = monitors.violated_now(self.frame) if monitors is not None else None
             if now is not None:
                 self._arrived(f"recovery for {now.failure.name}", since)
-                return self._on_failure(Detection(now.edge_id, now.failure, self.world.tick, detection.onset_tick, now.value))
+                return self._recover_after_wait(Detection(now.edge_id, now.failure, self.world.tick, detection.onset_tick, now.value), since)
             self._arrived("no failure mode of the edge is violated: the edge goes on", since)
             if suspended is not None:
                 self._arm_monitors(suspended)
@@ -301,6 +302,19 @@ class PlanArrivals:
         self.program, self.armed = None, None
         self.waiting = Waiting(until, since, detection.edge_id, detection.failure.name, arrived, self.world.tick)
         return True
+
+    def _recover_after_wait(self, detection: Detection, since: int) -> tuple[bool, str] | None:
+        """Recover from a failure that waited for its branch since tick ``since``.
+
+        The arms held still all that while, as a recovery's binding holds them while what was dropped
+        or taken comes to rest: the binding counts its wait from ``since``, not from now, so that a
+        pipelined recovery does not hold still twice over what the sequential plan waits once.
+        """
+        self.still_since = since
+        try:
+            return self._on_failure(detection)
+        finally:
+            self.still_since = None
 
     def as_arranged(self, detection: Detection) -> Detection:
         """A derived monitor's detection as the arranger's mode of its edge that reads the same constraint, if

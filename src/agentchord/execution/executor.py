@@ -163,6 +163,8 @@ class Executor(RecoverySwitching, PlanArrivals):
         self._early_armed: str | None = None
         self._rearm_tick = 0
         self._arriving: Waiting | None = None
+        # While a recovery that waited for its branch begins: the tick the arms have held still since.
+        self.still_since: int | None = None
         self.background = background
         self._incoming: tuple[int, TaskGraph] | None = None
 

@@ -60,6 +60,7 @@ class RecoverySwitching:
     monitors: dict[str, EdgeMonitors]
     program: EdgeProgram | None
     binding: Binding | None
+    still_since: int | None  # set by a pipelined plan while a recovery that waited for its branch begins
     armed: EdgeMonitors | None
     recovering_from: str | None
     fire_counts: dict[tuple[str, str], int]
@@ -93,7 +94,8 @@ class RecoverySwitching:
             return None
         # The arms hold still while what was dropped or taken comes to rest; then the arm is bound.
         self.program, self.armed = None, None
-        self.binding = Binding(candidates, objects, self.world.tick)
+        since = self.world.tick if self.still_since is None else self.still_since  # a pipelined plan's wait counts
+        self.binding = Binding(candidates, objects, since)
         return None
 
     def _bind(self, frame: FeatureFrame) -> tuple[bool, str] | None:
