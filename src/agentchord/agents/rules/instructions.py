@@ -1,8 +1,9 @@
 """Ground an instruction in the scene: the offline composer's reading of English.
 
 The words are parsed by the grammar of :mod:`agentchord.agents.rules.language` into
-clauses (a verb, its noun phrases, an arm, a place); this module decides what each noun
-phrase names in the scene and which goal predicates each clause states:
+clauses (a verb, its noun phrases, an arm, a place); this module decides which goal predicates
+each clause states, with what each noun phrase names in the scene read by
+:mod:`agentchord.agents.rules.references`:
 
 - objects by name, category word or synonym (``mug`` for a cup), colour, size (``the tall
   bottle``, ``the small block``, ``the big one``: of the kind last named), or a pronoun for the
@@ -31,40 +32,16 @@ from agentchord.agents.rules import knowledge as kb
 from agentchord.agents.rules.goals import Folded, Goal, GoalSpec, HandedOver, Inside, On, Placed, Poured
 from agentchord.agents.rules.language import Clause, NounPhrase, ParseError, Where, grammar_words, parse_prepared, prepare
 from agentchord.agents.rules.phrasing import Rewritten, known_words as phrasing_words
+from agentchord.agents.rules.references import (
+    CLOTH_PART_WORDS,
+    CLOTH_SIDE_WORDS,
+    FILLER_WORDS,
+    GROUP_WORDS,
+    POSITION_WORDS,
+    SIZE_WORDS,
+    Context,
+)
 from agentchord.robot.aloha import other_arm
-
-#: Size words: the candidate with the largest (True) or smallest (False) measure.
-_SIZE_WORDS = {
-    "tall": ("height", True), "taller": ("height", True), "tallest": ("height", True), "high": ("height", True),
-    "short": ("height", False), "shorter": ("height", False), "low": ("height", False),
-    "big": ("volume", True), "bigger": ("volume", True), "biggest": ("volume", True), "large": ("volume", True),
-    "larger": ("volume", True), "largest": ("volume", True), "wide": ("volume", True),
-    "small": ("volume", False), "smaller": ("volume", False), "smallest": ("volume", False), "little": ("volume", False),
-    "tiny": ("volume", False),
-}
-#: Words a noun phrase may carry that name nothing (``the bottle of water``, ``the empty cup``).
-_FILLER = frozenset({"water", "empty", "full", "coffee", "object", "thing", "item", "same", "original", "two"})
-#: Words for a group of scene objects (``the cutlery``): the category words they stand for.
-_GROUPS = {"cutlery": {"fork", "spoon", "knife"}, "utensils": {"fork", "spoon", "knife"}, "silverware": {"fork", "spoon", "knife"},
-           "flatware": {"fork", "spoon", "knife"}}
-#: Position words among several candidates: (axis, largest) -> the one furthest that way.
-_POSITION_WORDS = {"left": (0, False), "right": (0, True), "front": (1, False), "near": (1, False), "nearer": (1, False),
-                   "closer": (1, False), "back": (1, True), "far": (1, True), "farther": (1, True), "rear": (1, True)}
-#: Words for a part of a cloth (``the bottom corners of the towel``, ``its far edge``).
-_CLOTH_PART = frozenset({"corner", "corners", "edge", "edges", "side", "end", "half", "hem"})
-_CLOTH_SIDE = frozenset({"bottom", "top", "near", "far", "front", "back", "lower", "upper", "two", "both", "left", "right", "closest", "furthest"})
-
-
-def lemma_noun(word: str) -> str:
-    """The singular of a plural noun (``blocks`` -> ``block``), or the word."""
-    if word.endswith("ies") and len(word) > 4:
-        return word[:-3] + "y"
-    if word.endswith("es") and word[:-2].endswith(("ss", "sh", "ch", "x")):
-        return word[:-2]
-    if word.endswith("s") and not word.endswith("ss") and len(word) > 3:
-        return word[:-1]
-    return word
-
 
 @dataclass
 class Reading:
@@ -89,176 +66,7 @@ class Reading:
         return GoalSpec(goals=[g for part in self.goals for g in part])
 
 
-class _Context:
-    """What the clauses of one instruction share: the scene, the objects named so far, who holds what."""
-
-    def __init__(self, scene: Scene, instruction: str) -> None:
-        self.scene = scene
-        self.instruction = instruction
-        self.objects = {o.name: o for o in scene.objects}
-        self.cloths = kb.cloth_names(self.objects)
-        self.corners = {f"{c}_{k}" for c in self.cloths for k in kb.CLOTH_CORNERS}
-        self.mentioned: list[str] = []
-        self.held_by: dict[str, str] = {}
-        #: Objects picked up, poured from or handed over and not yet put down, last taken last:
-        #: what ``put it down`` puts down.
-        self.in_hand: list[str] = []
-        #: The head noun last named (``block``): what ``the big one`` is one of.
-        self.last_kind: str | None = None
-        #: How each phrase was read, for ``plan --explain``.
-        self.read: list[tuple[str, str, str]] = []
-        #: A cloth whose part was taken (``take the near corners of the towel``): a place of it on its other part folds it.
-        self.cloth_taken: str | None = None
-        #: The object last placed beside (``on the right`` later in the instruction is its right).
-        self.last_anchor: str | None = None
-
-    def note(self, words: str, role: str, what: str) -> None:
-        if (words, role, what) not in self.read:
-            self.read.append((words, role, what))
-
-    def error(self, words: str, problem: str) -> InstructionNotGroundedError:
-        return InstructionNotGroundedError(self.instruction, f"{words.strip()!r} {problem}")
-
-    def take(self, name: str) -> None:
-        if name in self.in_hand:
-            self.in_hand.remove(name)
-        self.in_hand.append(name)
-
-    def resolve_put_down(self, np: NounPhrase) -> list[str]:
-        """What a place clause names: ``it`` is the object last taken in hand, else as :meth:`resolve_all`."""
-        if np.pronoun == "it" and self.in_hand:
-            self.note(np.text, "object", self.in_hand[-1])
-            return [self.mention(self.in_hand[-1])]
-        return self.resolve_all(np)
-
-    def mention(self, name: str) -> str:
-        if name in self.mentioned:
-            self.mentioned.remove(name)
-        self.mentioned.append(name)
-        return name
-
-    # --- noun phrases -------------------------------------------------------------------
-    def resolve_all(self, np: NounPhrase) -> list[str]:
-        """Scene objects a noun phrase names: one, or several for ``both``, ``them``, ``all``."""
-        if np.pronoun in ("all", "them", "they"):
-            if not self.mentioned:
-                raise self.error(np.text, "has nothing to refer to (name the objects)")
-            group = list(self.mentioned) if np.pronoun == "all" else self.mentioned[-2:]
-            return sorted(group, key=self.mentioned.index)
-        if group := self.group(np):
-            return group
-        return [self.resolve(np)]
-
-    def group(self, np: NounPhrase) -> list[str]:
-        """The objects a plural or collective noun names (``both blocks``, ``the cutlery``), else none."""
-        if not np.words or np.of is not None:
-            return []
-        head = np.words[-1]
-        kinds = _GROUPS.get(head) or ({lemma_noun(head)} if lemma_noun(head) != head else set())
-        if not kinds:
-            return []
-        modifiers = [w for w in np.words[:-1] if w not in ("both", "all", "two", "the")]
-        pool = [o for o in self.scene.objects if o.name not in self.corners and kb.words(o) & {kb.SYNONYMS.get(k, k) for k in kinds}
-                and all(w in kb.words(o) for w in modifiers)]
-        if len(pool) < 2:
-            return []
-        names = [self.mention(o.name) for o in sorted(pool, key=lambda o: o.pos[0])]
-        self.note(np.text, "object", " and ".join(names))
-        return names
-
-    def resolve(self, np: NounPhrase, exclude: tuple[str, ...] = ()) -> str:
-        """The one scene object a noun phrase names (a pronoun: the last one mentioned, not in ``exclude``)."""
-        if np.pronoun:
-            if np.pronoun in ("all", "them", "they"):
-                raise self.error(np.text, "names several objects where one is wanted")
-            earlier = [m for m in self.mentioned if m not in exclude]
-            if not earlier:
-                raise self.error(np.text, "has nothing to refer to (no object was named before it)")
-            self.note(np.text, "object", earlier[-1])
-            return earlier[-1]
-        if len(np.words) > 1 and np.words[-1] in ("back", "down"):  # "put the bottle back" read as one phrase
-            np = NounPhrase(words=np.words[:-1], of=np.of)
-        words = [kb.SYNONYMS.get(w, w) for w in np.words if w not in _FILLER] or list(np.words)
-        if words[-1] == "one":
-            if self.last_kind is None:
-                raise self.error(np.text, "has nothing to refer to (name the object)")
-            words[-1] = self.last_kind
-        if np.of is not None and not words:
-            return self.resolve(np.of)
-        joined = "_".join(np.words)
-        if joined in self.objects:
-            if sum(np.words[-1] in kb.words(o) for o in self.scene.objects) > 1:  # a kind with several members: "the red one"
-                self.last_kind = np.words[-1]
-            self.note(np.text, "object", joined)
-            return self.mention(joined)
-        sizes = [w for w in words if w in _SIZE_WORDS]
-        pool = [o for o in self.scene.objects if o.name not in self.corners and o.name not in exclude]
-        # A position word picks among several of a kind ("the left block"); of one object it is no modifier.
-        positions = [w for w in words if w in _POSITION_WORDS and not any(w in kb.words(o) for o in pool)]
-        plain = [w for w in words if w not in _SIZE_WORDS and w not in positions]
-        candidates = [o for o in pool if all(w in kb.words(o) for w in plain)]
-        for word in positions:
-            if len(candidates) > 1:
-                axis, largest = _POSITION_WORDS[word]
-                candidates = [(max if largest else min)(candidates, key=lambda o, axis=axis: o.pos[axis])]
-        if not candidates and plain:
-            # The head noun alone may still be unique ("coffee capsule" -> capsule); a colour that
-            # does not match is a contradiction, not a modifier to ignore.
-            head = [o for o in pool if plain[-1] in kb.words(o)]
-            if len(head) == 1 and not set(plain[:-1]) & set(COLOURS):
-                candidates = head
-        for word in sizes:
-            if len(candidates) > 1:
-                measure, largest = _SIZE_WORDS[word]
-                key = (lambda o: o.extent[2]) if measure == "height" else (lambda o: o.extent[0] * o.extent[1] * o.extent[2])
-                candidates = [(max if largest else min)(candidates, key=key)]
-        if not candidates:
-            known = sorted({w for o in pool for w in kb.words(o)} | set(self.objects))
-            close = difflib.get_close_matches(plain[-1] if plain else np.text, known, n=2, cutoff=0.6)
-            hint = f"; did you mean {' or '.join(map(repr, close))}?" if close else ""
-            raise self.error(np.text, f"names no scene object (the scene has {', '.join(o.name for o in pool)}){hint}")
-        if len(candidates) > 1:
-            names = ", ".join(o.name for o in candidates)
-            raise self.error(np.text, f"is ambiguous: it could be {names}; name one by colour, size or name")
-        if plain:
-            self.last_kind = plain[-1]
-        self.note(np.text, "object", candidates[0].name)
-        return self.mention(candidates[0].name)
-
-    def table_place(self, np: NounPhrase) -> tuple[float, float] | None | bool:
-        """``False`` when ``np`` is not the table or a region of it; ``None`` for the table itself; else a point."""
-        words = list(np.words) + (list(np.of.words) if np.of is not None else [])
-        of_table = np.of is not None and set(np.of.words) & kb.TABLE_WORDS
-        if set(np.words) <= kb.TABLE_WORDS and np.words and np.of is None:
-            return None
-        region_words = set(words) & (kb.PART_WORDS | set(kb.DIRECTION_WORDS))
-        if of_table or (np.of is None and np.words and set(np.words) <= kb.PART_WORDS | set(kb.DIRECTION_WORDS) | kb.TABLE_WORDS and region_words):
-            return kb.table_point(words) or (kb.TABLE_CENTER if set(words) & {"center", "middle"} else None)
-        return False
-
-    def region(self, np: NounPhrase) -> str | None:
-        """The scene region a noun phrase names (``the target region``, ``the target``), if any."""
-        words = [w for w in np.words if w not in ("region", "area", "zone", "spot", "position", "place")]
-        if not words:
-            return None
-        for region in self.scene.regions:
-            vocabulary = set(region.name.lower().replace("_", " ").split()) | set(region.description.lower().split())
-            if region.name.lower() in words or (all(w in vocabulary for w in words) and set(np.words) & {"region", "area", "zone"}):
-                return region.name
-        return None
-
-    def arm_of(self, said: str | None, obj: str | None = None) -> str | None:
-        if said in ("left", "right"):
-            return said
-        if said == "other" and obj in self.held_by:
-            return other_arm(self.held_by[obj])
-        return self.held_by.get(obj) if obj else None
-
-
-# --- clauses -> goals ---------------------------------------------------------------------
-
-
-def _pour(c: Clause, ctx: _Context) -> list[Goal]:
+def _pour(c: Clause, ctx: Context) -> list[Goal]:
     if c.target is None:
         raise ctx.error(c.text, "does not say what to pour into (say 'into the cup')")
     target = ctx.resolve(c.target)
@@ -279,10 +87,10 @@ def _pour(c: Clause, ctx: _Context) -> list[Goal]:
     return [Poured(source=source, target=target, arm=arm, hold_target=hold_target)]
 
 
-def _cloth_of(np: NounPhrase, ctx: _Context) -> str | None:
+def _cloth_of(np: NounPhrase, ctx: Context) -> str | None:
     """The cloth a phrase names a part of (``the bottom corners of the towel``, ``its top corners``), if any."""
     words = [kb.SYNONYMS.get(w, w) for w in np.words]
-    if not words or words[-1] not in _CLOTH_PART or not set(words[:-1]) <= _CLOTH_SIDE:
+    if not words or words[-1] not in CLOTH_PART_WORDS or not set(words[:-1]) <= CLOTH_SIDE_WORDS:
         return None
     if np.of is not None:
         of = [kb.SYNONYMS.get(w, w) for w in np.of.words]
@@ -290,7 +98,7 @@ def _cloth_of(np: NounPhrase, ctx: _Context) -> str | None:
     return ctx.cloths[0] if len(ctx.cloths) == 1 else None
 
 
-def _pick(c: Clause, ctx: _Context) -> list[Goal]:
+def _pick(c: Clause, ctx: Context) -> list[Goal]:
     for np, arm in zip(c.objects, c.arms or [c.arm] * len(c.objects), strict=False):
         if (cloth := _cloth_of(np, ctx)) is not None:
             ctx.cloth_taken = cloth
@@ -303,7 +111,7 @@ def _pick(c: Clause, ctx: _Context) -> list[Goal]:
     return []
 
 
-def _handover(c: Clause, ctx: _Context) -> list[Goal]:
+def _handover(c: Clause, ctx: Context) -> list[Goal]:
     obj = ctx.resolve(c.objects[0])
     obj_ = ctx.objects[obj]
     giver = c.giver if c.giver in ("left", "right") else None
@@ -317,7 +125,7 @@ def _handover(c: Clause, ctx: _Context) -> list[Goal]:
     return [HandedOver(obj=obj, giver=giver, receiver=receiver)]
 
 
-def _fold(c: Clause, ctx: _Context) -> list[Goal]:
+def _fold(c: Clause, ctx: Context) -> list[Goal]:
     np = c.objects[0]
     words = [kb.SYNONYMS.get(w, w) for w in np.words]
     cloth = next((w for w in reversed(words) if w in ctx.cloths), None)
@@ -330,7 +138,7 @@ def _fold(c: Clause, ctx: _Context) -> list[Goal]:
     return [Folded(cloth=cloth)]
 
 
-def _beside(obj: str, anchor: str, direction: tuple[float, float], ctx: _Context, arm: str | None) -> Placed:
+def _beside(obj: str, anchor: str, direction: tuple[float, float], ctx: Context, arm: str | None) -> Placed:
     o, a = ctx.objects[obj], ctx.objects[anchor]
     d = kb.beside_distance(o, a)
     long_flat = kb.is_flat(o) and max(o.extent[:2]) > 3 * min(o.extent[:2])
@@ -338,7 +146,7 @@ def _beside(obj: str, anchor: str, direction: tuple[float, float], ctx: _Context
                   yaw=90.0 if long_flat and kb.is_flat(a) else None, arm=arm)
 
 
-def _relation(where: Where | None, ctx: _Context) -> Where | None:
+def _relation(where: Where | None, ctx: Context) -> Where | None:
     """``at`` a phrase like ``the left of the plate``, ``the front of the cup``, ``the top of it``: the relation it states."""
     if where is None or where.relation != "at":
         return where
@@ -359,7 +167,7 @@ def _relation(where: Where | None, ctx: _Context) -> Where | None:
     return where
 
 
-def _place_at(names: list[str], where: Where | None, c: Clause, ctx: _Context) -> list[Goal]:
+def _place_at(names: list[str], where: Where | None, c: Clause, ctx: Context) -> list[Goal]:
     where = _relation(where, ctx)
     # "... the fork to the left of the plate and the spoon on the right": a bare side after an anchor is the anchor's side.
     if where is not None and where.relation == "at" and ctx.last_anchor and where.phrases[0].of is None \
@@ -422,7 +230,7 @@ def _place_at(names: list[str], where: Where | None, c: Clause, ctx: _Context) -
     return [_beside(n, host, (-1.0 if ctx.objects[n].pos[0] < ctx.objects[host].pos[0] else 1.0, 0.0), ctx, arms[n]) for n in names]
 
 
-def _folds(c: Clause, ctx: _Context) -> str | None:
+def _folds(c: Clause, ctx: Context) -> str | None:
     """The cloth a clause folds by laying one part of it on another (``lay the bottom corners of the towel on its top corners``)."""
     if c.where is None or not c.where.phrases:
         return None
@@ -436,7 +244,7 @@ def _folds(c: Clause, ctx: _Context) -> str | None:
     return cloth
 
 
-def _place(c: Clause, ctx: _Context) -> list[Goal]:
+def _place(c: Clause, ctx: Context) -> list[Goal]:
     if (cloth := _folds(c, ctx)) is not None:
         ctx.note(c.text, "verb", f"fold the {cloth} (one part laid on another)")
         return [Folded(cloth=cloth)]
@@ -445,7 +253,7 @@ def _place(c: Clause, ctx: _Context) -> list[Goal]:
     return _place_at(names, c.where, c, ctx)
 
 
-def _move(c: Clause, ctx: _Context) -> list[Goal]:
+def _move(c: Clause, ctx: Context) -> list[Goal]:
     if (cloth := _folds(c, ctx)) is not None:
         return [Folded(cloth=cloth)]
     names = [n for np in c.objects for n in ctx.resolve_put_down(np)]
@@ -483,7 +291,7 @@ def read_instruction(instruction: str, scene: Scene) -> Reading:
         clauses = parse_prepared(prepared.text)
     except ParseError as exc:
         raise InstructionNotGroundedError(instruction, _not_understood(exc, scene)) from None
-    ctx = _Context(scene, instruction)
+    ctx = Context(scene, instruction)
     reading = Reading(instruction, clauses, prepared=prepared, words=ctx.read)
     for clause in clauses:
         reading.goals.append(_BUILD[clause.verb](clause, ctx))
@@ -510,12 +318,12 @@ def vocabulary(scene: Scene) -> tuple[frozenset[str], frozenset[str]]:
     if key not in _VOCABULARY:
         names = {w for o in scene.objects for w in kb.words(o)} | {o.name for o in scene.objects}
         regions = {w for r in scene.regions for w in f"{r.name} {r.description}".lower().replace("_", " ").split()}
-        objects = {w for w in names if w not in COLOURS and w not in _SIZE_WORDS and not kb.is_cloth_corner(f"x_{w}")}
-        objects |= {k for k, v in kb.SYNONYMS.items() if v in objects} | {g for g, kinds in _GROUPS.items() if kinds & objects}
+        objects = {w for w in names if w not in COLOURS and w not in SIZE_WORDS and not kb.is_cloth_corner(f"x_{w}")}
+        objects |= {k for k, v in kb.SYNONYMS.items() if v in objects} | {g for g, kinds in GROUP_WORDS.items() if kinds & objects}
         objects |= {w + "s" for w in objects}
-        known = (names | regions | objects | set(COLOURS) | set(_SIZE_WORDS) | _FILLER | kb.TABLE_WORDS | kb.PART_WORDS
-                 | set(kb.DIRECTION_WORDS) | set(kb.SYNONYMS) | _CLOTH_PART | _CLOTH_SIDE | set(_POSITION_WORDS) | grammar_words()
-                 | set(kb.CONTAINER_WORDS) | set(kb.POURABLE_WORDS) | set(_GROUPS))
+        known = (names | regions | objects | set(COLOURS) | set(SIZE_WORDS) | FILLER_WORDS | kb.TABLE_WORDS | kb.PART_WORDS
+                 | set(kb.DIRECTION_WORDS) | set(kb.SYNONYMS) | CLOTH_PART_WORDS | CLOTH_SIDE_WORDS | set(POSITION_WORDS) | grammar_words()
+                 | set(kb.CONTAINER_WORDS) | set(kb.POURABLE_WORDS) | set(GROUP_WORDS))
         _VOCABULARY[key] = (frozenset(known | phrasing_words()), frozenset(objects))
     return _VOCABULARY[key]
 

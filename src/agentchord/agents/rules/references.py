@@ -1,0 +1,225 @@
+"""What a noun phrase names in the scene: the offline composer's references.
+
+Objects by name, category word or synonym, colour, size or position among several of a kind
+(``the tall bottle``, ``the left block``, ``the red one``: of the kind last named), pronouns for
+the last one mentioned, groups (``the cutlery``), a cloth's parts; the table and its regions;
+places relative to objects; arms. :class:`Context` holds what the clauses of one instruction
+share while they are read (:mod:`agentchord.agents.rules.instructions`).
+"""
+
+from __future__ import annotations
+
+import difflib
+
+from agentchord.agents.exceptions import InstructionNotGroundedError
+from agentchord.agents.observe import COLOURS
+from agentchord.agents.scene import Scene
+from agentchord.agents.rules import knowledge as kb
+from agentchord.agents.rules.language import NounPhrase
+from agentchord.robot.aloha import other_arm
+
+#: Size words: the candidate with the largest (True) or smallest (False) measure.
+SIZE_WORDS = {
+    "tall": ("height", True), "taller": ("height", True), "tallest": ("height", True), "high": ("height", True),
+    "short": ("height", False), "shorter": ("height", False), "low": ("height", False),
+    "big": ("volume", True), "bigger": ("volume", True), "biggest": ("volume", True), "large": ("volume", True),
+    "larger": ("volume", True), "largest": ("volume", True), "wide": ("volume", True),
+    "small": ("volume", False), "smaller": ("volume", False), "smallest": ("volume", False), "little": ("volume", False),
+    "tiny": ("volume", False),
+}
+#: Words a noun phrase may carry that name nothing (``the bottle of water``, ``the empty cup``).
+FILLER_WORDS = frozenset({"water", "empty", "full", "coffee", "object", "thing", "item", "same", "original", "two"})
+#: Words for a group of scene objects (``the cutlery``): the category words they stand for.
+GROUP_WORDS = {"cutlery": {"fork", "spoon", "knife"}, "utensils": {"fork", "spoon", "knife"}, "silverware": {"fork", "spoon", "knife"},
+           "flatware": {"fork", "spoon", "knife"}}
+#: Position words among several candidates: (axis, largest) -> the one furthest that way.
+POSITION_WORDS = {"left": (0, False), "right": (0, True), "front": (1, False), "near": (1, False), "nearer": (1, False),
+                   "closer": (1, False), "back": (1, True), "far": (1, True), "farther": (1, True), "rear": (1, True)}
+#: Words for a part of a cloth (``the bottom corners of the towel``, ``its far edge``).
+CLOTH_PART_WORDS = frozenset({"corner", "corners", "edge", "edges", "side", "end", "half", "hem"})
+CLOTH_SIDE_WORDS = frozenset({"bottom", "top", "near", "far", "front", "back", "lower", "upper", "two", "both", "left", "right", "closest", "furthest"})
+
+
+
+def lemma_noun(word: str) -> str:
+    """The singular of a plural noun (``blocks`` -> ``block``), or the word."""
+    if word.endswith("ies") and len(word) > 4:
+        return word[:-3] + "y"
+    if word.endswith("es") and word[:-2].endswith(("ss", "sh", "ch", "x")):
+        return word[:-2]
+    if word.endswith("s") and not word.endswith("ss") and len(word) > 3:
+        return word[:-1]
+    return word
+
+
+class Context:
+    """What the clauses of one instruction share: the scene, the objects named so far, who holds what.
+
+    It decides what each noun phrase names (:meth:`resolve` and its kin): objects, the table and its
+    regions, places relative to objects, arms.
+    """
+
+    def __init__(self, scene: Scene, instruction: str) -> None:
+        self.scene = scene
+        self.instruction = instruction
+        self.objects = {o.name: o for o in scene.objects}
+        self.cloths = kb.cloth_names(self.objects)
+        self.corners = {f"{c}_{k}" for c in self.cloths for k in kb.CLOTH_CORNERS}
+        self.mentioned: list[str] = []
+        self.held_by: dict[str, str] = {}
+        #: Objects picked up, poured from or handed over and not yet put down, last taken last:
+        #: what ``put it down`` puts down.
+        self.in_hand: list[str] = []
+        #: The head noun last named (``block``): what ``the big one`` is one of.
+        self.last_kind: str | None = None
+        #: How each phrase was read, for ``plan --explain``.
+        self.read: list[tuple[str, str, str]] = []
+        #: A cloth whose part was taken (``take the near corners of the towel``): a place of it on its other part folds it.
+        self.cloth_taken: str | None = None
+        #: The object last placed beside (``on the right`` later in the instruction is its right).
+        self.last_anchor: str | None = None
+
+    def note(self, words: str, role: str, what: str) -> None:
+        if (words, role, what) not in self.read:
+            self.read.append((words, role, what))
+
+    def error(self, words: str, problem: str) -> InstructionNotGroundedError:
+        return InstructionNotGroundedError(self.instruction, f"{words.strip()!r} {problem}")
+
+    def take(self, name: str) -> None:
+        if name in self.in_hand:
+            self.in_hand.remove(name)
+        self.in_hand.append(name)
+
+    def resolve_put_down(self, np: NounPhrase) -> list[str]:
+        """What a place clause names: ``it`` is the object last taken in hand, else as :meth:`resolve_all`."""
+        if np.pronoun == "it" and self.in_hand:
+            self.note(np.text, "object", self.in_hand[-1])
+            return [self.mention(self.in_hand[-1])]
+        return self.resolve_all(np)
+
+    def mention(self, name: str) -> str:
+        if name in self.mentioned:
+            self.mentioned.remove(name)
+        self.mentioned.append(name)
+        return name
+
+    # --- noun phrases -------------------------------------------------------------------
+    def resolve_all(self, np: NounPhrase) -> list[str]:
+        """Scene objects a noun phrase names: one, or several for ``both``, ``them``, ``all``."""
+        if np.pronoun in ("all", "them", "they"):
+            if not self.mentioned:
+                raise self.error(np.text, "has nothing to refer to (name the objects)")
+            group = list(self.mentioned) if np.pronoun == "all" else self.mentioned[-2:]
+            return sorted(group, key=self.mentioned.index)
+        if group := self.group(np):
+            return group
+        return [self.resolve(np)]
+
+    def group(self, np: NounPhrase) -> list[str]:
+        """The objects a plural or collective noun names (``both blocks``, ``the cutlery``), else none."""
+        if not np.words or np.of is not None:
+            return []
+        head = np.words[-1]
+        kinds = GROUP_WORDS.get(head) or ({lemma_noun(head)} if lemma_noun(head) != head else set())
+        if not kinds:
+            return []
+        modifiers = [w for w in np.words[:-1] if w not in ("both", "all", "two", "the")]
+        pool = [o for o in self.scene.objects if o.name not in self.corners and kb.words(o) & {kb.SYNONYMS.get(k, k) for k in kinds}
+                and all(w in kb.words(o) for w in modifiers)]
+        if len(pool) < 2:
+            return []
+        names = [self.mention(o.name) for o in sorted(pool, key=lambda o: o.pos[0])]
+        self.note(np.text, "object", " and ".join(names))
+        return names
+
+    def resolve(self, np: NounPhrase, exclude: tuple[str, ...] = ()) -> str:
+        """The one scene object a noun phrase names (a pronoun: the last one mentioned, not in ``exclude``)."""
+        if np.pronoun:
+            if np.pronoun in ("all", "them", "they"):
+                raise self.error(np.text, "names several objects where one is wanted")
+            earlier = [m for m in self.mentioned if m not in exclude]
+            if not earlier:
+                raise self.error(np.text, "has nothing to refer to (no object was named before it)")
+            self.note(np.text, "object", earlier[-1])
+            return earlier[-1]
+        if len(np.words) > 1 and np.words[-1] in ("back", "down"):  # "put the bottle back" read as one phrase
+            np = NounPhrase(words=np.words[:-1], of=np.of)
+        words = [kb.SYNONYMS.get(w, w) for w in np.words if w not in FILLER_WORDS] or list(np.words)
+        if words[-1] == "one":
+            if self.last_kind is None:
+                raise self.error(np.text, "has nothing to refer to (name the object)")
+            words[-1] = self.last_kind
+        if np.of is not None and not words:
+            return self.resolve(np.of)
+        joined = "_".join(np.words)
+        if joined in self.objects:
+            if sum(np.words[-1] in kb.words(o) for o in self.scene.objects) > 1:  # a kind with several members: "the red one"
+                self.last_kind = np.words[-1]
+            self.note(np.text, "object", joined)
+            return self.mention(joined)
+        sizes = [w for w in words if w in SIZE_WORDS]
+        pool = [o for o in self.scene.objects if o.name not in self.corners and o.name not in exclude]
+        # A position word picks among several of a kind ("the left block"); of one object it is no modifier.
+        positions = [w for w in words if w in POSITION_WORDS and not any(w in kb.words(o) for o in pool)]
+        plain = [w for w in words if w not in SIZE_WORDS and w not in positions]
+        candidates = [o for o in pool if all(w in kb.words(o) for w in plain)]
+        for word in positions:
+            if len(candidates) > 1:
+                axis, largest = POSITION_WORDS[word]
+                candidates = [(max if largest else min)(candidates, key=lambda o, axis=axis: o.pos[axis])]
+        if not candidates and plain:
+            # The head noun alone may still be unique ("coffee capsule" -> capsule); a colour that
+            # does not match is a contradiction, not a modifier to ignore.
+            head = [o for o in pool if plain[-1] in kb.words(o)]
+            if len(head) == 1 and not set(plain[:-1]) & set(COLOURS):
+                candidates = head
+        for word in sizes:
+            if len(candidates) > 1:
+                measure, largest = SIZE_WORDS[word]
+                key = (lambda o: o.extent[2]) if measure == "height" else (lambda o: o.extent[0] * o.extent[1] * o.extent[2])
+                candidates = [(max if largest else min)(candidates, key=key)]
+        if not candidates:
+            known = sorted({w for o in pool for w in kb.words(o)} | set(self.objects))
+            close = difflib.get_close_matches(plain[-1] if plain else np.text, known, n=2, cutoff=0.6)
+            hint = f"; did you mean {' or '.join(map(repr, close))}?" if close else ""
+            raise self.error(np.text, f"names no scene object (the scene has {', '.join(o.name for o in pool)}){hint}")
+        if len(candidates) > 1:
+            names = ", ".join(o.name for o in candidates)
+            raise self.error(np.text, f"is ambiguous: it could be {names}; name one by colour, size or name")
+        if plain:
+            self.last_kind = plain[-1]
+        self.note(np.text, "object", candidates[0].name)
+        return self.mention(candidates[0].name)
+
+    def table_place(self, np: NounPhrase) -> tuple[float, float] | None | bool:
+        """``False`` when ``np`` is not the table or a region of it; ``None`` for the table itself; else a point."""
+        words = list(np.words) + (list(np.of.words) if np.of is not None else [])
+        of_table = np.of is not None and set(np.of.words) & kb.TABLE_WORDS
+        if set(np.words) <= kb.TABLE_WORDS and np.words and np.of is None:
+            return None
+        region_words = set(words) & (kb.PART_WORDS | set(kb.DIRECTION_WORDS))
+        if of_table or (np.of is None and np.words and set(np.words) <= kb.PART_WORDS | set(kb.DIRECTION_WORDS) | kb.TABLE_WORDS and region_words):
+            return kb.table_point(words) or (kb.TABLE_CENTER if set(words) & {"center", "middle"} else None)
+        return False
+
+    def region(self, np: NounPhrase) -> str | None:
+        """The scene region a noun phrase names (``the target region``, ``the target``), if any."""
+        words = [w for w in np.words if w not in ("region", "area", "zone", "spot", "position", "place")]
+        if not words:
+            return None
+        for region in self.scene.regions:
+            vocabulary = set(region.name.lower().replace("_", " ").split()) | set(region.description.lower().split())
+            if region.name.lower() in words or (all(w in vocabulary for w in words) and set(np.words) & {"region", "area", "zone"}):
+                return region.name
+        return None
+
+    def arm_of(self, said: str | None, obj: str | None = None) -> str | None:
+        if said in ("left", "right"):
+            return said
+        if said == "other" and obj in self.held_by:
+            return other_arm(self.held_by[obj])
+        return self.held_by.get(obj) if obj else None
+
+
+# --- clauses -> goals ---------------------------------------------------------------------
