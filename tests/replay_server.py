@@ -5,6 +5,9 @@ in a thread, answers ``POST /v1/chat/completions`` with the next item of its
 queue (a :class:`Completion`, or an :class:`HttpError` to simulate a transport
 failure) and records every request it got. Nothing leaves the machine.
 
+A ``responder`` (a callable from the request body to a reply) answers instead of the queue:
+the prompt evaluation answers each request from its replay fixtures that way.
+
 Example:
     with ReplayServer() as server:
         server.push(Completion('{"task": ...}'), HttpError(500))
@@ -17,6 +20,7 @@ import json
 import threading
 import time
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from typing import Any
@@ -80,12 +84,16 @@ class Received:
 class ReplayServer:
     """The server; a context manager that starts and stops it.
 
+    Args:
+        responder: Answers each request from its JSON body (default: the queue).
+
     Attributes:
         requests: Every request received, in order.
         queue: Replies still to give, in order.
     """
 
-    def __init__(self) -> None:
+    def __init__(self, responder: Callable[[Any], Completion | HttpError] | None = None) -> None:
+        self.responder = responder
         self.requests: list[Received] = []
         self.queue: deque[Completion | HttpError] = deque()
         self._lock = threading.Lock()
@@ -132,6 +140,8 @@ class ReplayServer:
     def _next(self, received: Received) -> Completion | HttpError | None:
         with self._lock:
             self.requests.append(received)
+            if self.responder is not None:
+                return self.responder(received.body)
             return self.queue.popleft() if self.queue else None
 
     def _handler_class(self) -> type[BaseHTTPRequestHandler]:

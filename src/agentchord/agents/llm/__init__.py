@@ -30,8 +30,10 @@ Configuration comes from the environment or from arguments::
     graph = reasoner.compose(ComposeRequest(instruction=..., scene=...))
 
 The package, one concept per module: ``config`` (settings), ``messages`` (what is sent),
-``replies`` (what comes back, checked), ``transport`` (timeouts, retries, back-off) and
-``reasoner`` (the ask-validate-repair loop).
+``skills`` (the skill notes a request's prompt carries), ``sizes`` (how large each prompt is),
+``replies`` (what comes back, checked), ``transport`` (timeouts, retries, back-off),
+``reasoner`` (the ask-validate-repair loop) and ``fixtures`` (replayed replies of the prompt
+evaluation, each checked against the request it answers). docs/llm.md has the set-up.
 """
 
 from __future__ import annotations

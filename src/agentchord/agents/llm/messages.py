@@ -1,18 +1,40 @@
-"""What is sent to the model: the system prompt of each agent, the request, a repair turn."""
+"""What is sent to the model: the system prompt of each agent, the request, a repair turn.
+
+The system prompt is the agent's prompt file plus the skill notes the request calls for
+(:mod:`~agentchord.agents.llm.skills`); the user message carries the whole scene the offline
+reasoner sees (objects, arms, regions, notes), so both reason over the same facts.
+"""
 
 from __future__ import annotations
 
 import json
 
 from agentchord.agents.llm.replies import task_graph_schema
+from agentchord.agents.llm.skills import skills_section
 from agentchord.agents.prompts import graph_json, render_prompt
 from agentchord.agents.reasoner import AgentRequest, ArrangeRequest, ComposeRequest, ConductRequest
 from agentchord.agents.scene import Scene
 
+#: How to read the scene's numbers; the same words head every agent's scene.
+SCENE_LEGEND = (
+    "world frame, metres; quat = w, x, y, z; extent = full size along the object's principal axes; "
+    "axis = its bottom-to-top direction; regions = named discs on the table (centre x, y and radius) "
+    "that an instruction may name"
+)
 
-def system_prompt(agent: str, mode: str = "json_schema") -> str:
-    """The system message of an agent; without ``json_schema`` output, the schema is appended."""
+
+def system_prompt(agent: str, mode: str = "json_schema", request: AgentRequest | None = None) -> str:
+    """The system message of an agent; without ``json_schema`` output, the schema is appended.
+
+    Args:
+        agent: ``composer``, ``arranger`` or ``conductor``.
+        mode: The structured-output mode of the request.
+        request: The request it answers: its instruction and scene choose the skill notes
+            appended to the prompt (none without a request).
+    """
     prompt = render_prompt(agent)
+    if request is not None:
+        prompt += skills_section(agent, request)
     if mode == "json_schema":
         return prompt
     schema = json.dumps(task_graph_schema(), separators=(",", ":"))
@@ -27,8 +49,7 @@ def request_message(request: AgentRequest) -> str:
             [
                 f"Instruction: {request.instruction}",
                 f"Task name: {request.task or '(choose a short snake_case name)'}",
-                "First observation (world frame, metres; quat = w, x, y, z; extent = full size along the "
-                "object's principal axes; axis = its bottom-to-top direction):",
+                f"First observation ({SCENE_LEGEND}):",
                 scene,
                 "",
                 "Write the nominal task graph.",
@@ -37,7 +58,7 @@ def request_message(request: AgentRequest) -> str:
     if isinstance(request, ArrangeRequest):
         lines = [
             f"Instruction: {request.graph.instruction or '(not given)'}",
-            "Scene (world frame, metres; quat = w, x, y, z; extent = full size along the object's principal axes):",
+            f"Scene ({SCENE_LEGEND}):",
             scene,
             "",
         ]
@@ -64,7 +85,7 @@ def request_message(request: AgentRequest) -> str:
         return "\n".join(
             [
                 f"Instruction: {request.graph.instruction or '(not given)'}",
-                "Scene (world frame, metres; quat = w, x, y, z; extent = full size along the object's principal axes):",
+                f"Scene ({SCENE_LEGEND}):",
                 scene,
                 "",
                 "Recovery-augmented task graph:",
@@ -77,14 +98,20 @@ def request_message(request: AgentRequest) -> str:
 
 
 def scene_json(scene: Scene) -> str:
-    """A scene as JSON, one object or arm per line."""
+    """A scene as JSON, every field of it (objects, arms, regions, notes), one item per line.
+
+    Every field of :class:`~agentchord.agents.scene.Scene` is written, so a field added to the
+    scene reaches the model too: it reads what the offline reasoner reads.
+    """
     data = scene.model_dump(mode="json")
-    lines = ["{"]
-    for key in ("objects", "arms"):
-        items = [f"    {json.dumps(item)}" for item in data[key]]
-        lines += [f'  "{key}": [', ",\n".join(items), "  ],"] if items else [f'  "{key}": [],']
-    lines += [f'  "notes": {json.dumps(data["notes"])}', "}"]
-    return "\n".join(lines)
+    entries = []
+    for key, value in data.items():
+        if isinstance(value, list) and value:
+            items = ",\n".join(f"    {json.dumps(item)}" for item in value)
+            entries.append(f'  "{key}": [\n{items}\n  ]')
+        else:
+            entries.append(f'  "{key}": {json.dumps(value)}')
+    return "{\n" + ",\n".join(entries) + "\n}"
 
 
 def repair_message(problems: list[str]) -> str:

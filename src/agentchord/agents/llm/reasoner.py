@@ -119,7 +119,7 @@ class LlmReasoner:
                 call.attempts.append(attempt)
                 begun = self._clock()
                 try:
-                    completion = self._complete(agent, messages, attempt, deadline)
+                    completion = self._complete(agent, messages, attempt, deadline, request)
                 finally:
                     attempt.latency_s = self._clock() - begun
                 refusal, unreadable = read_completion(completion, attempt, config.max_reply_chars)
@@ -151,12 +151,17 @@ class LlmReasoner:
             self.calls.append(call)
 
     def _complete(
-        self, agent: str, messages: list[dict[str, Any]], attempt: ReasonerAttempt, deadline: float | None = None
+        self,
+        agent: str,
+        messages: list[dict[str, Any]],
+        attempt: ReasonerAttempt,
+        deadline: float | None = None,
+        request: AgentRequest | None = None,
     ) -> Any:
         """One chat completion, with transport retries and the structured-output fallback.
 
         Each request is bounded by ``timeout_s`` of wall time and all of them by ``deadline``
-        (a ``time.monotonic()`` instant).
+        (a ``time.monotonic()`` instant); ``request`` chooses the system prompt's skill notes.
         """
         config = self.config
         if deadline is None:
@@ -164,7 +169,7 @@ class LlmReasoner:
         retries = 0
         while True:
             mode = self._modes[0]
-            messages[0]["content"] = system_prompt(agent, mode)
+            messages[0]["content"] = system_prompt(agent, mode, request)
             left = deadline - time.monotonic()
             if left <= 0:
                 raise ReasonerTransportError(

@@ -16,6 +16,9 @@ not have:
 ``{{trigger_defaults}}``  default margin and window of a failure mode
 ``{{example_*}}``         the worked example: the library single-arm pour graph
 ========================  ===========================================================
+
+``skills.md`` beside them holds the skill notes that
+:mod:`agentchord.agents.llm.skills` appends to a prompt when a request calls for them.
 """
 
 from __future__ import annotations
@@ -42,10 +45,14 @@ EXAMPLE_TASK = "single_arm_pour_water"
 _PLACEHOLDER = re.compile(r"\{\{\s*([a-z_]+)\s*\}\}")
 
 
+#: Markdown files beside the agents' prompts that are not an agent's prompt.
+NOT_AGENTS = ("skills.md",)
+
+
 def prompt_names() -> list[str]:
-    """Names of the prompt files (without ``.md``): one per agent."""
+    """Names of the prompt files (without ``.md``): one per agent (``skills.md`` holds skill notes)."""
     folder = resources.files(__name__)
-    return sorted(p.name[: -len(".md")] for p in folder.iterdir() if p.name.endswith(".md"))
+    return sorted(p.name[: -len(".md")] for p in folder.iterdir() if p.name.endswith(".md") and p.name not in NOT_AGENTS)
 
 
 def prompt_template(agent: str) -> str:

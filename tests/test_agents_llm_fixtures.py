@@ -1,0 +1,180 @@
+"""The prompt evaluation: each case's replies replayed through ``plan --reasoner llm``, checked against
+the requests they answer; what the model is sent (the whole scene, the skill notes a task needs)."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+import yaml
+from click.testing import CliRunner
+from replay_server import Completion, HttpError, ReplayServer
+
+from agentchord.agents import ComposeRequest, Scene, SceneObject
+from agentchord.agents.llm import request_message, scene_json, system_prompt
+from agentchord.agents.llm.fixtures import (
+    FixtureBook,
+    FixtureError,
+    FixtureMissing,
+    FixtureOutdated,
+    message_agent,
+    request_digest,
+)
+from agentchord.agents.llm.sizes import estimate_tokens, prompt_size
+from agentchord.agents.llm.skills import SkillNotesError, parse_skill_notes, select_notes, skill_notes
+from agentchord.agents.scene import ArmState, Region
+from agentchord.cli import main
+from agentchord.graph.loader import load_graph
+
+CASES_DIR = Path(__file__).parent / "data" / "llm"
+CASES = sorted(p.name for p in CASES_DIR.iterdir() if (p / "case.yaml").is_file())
+
+
+def scene_with_regions() -> Scene:
+    return Scene(
+        objects=[SceneObject(name="block", description="orange block", pos=(-0.18, 0.53, 0.09), extent=(0.04, 0.04, 0.19))],
+        arms=[ArmState(name="left", ee=(-0.2, 0.5, 0.3)), ArmState(name="right", ee=(0.2, 0.5, 0.3))],
+        regions=[Region(name="target", description="target region on the right half", center=(0.12, 0.45), radius=0.04)],
+        notes="table top at z = 0",
+    )
+
+
+def fixture_responder(book: FixtureBook):
+    """Answer each chat request with the case's stored reply; refuse (HTTP 418, not retried) otherwise."""
+
+    def respond(body) -> Completion | HttpError:
+        try:
+            return Completion(book.answer(body["messages"]))
+        except FixtureError as error:
+            return HttpError(418, str(error))
+
+    return respond
+
+
+# --- what the model is sent ------------------------------------------------------------------
+
+
+def test_every_agent_request_holds_the_facts_the_rules_reasoner_reads():
+    # The rules reasoner reads the Scene object; the model reads scene_json in its user message.
+    scene = scene_with_regions()
+    block = scene_json(scene)
+    assert Scene.model_validate(json.loads(block)) == scene  # every field, nothing dropped
+    message = request_message(ComposeRequest(instruction="Hand the block over.", scene=scene))
+    assert block in message
+    assert '"center": [0.12, 0.45]' in message and "table top at z = 0" in message
+
+
+@pytest.mark.parametrize(("case", "words"), [
+    ("handover_block", '{"name": "target", "description": "target region on the right half of the table", "center": [0.12, 0.45], "radius": 0.04}'),
+    ("setup_coffee_tray", '{"name": "forward", "description": "forward front position where the tray goes", "center": [0.0, 0.67], "radius": 0.03}'),
+])
+def test_task_regions_reach_every_agent(case, words):
+    for request in sorted((CASES_DIR / case).glob("*.request.md")):
+        assert words in request.read_text(encoding="utf-8"), request.name
+
+
+def test_skill_notes_follow_the_request():
+    def notes(instruction: str, scene: Scene) -> set[str]:
+        return {note.name for note in select_notes(ComposeRequest(instruction=instruction, scene=scene))}
+
+    scene = scene_with_regions()
+    assert notes("Hand the block over to the right arm.", scene) == {"handover", "regions"}  # region named in the scene
+    pour = Scene(objects=[SceneObject(name="bottle", pos=(0.1, 0.4, 0.09), extent=(0.05, 0.05, 0.18))])
+    assert notes("Pour water from the bottle.", pour) == {"pouring"}
+    towel = Scene(objects=[SceneObject(name="towel_bl", pos=(0.0, 0.4, 0.0), extent=(0.01, 0.01, 0.01))])
+    assert "cloth" in notes("Fold it in half.", towel)
+    prompt = system_prompt("arranger", request=ComposeRequest(instruction="Hand the block over.", scene=scene))
+    assert "Recovering a hand-over" in prompt  # the arranger's paragraph
+    assert "Recovering a hand-over" not in system_prompt("composer", request=ComposeRequest(instruction="Hand the block over.", scene=scene))
+    assert "# Skill notes" not in system_prompt("composer")
+
+
+def test_every_note_is_selectable_and_malformed_notes_are_named():
+    assert {note.name for note in skill_notes()} >= {"handover", "two_arm_carry", "cloth", "beside", "inside", "pouring", "regions"}
+    assert all(note.when for note in skill_notes())
+    with pytest.raises(SkillNotesError, match="section 'x': expected a When: line"):
+        parse_skill_notes("## x\nTitle: X\n\ntext\n")
+    with pytest.raises(SkillNotesError, match=r"unknown agent tag \[planner\]"):
+        parse_skill_notes("## x\nWhen: y\nTitle: X\n\n[planner] text\n")
+
+
+def test_prompt_size_counts_the_notes():
+    request = ComposeRequest(instruction="Hand the block over.", scene=scene_with_regions())
+    size = prompt_size(request)
+    assert size.agent == "composer" and size.notes_chars > 0
+    assert size.system_chars == len(system_prompt("composer", request=request))
+    assert size.tokens == estimate_tokens("x" * size.chars)
+
+
+# --- the replay fixtures --------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_fixtures_answer_their_requests_and_plan(case, tmp_path, monkeypatch):
+    """``plan --reasoner llm`` against the case's replies: every request must be the one answered."""
+    book = FixtureBook.load(CASES_DIR / case)
+    args = ["plan", book.case.instruction, "--task", book.case.task, "--seed", str(book.case.seed), "--reasoner", "llm", "-o", str(tmp_path / "g.yaml")]
+    if book.case.goal is not None:
+        goal = tmp_path / "goal.yaml"
+        goal.write_text(yaml.safe_dump(book.case.goal))
+        args += ["--goal", str(goal)]
+    with ReplayServer(fixture_responder(book)) as server:
+        monkeypatch.setenv("AGENTCHORD_LLM_BASE_URL", server.base_url)
+        monkeypatch.setenv("AGENTCHORD_LLM_MODEL", "fixture")
+        monkeypatch.setenv("AGENTCHORD_LLM_API_KEY", "none")
+        result = CliRunner().invoke(main, args)
+    assert not book.problems, "fixtures to answer again:\n" + "\n".join(book.problems)
+    assert result.exit_code == 0, result.output
+    assert book.answered == len(book.case.turns)  # every stored reply used, in order
+    graph = load_graph(tmp_path / "g.yaml")
+    assert graph.recovery_edges(), "the arranger's recovery branches survived the plan"
+
+
+def test_a_changed_request_is_flagged_not_answered(tmp_path):
+    folder = tmp_path / "case"
+    shutil.copytree(CASES_DIR / "handover_block", folder)
+    book = FixtureBook.load(folder)
+    first = (folder / "01-composer.request.md").read_text(encoding="utf-8")
+    system = first.split("<!-- message 1: user -->")[0]
+    messages = [{"role": "system", "content": "You are ... (the composer) of AgentChord" + system}, {"role": "user", "content": "changed"}]
+    with pytest.raises(FixtureOutdated, match="01-composer.reply.json: answers another request"):
+        book.answer(messages)
+    recording = FixtureBook.load(folder, record=True)
+    with pytest.raises(FixtureOutdated):
+        recording.answer(messages)
+    assert (folder / "01-composer.reply.stale.json").is_file() and not (folder / "01-composer.reply.json").exists()
+    assert FixtureBook.load(folder).case.turns[0].request_sha256 == request_digest(messages)
+    with pytest.raises(FixtureMissing, match="no reply to turn 1"):
+        FixtureBook.load(folder).answer(messages)
+
+
+def test_fixture_errors_name_the_file(tmp_path):
+    with pytest.raises(FixtureError, match="case.yaml: no such case file"):
+        FixtureBook.load(tmp_path)
+    (tmp_path / "case.yaml").write_text("task: t\n")
+    with pytest.raises(FixtureError, match="case.yaml: not a fixture case"):
+        FixtureBook.load(tmp_path)
+    with pytest.raises(FixtureError, match="not the system prompt"):
+        message_agent([{"role": "user", "content": "hi"}])
+
+
+# --- the episodes (slow) --------------------------------------------------------------------
+
+
+#: Cases whose planned graph does not yet meet 3 of 3 undisturbed (docs/llm.md says why).
+SHORT = {"fold_towel": "the left bottom corner slips out of the pinch during the carry (1 of 3 undisturbed)"}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("case", [pytest.param(c, marks=pytest.mark.xfail(reason=SHORT[c], strict=False)) if c in SHORT else c for c in CASES])
+def test_planned_graph_succeeds_undisturbed(case):
+    import sys  # noqa: PLC0415
+
+    sys.path.insert(0, str(Path(__file__).parents[1] / "benchmarks"))
+    from llm_prompt_eval import plan_case, run_episodes  # noqa: PLC0415
+
+    graph, _ = plan_case(case)
+    rows = run_episodes(FixtureBook.load(CASES_DIR / case).case.task, graph, [0, 1, 2], None)
+    assert all(row["success"] for row in rows), rows
