@@ -42,3 +42,25 @@ def test_recovered_only_once_the_recovery_merges_and_both_of_two_nested_ones():
     injected = [first, second, _Event(300, "drop")]  # a third, never detected
     assert ledger.by_kind(injected) == {"drop": [2, 1, 1], "pull": [1, 1, 1]}
     assert ledger.drops(injected) == (2, 1, 1)
+
+
+def test_a_detection_reported_late_books_the_disturbance_before_it_not_one_during_the_wait():
+    # A failure fired at 279 and waited for its branch; a second disturbance came at 367, during the wait.
+    ledger = DisturbanceLedger()
+    pull, second = _Event(276, "pull", obj="fork"), _Event(367, "pull", obj="spoon")
+    ledger.injected(pull, 0.0)
+    ledger.injected(second, 0.0)
+    assert ledger.detection(279) is pull
+    assert ledger.latency_ticks == [3]
+    # The second one stays open for its own detection.
+    assert ledger.detection(930) is second
+    assert ledger.latency_ticks == [3, 563]
+
+
+def test_a_disturbance_not_detected_before_the_next_one_is_not_counted():
+    ledger = DisturbanceLedger()
+    missed, caught = _Event(100, "perturb"), _Event(200, "drop")
+    ledger.injected(missed, 0.0)
+    ledger.injected(caught, 0.0)
+    assert ledger.detection(203) is caught and ledger.detected == [caught]
+    assert ledger.detection(300) is None
