@@ -257,14 +257,14 @@ class ChunkMLPPolicy(PreTrainedPolicy):
             return self._queue.pop(0)[None]
         chunk = self.predict_action_chunk(obs)[0]  # (K, A)
         if self._avg is None:
-            avg, count = chunk, torch.ones(len(chunk), dtype=torch.long)
+            avg, count = chunk, torch.ones(len(chunk), dtype=torch.long, device=chunk.device)
         else:
             # ACT's temporal ensembling: the i-th prediction of a tick weighs exp(-m * i), the oldest i = 0.
-            w = torch.exp(-coeff * torch.arange(len(chunk), dtype=torch.float32))
+            w = torch.exp(-coeff * torch.arange(len(chunk), dtype=torch.float32, device=chunk.device))
             cum = torch.cumsum(w, 0)
             c = self._count
             mean = (self._avg * cum[c - 1, None] + chunk[:-1] * w[c, None]) / cum[c, None]
             avg = torch.cat([mean, chunk[-1:]])
-            count = torch.cat([c + 1, torch.ones(1, dtype=torch.long)])
+            count = torch.cat([c + 1, torch.ones(1, dtype=torch.long, device=chunk.device)])
         self._avg, self._count = avg[1:], count[1:]
         return avg[:1]

@@ -387,7 +387,9 @@ def stage_eval(out: Path, which: str, condition: str, trials: int, threads: int 
     todo = [s for s in range(EVAL_SEED, EVAL_SEED + trials) if s not in seen]
     if todo:
         t0 = time.perf_counter()
-        policy = ChunkMLPPolicy.from_pretrained(out / f"policy_{which}", device=device)
+        policy = ChunkMLPPolicy.from_pretrained(out / f"policy_{which}")
+        policy.config.device = device
+        policy.to(device)
         env = gymnasium.make(ENV_ID, disturb=None if condition == "none" else condition)
         bar = progress(todo, desc=f"eval {which} {condition}", unit="trial")
         with path.open("a") as f:
@@ -483,7 +485,7 @@ def stage_report(out: Path, sets: list[str], trials: int, demos: int, log=print)
                         f"{moved} | {s['regrasped']} | {train['train_s'] / 60:.1f} min | {s['eval_s'] / 60:.1f} min |")
         data["sets"][which] = entry
     table = ("| set | demos | evaluation | success | Wilson 95% CI | success when the cup moved after the grasp | "
-             "trials with a re-grasp | train time | eval time |\n"
+             "trials where the grasp contact broke and re-formed | train time | eval time |\n"
              "| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n" + "\n".join(rows))
     log(table)
     (out / "table3.md").write_text(table + "\n")
