@@ -157,7 +157,6 @@ def test_a_failed_trial_is_the_environment_s_own_failure() -> None:
     env.close()
 
 
-@pytest.mark.slow
 def test_a_trial_s_success_is_the_environment_s_own_is_success() -> None:
     from agentchord.execution.episode import EpisodeSpec, run_episode
     from agentchord.gym.aloha import joint_action
