@@ -43,7 +43,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("stage", choices=("record", "train", "eval", "report", "all"))
     parser.add_argument("--out", type=Path, required=True)
-    parser.add_argument("--demos", type=int, default=100, help="demonstrations per training set")
+    parser.add_argument("--demos", type=int, default=150, help="demonstrations per training set")
     parser.add_argument("--dose", default="0,50", help="recovery shares (%%) of the sets: 0 is set A")
     parser.add_argument("--set", action="append", help="only these sets (A, B25, B50 ...); default: --dose's")
     parser.add_argument("--condition", action="append", choices=CONDITIONS,
