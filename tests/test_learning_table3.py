@@ -169,3 +169,15 @@ def test_a_trial_s_success_is_the_environment_s_own_is_success() -> None:
     assert good["success"] is True and env.seen[-1] is True and not any(env.seen[:-1])
     assert good["ticks"] == len(env.seen) and good["grasps"] >= 1 and good["poured"] and not good["cup_moved"]
     env.close()
+
+
+@pytest.mark.slow
+def test_the_record_stage_writes_what_the_train_stage_reads(tmp_path: Path) -> None:
+    """Recorded for real: one nominal episode, one that recovers from the cup moved after the grasp."""
+    data = table3.stage_record(tmp_path, 1, 1, log=lambda *_: None)
+    assert len(data["nominal"]["episodes"]) == 1 and len(data["recovered"]["cup_recovery_episodes"]) >= 1
+    episodes, info = table3.training_set(tmp_path, "B50", 2)
+    rec = data["recovered"]["episodes"][data["recovered"]["cup_recovery_episodes"][0]]
+    assert info["parts"]["recovered"]["frames"] == rec["frames"] == len(episodes[1]["action"])
+    assert info["recovery_frames"] == rec["recovery_frames"] == int(episodes[1]["agentchord.recovery"].sum()) > 0
+    assert info["parts"]["nominal"]["frames"] == data["nominal"]["episodes"][0]["frames"]
