@@ -37,7 +37,7 @@ CONDITIONS = ("shift", "none")
 class TrainConfig:
     """One training configuration, the same for every set."""
 
-    steps: int = 10000
+    steps: int = 20000
     batch_size: int = 256
     lr: float = 1e-3
     weight_decay: float = 1e-4
