@@ -28,9 +28,9 @@ from pathlib import Path
 import numpy as np
 
 from agentchord.gym.aloha import ARMS, gripper_open
+from agentchord.gym.cameras import RgbCameras
 from agentchord.worlds.protocol import CONTROL_HZ
 from agentchord.worlds.sim.markers import KIND, WHAT, DisturbanceMarkers, Shape
-from agentchord.worlds.sim.render import MarkedCameras
 
 #: Trace events logged to ``events``, with their level.
 EVENT_LEVELS = {
@@ -80,7 +80,7 @@ class RerunLogger:
         self._seen = 0
         self._started = False
         self._active: tuple[str, str] | None = None
-        self._renderer: MarkedCameras | None = None
+        self._renderer: RgbCameras | None = None
         self._markers: DisturbanceMarkers | None = None
         self._shown = ""  # the disturbances shown at the last tick, as the text log says them
         self.ticks = 0
@@ -139,7 +139,7 @@ class RerunLogger:
         shapes = self._log_disturbances(executor)
         if self.cameras and tick % self.image_every == 0:
             if self._renderer is None:
-                self._renderer = MarkedCameras(world, self.cameras, self.image_size)
+                self._renderer = RgbCameras(world, self.cameras, self.image_size)
             for camera, image in self._renderer.render(shapes).items():
                 rec.log(f"cameras/{camera}", rr.Image(image).compress(jpeg_quality=80))
         if tick % self.image_every == 0:

@@ -6,10 +6,10 @@ policy and a dataset want plain RGB frames: one ``mujoco.Renderer`` per camera h
 
 from __future__ import annotations
 
-import mujoco
 import numpy as np
 
-from agentchord.worlds.sim.renderers import close_at_exit, closed
+from agentchord.worlds.sim.markers import Shape, add_to_scene
+from agentchord.worlds.sim.renderers import close_at_exit, closed, open_renderer
 
 
 class RgbCameras:
@@ -31,14 +31,20 @@ class RgbCameras:
         self.world = world
         self.cameras = tuple(cameras)
         self.size = size
-        self._renderer = mujoco.Renderer(world.model, height=size[0], width=size[1]) if cameras else None
+        self._renderer = open_renderer(world.model, height=size[0], width=size[1]) if cameras else None
         close_at_exit(self)
 
-    def render(self) -> dict[str, np.ndarray]:
-        """One (H, W, 3) uint8 image per camera of the state now."""
+    def render(self, shapes: list[Shape] | tuple[Shape, ...] = ()) -> dict[str, np.ndarray]:
+        """One (H, W, 3) uint8 image per camera of the state now, ``shapes`` drawn in.
+
+        ``shapes``: disturbance markers (:meth:`agentchord.worlds.sim.markers.DisturbanceMarkers.shapes`,
+        a Rerun recording's images); observations and datasets pass none.
+        """
         out = {}
         for camera in self.cameras:
             self._renderer.update_scene(self.world.data, camera=camera)
+            if shapes:
+                add_to_scene(self._renderer.scene, list(shapes))
             out[camera] = self._renderer.render().copy()
         return out
 

@@ -11,7 +11,7 @@ import mujoco
 import numpy as np
 
 from agentchord.worlds.protocol import CameraFrame
-from agentchord.worlds.sim.renderers import close_at_exit, closed
+from agentchord.worlds.sim.renderers import close_at_exit, closed, open_renderer
 
 class DepthCamera:
     """A scene camera that renders depth and segmentation with its own ``mujoco.Renderer``
@@ -38,7 +38,7 @@ class DepthCamera:
         self.camera = camera
         self.camera_id = model.camera(camera).id
         self.width, self.height = width, height
-        self.renderer = mujoco.Renderer(model, height, width)
+        self.renderer = open_renderer(model, height, width)
         self.option = mujoco.MjvOption()
         self.option.sitegroup[:] = 0  # sites (the TCP markers) are not scene surfaces
         extent = model.stat.extent

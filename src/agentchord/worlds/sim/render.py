@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from agentchord.worlds.sim.markers import KIND, WHAT, DisturbanceMarkers, add_to_scene
-from agentchord.worlds.sim.renderers import close_at_exit, closed
+from agentchord.worlds.sim.renderers import open_renderer
 from agentchord.worlds.sim.world import CONTROL_HZ, SimWorld
 
 #: The disturbance announcements of ``agentchord run --video`` (``DISTURBANCE: kind obj``): they name the kind.
@@ -33,13 +33,11 @@ class VideoRecorder:
     """
 
     def __init__(self, world: SimWorld, path: str | Path, camera: str = "front", every: int = 2, size: tuple[int, int] = (640, 480)) -> None:
-        import mujoco  # noqa: PLC0415  (MUJOCO_GL is set by the package's __init__)
-
         self.world = world
         self.path = Path(path)
         self.camera = camera
         self.every = every
-        self.renderer = mujoco.Renderer(world.model, height=size[1], width=size[0])
+        self.renderer = open_renderer(world.model, height=size[1], width=size[0])
         self.frames: list[np.ndarray] = []
         self.caption = ""
         self.flash = ""
@@ -118,48 +116,3 @@ class VideoRecorder:
         renderer, self.renderer = self.renderer, None
         if renderer is not None:
             renderer.close()
-
-
-class MarkedCameras:
-    """RGB images of some scene cameras with disturbance markers drawn in (close when done).
-
-    What ``gym.cameras.RgbCameras`` renders, plus the shapes of
-    :meth:`agentchord.worlds.sim.markers.DisturbanceMarkers.shapes` (a Rerun recording's images).
-
-    Args:
-        world: The simulated world.
-        cameras: Camera names of its scene.
-        size: (height, width) in pixels.
-
-    Raises:
-        KeyError: A camera the scene lacks.
-    """
-
-    def __init__(self, world: SimWorld, cameras: tuple[str, ...], size: tuple[int, int] = (240, 320)) -> None:
-        import mujoco  # noqa: PLC0415
-
-        missing = [c for c in cameras if c not in world.camera_names]
-        if missing:
-            raise KeyError(f"no camera {missing[0]!r} in the scene (cameras: {', '.join(world.camera_names)})")
-        self.world = world
-        self.cameras = tuple(cameras)
-        self._renderer = mujoco.Renderer(world.model, height=size[0], width=size[1]) if cameras else None
-        close_at_exit(self)
-
-    def render(self, shapes: list | tuple = ()) -> dict[str, np.ndarray]:
-        """One (H, W, 3) uint8 image per camera of the state now, ``shapes`` drawn in."""
-        out = {}
-        if self._renderer is None:
-            return out
-        for camera in self.cameras:
-            self._renderer.update_scene(self.world.data, camera=camera)
-            add_to_scene(self._renderer.scene, list(shapes))
-            out[camera] = self._renderer.render().copy()
-        return out
-
-    def close(self) -> None:
-        """Free the renderer; a second call does nothing."""
-        if self._renderer is not None:
-            self._renderer.close()
-            self._renderer = None
-        closed(self)

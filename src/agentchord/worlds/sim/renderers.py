@@ -1,10 +1,17 @@
-"""Renderers closed before the process exits: one exit hook for every open MuJoCo renderer owner."""
+"""MuJoCo renderers: opened safely beside torch, and closed before the process exits.
+
+Every renderer of the package is opened by :func:`open_renderer` and registered with
+:func:`close_at_exit` by its owner.
+"""
 
 from __future__ import annotations
 
 import atexit
+import importlib.util
 import weakref
 from typing import Protocol
+
+import mujoco
 
 
 class Closable(Protocol):
@@ -37,3 +44,24 @@ def close_at_exit(owner: Closable) -> None:
 def closed(owner: Closable) -> None:
     """``owner`` closed its renderer itself: nothing to do at exit."""
     _OPEN.discard(owner)
+
+
+_TRITON_LOADED = False
+
+
+def _load_triton_first() -> None:
+    # Headless EGL on a CPU is Mesa's llvmpipe, which loads its own LLVM. Triton (imported by
+    # torch when a policy trains) bundles another; loaded after Mesa's, it segfaults the process.
+    # Loaded before, both work. So a process that renders and then trains (record a dataset with
+    # images, then learn from it) loads Triton first, when it is installed (about 0.2 s, once).
+    global _TRITON_LOADED
+    if not _TRITON_LOADED:
+        _TRITON_LOADED = True
+        if importlib.util.find_spec("triton") is not None:
+            import triton  # noqa: F401, PLC0415
+
+
+def open_renderer(model: mujoco.MjModel, height: int, width: int) -> mujoco.Renderer:
+    """A ``mujoco.Renderer`` of ``model``, Triton loaded before its GL context (see above)."""
+    _load_triton_first()
+    return mujoco.Renderer(model, height=height, width=width)
