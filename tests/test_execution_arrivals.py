@@ -99,3 +99,18 @@ def test_a_recovery_starts_once_its_entry_is_here_and_waits_at_its_node_for_the_
     assert arrived["tick"] < grounded["tick"]
     assert [e["edge"] for e in pipelined.trace.of("edge_start")] == [e["edge"] for e in sequential.trace.of("edge_start")]
     assert pipelined.plan_wait_s == pytest.approx((arrived["waited_ticks"] + grounded["waited_ticks"]) / 50)
+
+
+def test_a_failure_before_its_branch_hurries_it(monkeypatch):
+    # The bottle dropped on e3 while the arranger still wrote e2's branches: its own branch goes first.
+    drop = ScriptedDrop("rotate_eef", after=10)
+    hurried = _run(disturbance=drop)
+    events = hurried.trace.of("plan_hurried")
+    assert {e["edge"] for e in events} == {"e3"}
+    assert any("e3/bottle_dropped branch" in e["moved"] for e in events)
+    monkeypatch.setattr("agentchord.execution.planning.PlanSchedule.hurried", lambda self, *args: self)
+    waited = _run(disturbance=drop)
+    assert hurried.success and waited.success
+    assert hurried.early_failures[0]["tick"] == waited.early_failures[0]["tick"]
+    assert hurried.early_failures[0]["waited_ticks"] < waited.early_failures[0]["waited_ticks"] - 25
+    assert hurried.plan_wait_s < waited.plan_wait_s

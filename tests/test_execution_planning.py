@@ -94,3 +94,28 @@ def test_ticks_count_from_the_first_motion():
     assert schedule.tick_of(schedule.first_motion_s + 1.0) == 50
     assert schedule.tick_of(schedule.first_motion_s + 0.011) == 1  # armed on the first tick at or after it
     assert schedule.tick_of(0.0) == 0
+
+
+def test_a_failure_before_its_branch_hurries_what_the_branch_still_needs_and_leaves_what_started_before():
+    graph = _graph()
+    schedule = pipelined_schedule(graph, TokenLatencyModel())
+    at = schedule.modes_listed_s["e2"]  # the robot is on e3's way; e3's modes are not even asked yet
+    hurried = schedule.hurried(at, "e3", "bottle_dropped")
+    assert hurried.hurries[-1].edge_id == "e3" and hurried.hurried(at, "e3", "bottle_dropped").hurries[0] == hurried.hurries[-1]
+    # What started before the failure is as it was ...
+    before = {(c.call.part, c.start_s, c.end_s) for c in schedule.calls if c.start_s < at}
+    assert before == {(c.call.part, c.start_s, c.end_s) for c in hurried.calls if c.start_s < at}
+    # ... the hurried branch arrives sooner, and the calls it needs went before every call not hurried that
+    # could have started then.
+    assert hurried.mode_ready_s[("e3", "bottle_dropped")] < schedule.mode_ready_s[("e3", "bottle_dropped")] - 1.0
+    starts = {c.call.part: c.start_s for c in hurried.calls}
+    assert starts["e3 failure modes"] <= starts["e2/cup_shifted entry grounded"] or starts["e3 failure modes"] < starts["e4 failure modes"]
+    assert starts["e3/bottle_dropped branch"] < starts["e3/cup_tipped branch"]
+    # Never more calls in flight than the model serves, hurried or not.
+    assert all(_overlap(hurried.calls, c.start_s) <= 4 for c in hurried.calls)
+
+
+def test_a_schedule_without_its_inputs_is_not_hurried():
+    schedule = pipelined_schedule(_graph(), TokenLatencyModel())
+    bare = type(schedule)(schedule.calls, schedule.first_motion_s, schedule.edge_ready_s, schedule.mode_ready_s)
+    assert bare.hurried(5.0, "e3", "bottle_dropped") is bare

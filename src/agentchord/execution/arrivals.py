@@ -259,17 +259,21 @@ class PlanArrivals:
         derived = detection.failure.intent == DERIVED_INTENT
         listed = self._listed_tick(detection.edge_id) if derived else None
         if listed is not None:
-            until = listed  # which modes the edge has is not known yet
+            self._hurry(detection.edge_id, None)  # which modes the edge has is not known yet
+            until = self._listed_tick(detection.edge_id) or self.world.tick
         elif derived:
             watching = self.as_arranged(detection)
             if watching is not detection:
                 return self._early_failure(watching, suspended, since)
+            if self._pending_modes(detection.edge_id):
+                self._hurry(detection.edge_id, None)
             pending = self._pending_modes(detection.edge_id)
             until = pending[-1] if pending else self.world.tick
         else:
-            until = self._mode_tick(detection.edge_id, detection.failure.name)
-            if until is None:
+            if self._mode_tick(detection.edge_id, detection.failure.name) is None:
                 return False
+            self._hurry(detection.edge_id, detection.failure.name)
+            until = self._mode_tick(detection.edge_id, detection.failure.name) or self.world.tick
         suspended = self.program if suspended is None else suspended
         since = self.world.tick if since is None else since
 
@@ -302,6 +306,20 @@ class PlanArrivals:
         self.program, self.armed = None, None
         self.waiting = Waiting(until, since, detection.edge_id, detection.failure.name, arrived, self.world.tick)
         return True
+
+    def _hurry(self, edge_id: str, failure: str | None) -> None:
+        """Tell the planner what the robot now waits for: the branch of ``failure`` on ``edge_id`` (None: every
+        mode of the edge) goes first from this tick (:meth:`PlanSchedule.hurried`; a modelled schedule only)."""
+        schedule = self.schedule
+        if schedule is None or schedule.inputs is None:
+            return
+        self.schedule = schedule.hurried(schedule.first_motion_s + self.world.tick / CONTROL_HZ, edge_id, failure)
+        if self._early_armed is not None:  # the running edge's modes may come at another tick now
+            listed = self._listed_tick(self._early_armed)
+            self._rearm_tick = self.world.tick if listed is None else listed
+        before = {(c.call.part, c.start_s) for c in schedule.calls}
+        moved = [c.call.part for c in self.schedule.calls if (c.call.part, c.start_s) not in before]
+        self.trace.add(self.world.tick, "plan_hurried", edge=edge_id, failure=failure, moved=moved)
 
     def _recover_after_wait(self, detection: Detection, since: int) -> tuple[bool, str] | None:
         """Recover from a failure that waited for its branch since tick ``since``.

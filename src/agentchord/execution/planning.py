@@ -18,7 +18,12 @@ monitors are armed once the arranger's list of its modes has arrived; a mode can
 once its recovery entry has arrived grounded; an edge further on in a branch, like a nominal one, is
 waited for if the robot reaches it first.
 
-Pure functions of a graph and a latency model: the same graph and model give the same schedule.
+A failure that fires before its branch has arrived **hurries** it: from that moment the calls its
+branch still needs (the edge's list of modes, the branch, the grounding of its entry and of the
+entry's alternatives) go first whenever a slot frees, as a planner told what the robot waits for
+would send them (:meth:`PlanSchedule.hurried`). Calls that started before stay as they were.
+
+Pure functions of a graph, a latency model and the hurries: the same inputs give the same schedule.
 """
 
 from __future__ import annotations
@@ -85,6 +90,8 @@ class PlanSchedule:
             has arrived: the monitors are armed from then on. A recovery edge's come with it.
         owners: Recovery edge or node id -> the (nominal edge, failure mode) whose branch brings it.
         critical: The parts the first motion waited for (the composer's stream, the first edge's grounding).
+        hurries: The failures that hurried their branches, in the order they fired.
+        inputs: The graph and latency model it was made from (None: a schedule that cannot be hurried).
     """
 
     calls: tuple[ScheduledCall, ...]
@@ -94,15 +101,44 @@ class PlanSchedule:
     modes_listed_s: dict[str, float] = field(default_factory=dict)
     owners: dict[str, tuple[str, str]] = field(default_factory=dict)
     critical: tuple[str, ...] = ()
+    hurries: tuple[Hurry, ...] = ()
+    inputs: tuple[TaskGraph, AnyLatencyModel] | None = field(default=None, compare=False, repr=False)
 
     def tick_of(self, seconds: float) -> int:
         """The control tick (counted from the first motion) at which a part arriving at ``seconds`` is armed."""
         return max(0, math.ceil(round((seconds - self.first_motion_s) * CONTROL_HZ, 6)))
 
+    def hurried(self, at_s: float, edge_id: str, failure: str | None) -> PlanSchedule:
+        """The schedule once a failure of ``edge_id`` (``failure``, or None: which mode is not known yet)
+        fired at ``at_s`` before its branch arrived: what that branch still needs goes first from then on.
+
+        What started before ``at_s`` keeps its times; a schedule without inputs stays as it is.
+        """
+        if self.inputs is None:
+            return self
+        graph, latency = self.inputs
+        return pipelined_schedule(graph, latency, (*self.hurries, Hurry(at_s, edge_id, failure)))
+
     def branches_ready_s(self, edge_id: str) -> float:
         """When every failure mode of ``edge_id`` has arrived (its list, if it has none)."""
         modes = [s for (edge, _), s in self.mode_ready_s.items() if edge == edge_id]
         return max([self.modes_listed_s.get(edge_id, 0.0), *modes])
+
+
+@dataclass(frozen=True)
+class Hurry:
+    """A failure that fired before its branch arrived: from ``at_s`` on, its branch's calls go first.
+
+    Attributes:
+        at_s: When it fired (seconds from the start of planning).
+        edge_id: The nominal edge it fired on.
+        failure: Its failure mode; None for a monitor derived from the edge's constraints before the
+            arranger listed the edge's modes (every mode of the edge is hurried then).
+    """
+
+    at_s: float
+    edge_id: str
+    failure: str | None = None
 
 
 @dataclass
@@ -117,9 +153,15 @@ class _Job:
     offset_s: float = 0.0
     start_s: float = 0.0
     end_s: float = 0.0
+    hurried_s: float | None = None  # from then on it goes before every call not hurried (the earliest hurry)
+
+    def rank(self, now: float) -> tuple:
+        if self.hurried_s is not None and self.hurried_s <= now:
+            return (0, self.hurried_s, self.priority)
+        return (1, 0.0, self.priority)
 
 
-def pipelined_schedule(graph: TaskGraph, latency: AnyLatencyModel) -> PlanSchedule:
+def pipelined_schedule(graph: TaskGraph, latency: AnyLatencyModel, hurries: tuple[Hurry, ...] = ()) -> PlanSchedule:
     """The pipelined plan of ``graph``: each call's start and end, and when each part is armed.
 
     Calls, in the order the robot needs them: the nominal edges' groundings first (without them the
@@ -128,7 +170,8 @@ def pipelined_schedule(graph: TaskGraph, latency: AnyLatencyModel) -> PlanSchedu
     (an edge's grounding the edge from the composer's stream; its modes the edge and its nodes; a
     branch also the nominal nodes it leaves from and merges at) and the model has a free slot (``latency.concurrency`` at once; the composer
     holds one while it streams); among the calls ready, the first in need goes first. A flat latency
-    model does not stream: everything arrives with the whole nominal graph.
+    model does not stream: everything arrives with the whole nominal graph. ``hurries``: failures that
+    fired before their branch (:meth:`PlanSchedule.hurried`).
     """
     path = nominal_path(graph)
     composer = composer_call(graph)
@@ -178,6 +221,7 @@ def pipelined_schedule(graph: TaskGraph, latency: AnyLatencyModel) -> PlanSchedu
                 ground_key.update({e.id: f"rest:{mode}" for e in rest})
             ground_key.update({e.id: f"entry:{mode}" for e in first})
             ground_key[f"{edge_id}/{failure.name}"] = f"entry:{mode}"
+    _hurry(jobs, hurries, graph, ground_key)
     done = _serve(jobs, latency, busy_until=[composer_end])
     ends = {job.key: job.end_s for job in done}
     recovery_ready = {item: ends[key] for item, key in ground_key.items() if "/" not in item}
@@ -197,7 +241,27 @@ def pipelined_schedule(graph: TaskGraph, latency: AnyLatencyModel) -> PlanSchedu
     first = edge_ready[path[0]] if path else composer_end
     listed = {edge_id: ends[f"modes:{edge_id}"] for edge_id in path}
     critical = (composer.part, f"{path[0]} grounded") if path else (composer.part,)
-    return PlanSchedule(tuple(calls), first, edge_ready, modes, listed, owners, critical)
+    return PlanSchedule(tuple(calls), first, edge_ready, modes, listed, owners, critical, tuple(hurries), (graph, latency))
+
+
+def _hurry(jobs: list[_Job], hurries: tuple[Hurry, ...], graph: TaskGraph, ground_key: dict[str, str]) -> None:
+    """Mark the calls each hurried branch still needs: the edge's list of modes, the branch, the grounding of
+    its entry and of the entry's alternatives (another mode's branch may bring one), and the calls they read."""
+    by_key = {job.key: job for job in jobs}
+    for hurry in hurries:
+        modes = [hurry.failure] if hurry.failure is not None else [f.name for f in graph.edge(hurry.edge_id).failures]
+        keys = [f"modes:{hurry.edge_id}"]
+        for name in modes:
+            keys.append(f"entry:{hurry.edge_id}/{name}")
+            failure = next((f for f in graph.edge(hurry.edge_id).failures if f.name == name), None)
+            if failure is not None:
+                keys += [ground_key[e] for e in with_alternatives(graph, [failure.recovery]) if e in ground_key]
+        while keys:
+            job = by_key.get(keys.pop())
+            if job is None or (job.hurried_s is not None and job.hurried_s <= hurry.at_s):
+                continue
+            job.hurried_s = hurry.at_s
+            keys += [k for k in (job.after, job.after_start) if k is not None]
 
 
 def _serve(jobs: list[_Job], latency: AnyLatencyModel, busy_until: list[float]) -> list[_Job]:
@@ -216,7 +280,7 @@ def _serve(jobs: list[_Job], latency: AnyLatencyModel, busy_until: list[float]) 
         released = [j for j in pending if j.release_s is not None]
         slot = min(range(len(slots)), key=lambda i: slots[i])
         now = max(slots[slot], min(j.release_s for j in released))
-        job = min((j for j in released if j.release_s <= now), key=lambda j: j.priority)
+        job = min((j for j in released if j.release_s <= now), key=lambda j: j.rank(now))
         job.start_s, job.end_s = now, now + latency.price(job.call)
         slots[slot] = job.end_s
         ended[job.key] = job.end_s
