@@ -14,7 +14,7 @@ LEROBOT ?= lerobot==0.4.4
 # torchcodec (lerobot's video decoder) loads Debian's FFmpeg 5 libraries.
 FFMPEG_LIBS := libavutil57 libavcodec59 libavformat59 libavdevice59 libavfilter8 libswscale6 libswresample4
 
-.PHONY: install install-test system-deps system-deps-learn demo test test-all bench clean
+.PHONY: install install-test system-deps system-deps-learn demo test test-all lint bench clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -59,6 +59,12 @@ demo: install
 
 test: install-test
 	AGENTCHORD_REQUIRE_LEROBOT=1 $(BIN)/pytest $(PYTEST_ARGS)
+
+# Lint: ruff's rules and mypy (both configured in pyproject.toml), and the import contracts.
+lint: install-test
+	$(BIN)/ruff check src tests benchmarks
+	$(BIN)/mypy
+	$(BIN)/lint-imports
 
 test-all: install-test
 	AGENTCHORD_REQUIRE_LEROBOT=1 $(BIN)/pytest -n 2

@@ -14,16 +14,16 @@ import time
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")  # one core, as the target says
 
-import numpy as np  # noqa: E402
-from rich.console import Console  # noqa: E402
-from rich.table import Table  # noqa: E402
+import numpy as np
+from rich.console import Console
+from rich.table import Table
 
-from agentchord.actions.controller import RobotController  # noqa: E402
-from agentchord.execution.episode import EpisodeSpec, run_episode  # noqa: E402
-from agentchord.features.oracle import OracleExtractor  # noqa: E402
-from agentchord.solvers.ik import PoseTarget  # noqa: E402
-from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: E402
-from agentchord.worlds.sim.world import SimWorld  # noqa: E402
+from agentchord.actions.controller import RobotController
+from agentchord.execution.episode import EpisodeSpec, run_episode
+from agentchord.features.oracle import OracleExtractor
+from agentchord.solvers.ik import PoseTarget
+from agentchord.worlds.sim.tasks import SIM_TASKS
+from agentchord.worlds.sim.world import SimWorld
 
 TASK = "single_arm_pour_water"
 

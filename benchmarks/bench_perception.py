@@ -21,16 +21,16 @@ import time
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
-import agentchord  # noqa: E402, F401  (sets MUJOCO_GL before mujoco is imported)
-import mujoco  # noqa: E402
-import numpy as np  # noqa: E402
-from rich.console import Console  # noqa: E402
-from rich.table import Table  # noqa: E402
+import agentchord  # noqa: F401  (sets MUJOCO_GL before mujoco is imported)
+import mujoco
+import numpy as np
+from rich.console import Console
+from rich.table import Table
 
-from agentchord.features.rgbd import PERCEPTION_CAMERAS, RgbdExtractor  # noqa: E402
-from agentchord.features.segmentation import LabelSegmenter, NoisySegmenter  # noqa: E402
-from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: E402
-from agentchord.worlds.sim.world import SimWorld  # noqa: E402
+from agentchord.features.rgbd import PERCEPTION_CAMERAS, RgbdExtractor
+from agentchord.features.segmentation import LabelSegmenter, NoisySegmenter
+from agentchord.worlds.sim.tasks import SIM_TASKS
+from agentchord.worlds.sim.world import SimWorld
 
 TASK = "single_arm_pour_water"
 TARGET_CENTRE_MM = 5.0

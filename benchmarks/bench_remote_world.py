@@ -23,14 +23,14 @@ import time
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
-import numpy as np  # noqa: E402
-from rich.console import Console  # noqa: E402
-from rich.table import Table  # noqa: E402
+import numpy as np
+from rich.console import Console
+from rich.table import Table
 
-from agentchord.execution.episode import EpisodeSpec, run_episode  # noqa: E402
-from agentchord.worlds.protocol import ArmCommand  # noqa: E402
-from agentchord.worlds.remote import RemoteWorld  # noqa: E402
-from agentchord.worlds.sim.trial import open_world  # noqa: E402
+from agentchord.execution.episode import EpisodeSpec, run_episode
+from agentchord.worlds.protocol import ArmCommand
+from agentchord.worlds.remote import RemoteWorld
+from agentchord.worlds.sim.trial import open_world
 
 
 def start_server(task: str) -> tuple[subprocess.Popen, str]:

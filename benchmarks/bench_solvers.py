@@ -20,16 +20,16 @@ import os
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
-import numpy as np  # noqa: E402
-from rich.console import Console  # noqa: E402
-from rich.table import Table  # noqa: E402
+import numpy as np
+from rich.console import Console
+from rich.table import Table
 
-from agentchord.features.frame import FeatureFrame, make_static_frame  # noqa: E402
-from agentchord.solvers.constraints import expression_costs  # noqa: E402
-from agentchord.solvers.obstacles import held_spheres, scene_spheres  # noqa: E402
-from agentchord.solvers.path import RecedingHorizonPathSolver, plan_path  # noqa: E402
-from agentchord.solvers.subgoal import SubgoalSolver  # noqa: E402
-from agentchord.solvers.subgoal_problem import SubgoalProblem, SubgoalSolution  # noqa: E402
+from agentchord.features.frame import FeatureFrame, make_static_frame
+from agentchord.solvers.constraints import expression_costs
+from agentchord.solvers.obstacles import held_spheres, scene_spheres
+from agentchord.solvers.path import RecedingHorizonPathSolver, plan_path
+from agentchord.solvers.subgoal import SubgoalSolver
+from agentchord.solvers.subgoal_problem import SubgoalProblem, SubgoalSolution
 
 #: Targets (ms) per row kind.
 TARGET_MS = {"cold": 1000.0, "warm": 50.0, "path": 50.0}

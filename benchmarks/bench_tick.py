@@ -22,20 +22,20 @@ from contextlib import contextmanager
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")  # one core, as the episode benchmark's target says
 
-import mujoco  # noqa: E402
-import numpy as np  # noqa: E402
-from rich.console import Console  # noqa: E402
-from rich.table import Table  # noqa: E402
+import mujoco
+import numpy as np
+from rich.console import Console
+from rich.table import Table
 
-from agentchord.actions.controller import RobotController  # noqa: E402
-from agentchord.execution.edge_program import EdgeProgram  # noqa: E402
-from agentchord.execution.episode import EpisodeSpec, run_episode  # noqa: E402
-from agentchord.execution.executor import Executor  # noqa: E402
-from agentchord.features.oracle import OracleExtractor  # noqa: E402
-from agentchord.monitor import EdgeMonitors  # noqa: E402
-from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: E402
-from agentchord.worlds.sim.trial import open_world, scene_rng  # noqa: E402
-from agentchord.worlds.sim.world import SimWorld  # noqa: E402
+from agentchord.actions.controller import RobotController
+from agentchord.execution.edge_program import EdgeProgram
+from agentchord.execution.episode import EpisodeSpec, run_episode
+from agentchord.execution.executor import Executor
+from agentchord.features.oracle import OracleExtractor
+from agentchord.monitor import EdgeMonitors
+from agentchord.worlds.sim.tasks import SIM_TASKS
+from agentchord.worlds.sim.trial import open_world, scene_rng
+from agentchord.worlds.sim.world import SimWorld
 
 TASKS = "single_arm_pour_water,fold_towel"
 #: The tick's timed parts: (name, class, method). ``RobotController.step`` times the IK and the

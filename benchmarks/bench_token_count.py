@@ -48,7 +48,7 @@ def replies(task: str) -> dict[str, str]:
 def main() -> int:
     console = Console()
     try:
-        import bpe_openai  # noqa: PLC0415
+        import bpe_openai
     except ImportError:
         console.print("bpe-openai is not installed: pip install bpe-openai (o200k_base is in its wheel) to compare.")
         return 0

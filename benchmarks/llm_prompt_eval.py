@@ -61,8 +61,8 @@ def plan_case(name: str, record: bool = False) -> tuple[TaskGraph, list]:
 
 def run_episodes(task: str, graph: TaskGraph, seeds: list[int], protocol: str | None) -> list[dict]:
     """One episode per seed of ``graph`` on ``task``; each summary with its seed."""
-    from agentchord.execution.episode import EpisodeSpec, run_episode  # noqa: PLC0415
-    from agentchord.worlds.sim.disturbances import PRESETS  # noqa: PLC0415
+    from agentchord.execution.episode import EpisodeSpec, run_episode
+    from agentchord.worlds.sim.disturbances import PRESETS
 
     out = []
     for seed in seeds:

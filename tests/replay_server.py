@@ -148,10 +148,10 @@ class ReplayServer:
         server = self
 
         class Handler(BaseHTTPRequestHandler):
-            def log_message(self, format: str, *args: Any) -> None:  # noqa: A002 - stdlib signature
+            def log_message(self, format: str, *args: Any) -> None:  # stdlib signature
                 pass  # keep test output clean
 
-            def do_POST(self) -> None:  # noqa: N802 - stdlib name
+            def do_POST(self) -> None:  # stdlib name
                 length = int(self.headers.get("content-length", 0))
                 raw = self.rfile.read(length)
                 try:

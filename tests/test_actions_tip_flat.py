@@ -91,7 +91,7 @@ def test_no_push_when_blocked_both_ways_or_the_tool_is_not_top_down():
 
 def _run(robot, extractor, action, max_ticks=2500):
     action.initialise(robot)
-    for tick in range(max_ticks):
+    for _ in range(max_ticks):
         status = action.update(robot)
         if status != Status.RUNNING:
             return status

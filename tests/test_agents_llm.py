@@ -451,8 +451,8 @@ def test_wrong_request_type_is_refused(server, nominal, scene):
 
 def test_other_client_errors_become_transport_errors(nominal, scene):
     class Broken:
-        class chat:  # noqa: N801 - mimics the client's attribute path
-            class completions:  # noqa: N801
+        class chat:  # mimics the client's attribute path
+            class completions:
                 @staticmethod
                 def create(**kwargs):
                     raise openai.OpenAIError("unreadable response")

@@ -170,10 +170,10 @@ SHORT: dict[str, str] = {}  # case -> why its graph is known to fall short (an x
 @pytest.mark.slow
 @pytest.mark.parametrize("case", [pytest.param(c, marks=pytest.mark.xfail(reason=SHORT[c], strict=False)) if c in SHORT else c for c in CASES])
 def test_planned_graph_succeeds_undisturbed(case):
-    import sys  # noqa: PLC0415
+    import sys
 
     sys.path.insert(0, str(Path(__file__).parents[1] / "benchmarks"))
-    from llm_prompt_eval import plan_case, run_episodes  # noqa: PLC0415
+    from llm_prompt_eval import plan_case, run_episodes
 
     graph, _ = plan_case(case)
     rows = run_episodes(FixtureBook.load(CASES_DIR / case).case.task, graph, [0, 1, 2], None)

@@ -42,7 +42,8 @@ def test_each_paper_instruction_plans_a_valid_nominal_graph(task):
 
 def test_single_arm_pour_is_grasp_approach_tilt_untilt_place_home():
     graph = RulesReasoner().compose(ComposeRequest(instruction=load_task_graph("single_arm_pour_water").instruction, scene=scene_of("single_arm_pour_water")))
-    assert fns(graph) == [[("right", "grasp")], [("right", "move_to_obj")], [("right", "rotate_eef")], [("right", "rotate_eef")], [("right", "place")], [("right", "back")]]
+    assert fns(graph) == [[("right", "grasp")], [("right", "move_to_obj")], [("right", "rotate_eef")], [("right", "rotate_eef")],
+                          [("right", "place")], [("right", "back")]]
     v3 = graph.node("v3").constraints
     assert "70 - tilt(bottle)" in v3 and "0.5 - holding(right, bottle)" in v3
 

@@ -115,14 +115,14 @@ def test_the_issue_instructions_plan_end_to_end(task, instruction):
 @pytest.mark.slow
 @pytest.mark.parametrize(("task", "instruction"), ISSUE, ids=[f"{t}: {i[:40]}" for t, i in ISSUE])
 def test_a_sample_succeeds_when_run(task, instruction):
-    from agentchord.execution.episode import EpisodeSpec, run_episode  # noqa: PLC0415
+    from agentchord.execution.episode import EpisodeSpec, run_episode
 
     result = run_episode(EpisodeSpec(task=task, p=0.0, seed=0, instruction=instruction))
     assert result.success, result.reason
 
 
 def test_explain_prints_clauses_goals_skills_and_graph():
-    from agentchord.agents.rules.explain import explain_plan  # noqa: PLC0415
+    from agentchord.agents.rules.explain import explain_plan
 
     text = explain_plan(ISSUE[2][1], scene("handover_block"))
     assert "clauses -> goal predicates:" in text

@@ -66,7 +66,7 @@ def test_the_commands_refuse_two_outputs_on_one_path(tmp_path, args):
 
 
 def test_run_refuses_to_write_over_its_graph(tmp_path):
-    from agentchord.tasks import library_path  # noqa: PLC0415
+    from agentchord.tasks import library_path
 
     graph = tmp_path / "g.yaml"
     graph.write_text(library_path(POUR).read_text())
@@ -89,7 +89,7 @@ def test_a_terminated_command_exits_143_with_one_line():
     def stub() -> None:
         raise Terminated
 
-    from agentchord.cli.support import GuardedGroup  # noqa: PLC0415
+    from agentchord.cli.support import GuardedGroup
 
     group = GuardedGroup(commands={"stub": stub})
     result = CliRunner().invoke(group, ["stub"])

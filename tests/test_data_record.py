@@ -11,8 +11,8 @@ import pytest
 pa = pytest.importorskip("pyarrow")
 pq = pytest.importorskip("pyarrow.parquet")
 
-from agentchord.data.record import record  # noqa: E402
-from agentchord.tasks import load_task_graph  # noqa: E402
+from agentchord.data.record import record
+from agentchord.tasks import load_task_graph
 
 TASK = "single_arm_pour_water"
 

@@ -10,8 +10,8 @@ from click.testing import CliRunner
 pytest.importorskip("rerun")
 pytest.importorskip("rerun.chunk", reason="reading .rrd files back needs rerun-sdk's RrdReader (0.41+)")
 
-from agentchord.cli import main  # noqa: E402
-from agentchord.data.rerun_log import read_recording  # noqa: E402
+from agentchord.cli import main
+from agentchord.data.rerun_log import read_recording
 
 
 @pytest.fixture(scope="module")

@@ -378,7 +378,7 @@ def test_one_failing_output_does_not_lose_the_others(tmp_path):
         raise OutputPathError("t.jsonl", "No space left on device")
 
     with pytest.raises(BadInput, match="cannot write trace t.jsonl"):
-        _write_outputs(Console(file=open(os.devnull, "w")), [  # noqa: SIM115
+        _write_outputs(Console(file=open(os.devnull, "w")), [
             ("trace", "t.jsonl", fail),
             ("summary", str(good), lambda: atomic_write_text(good, "{}")),
         ])

@@ -209,7 +209,7 @@ class CorruptingServer(WorldServer):
 
 
 def _serve(server):
-    import threading  # noqa: PLC0415
+    import threading
 
     stop, bound, endpoint = threading.Event(), threading.Event(), []
 
@@ -293,7 +293,7 @@ def test_a_reply_that_is_not_the_protocol_is_a_remote_world_error():
     socket = context.socket(zmq.REP)
     socket.setsockopt(zmq.LINGER, 0)
     port = socket.bind_to_random_port("tcp://127.0.0.1")
-    import threading  # noqa: PLC0415
+    import threading
 
     def answer():
         if socket.poll(10000):
@@ -365,7 +365,7 @@ def test_a_second_client_is_refused_and_the_first_episode_equals_the_local_one()
 
 
 def test_the_reply_timeout_is_configurable_and_checked(monkeypatch):
-    from agentchord.worlds.remote import ENV_TIMEOUT, RemoteWorldSettingError, timeout_from_env  # noqa: PLC0415
+    from agentchord.worlds.remote import ENV_TIMEOUT, RemoteWorldSettingError, timeout_from_env
 
     assert timeout_from_env({}) == 120.0
     assert timeout_from_env({ENV_TIMEOUT: "2.5"}) == 2.5
@@ -389,7 +389,7 @@ def test_the_reply_timeout_is_configurable_and_checked(monkeypatch):
     ("tcp://no-such-host.invalid:5555", "cannot resolve 'no-such-host.invalid'"),
 ])
 def test_an_address_the_client_cannot_use_is_refused_at_once(address, message):
-    import time  # noqa: PLC0415
+    import time
 
     start = time.monotonic()
     result = CliRunner().invoke(main, ["run", TASK, "--world", address])

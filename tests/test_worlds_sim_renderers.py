@@ -34,9 +34,9 @@ def test_rendering_then_importing_triton_does_not_crash():
 
 
 def test_open_renderer_renders_the_model():
-    import mujoco  # noqa: PLC0415
+    import mujoco
 
-    from agentchord.worlds.sim.renderers import open_renderer  # noqa: PLC0415
+    from agentchord.worlds.sim.renderers import open_renderer
 
     model = mujoco.MjModel.from_xml_string("<mujoco><worldbody><geom size='0.1'/></worldbody></mujoco>")
     renderer = open_renderer(model, 24, 40)

@@ -177,7 +177,7 @@ def test_release_after_must_be_positive():
 
 
 def test_a_served_ipv6_world_is_reachable_in_brackets():
-    from agentchord.worlds.remote import RemoteWorld  # noqa: PLC0415
+    from agentchord.worlds.remote import RemoteWorld
 
     try:
         address, stop, thread = serve_in_thread(TASK, host="::1")

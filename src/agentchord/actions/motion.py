@@ -193,7 +193,7 @@ def move_along_solved_path(
     turns toward the goal's in step with the distance covered. The last centimetres are a
     straight move, so the pose at the end is exactly ``goal``.
     """
-    from agentchord.solvers.path import RecedingHorizonPathSolver  # noqa: PLC0415  (scipy only when used)
+    from agentchord.solvers.path import RecedingHorizonPathSolver  # scipy only when used
 
     start = robot.commanded_pose(arm)
     goal_pos = clip_to_workspace(goal.pos)

@@ -33,11 +33,11 @@ def make_reasoner(kind: str = "rules", *, goal: GoalSpec | None = None, watch_vi
         ReasonerConfigError: Unknown kind, or the LLM is not configured.
     """
     if kind == "rules":
-        from agentchord.agents.rules import RulesReasoner  # noqa: PLC0415
+        from agentchord.agents.rules import RulesReasoner
 
         return RulesReasoner(goal, watch_visibility=watch_visibility)
     if kind == "llm":
-        from agentchord.agents.llm import LlmConfig, LlmReasoner  # noqa: PLC0415
+        from agentchord.agents.llm import LlmConfig, LlmReasoner
 
         return LlmReasoner(LlmConfig.from_env(**{k: v for k, v in llm_options.items() if v is not None}))
     raise ReasonerConfigError(f"unknown reasoner {kind!r} (choose from: {', '.join(REASONERS)})")
@@ -186,7 +186,7 @@ class Replanner:
 
     def remaining(self, achieved: set[int]) -> GoalSpec | None:
         """The goal spec left once the goals at indices ``achieved`` happened (None: nothing left)."""
-        from agentchord.agents.rules.goals import Placed  # noqa: PLC0415
+        from agentchord.agents.rules.goals import Placed
 
         seen = {o.name: o for o in self.first.objects}
         goals = []
@@ -220,7 +220,7 @@ class Replanner:
             arm.model_copy(update={"home": arm.name not in homes or _distance(arm.ee, homes[arm.name]) < HOME_TOLERANCE})
             for arm in scene.arms]})
         if self.reasoner_kind == "rules":
-            from agentchord.agents.rules import facts  # noqa: PLC0415
+            from agentchord.agents.rules import facts
 
             state = facts.initial_state(scene, remaining)
             if facts.goal_facts(remaining, scene)[-1] <= state:

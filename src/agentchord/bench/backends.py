@@ -40,7 +40,7 @@ def run_ray(keys: list[EpisodeKey], config: SweepConfig, address: str | None = N
         BackendError: Ray is not installed, or the cluster cannot be joined.
     """
     try:
-        import ray  # noqa: PLC0415
+        import ray
     except ImportError:
         raise BackendError("--backend ray needs Ray: pip install 'agentchord[ray]'") from None
     started_here = not ray.is_initialized()

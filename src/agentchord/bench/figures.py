@@ -11,10 +11,10 @@ from agentchord.execution.methods import METHODS, SHORT
 
 
 def _pyplot():
-    import matplotlib  # noqa: PLC0415
+    import matplotlib
 
     matplotlib.use("Agg")  # headless: no display here or on a cluster node
-    import matplotlib.pyplot as plt  # noqa: PLC0415
+    import matplotlib.pyplot as plt
 
     return plt
 

@@ -113,9 +113,9 @@ def sweep_keys(tasks: list[str], methods: list[str], conditions: list[Condition]
 
 def episode_spec(key: EpisodeKey, config: SweepConfig) -> EpisodeSpec:
     """The episode a key names, under the sweep's config."""
-    from agentchord.worlds.sim.disturbances import PRESETS  # noqa: PLC0415
+    from agentchord.worlds.sim.disturbances import PRESETS
 
-    from agentchord.tasks import load_task_graph  # noqa: PLC0415
+    from agentchord.tasks import load_task_graph
 
     condition = key.condition
     disturb = PRESETS[condition.protocol] if condition.protocol else ("drop",)
@@ -152,7 +152,7 @@ def run_record(key: EpisodeKey, config: SweepConfig) -> dict:
     started = time.perf_counter()
     try:
         result = run_episode(episode_spec(key, config))
-    except Exception as error:  # noqa: BLE001  (recorded with its traceback; the sweep goes on)
+    except Exception as error:  # recorded with its traceback; the sweep goes on
         return error_record(key, error, time.perf_counter() - started)
     summary = result.summary()
     injected = sum(counts[0] for counts in summary["disturbances"].values())

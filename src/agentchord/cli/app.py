@@ -48,8 +48,8 @@ main.add_command(demo)
 @main.command()
 def tasks() -> None:
     """List the simulated tasks, with a one-line description each."""
-    from agentchord.tasks import library_tasks  # noqa: PLC0415
-    from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: PLC0415
+    from agentchord.tasks import library_tasks
+    from agentchord.worlds.sim.tasks import SIM_TASKS
 
     graphs = set(library_tasks())
     width = max(len(name) for name in SIM_TASKS)
@@ -78,9 +78,9 @@ def serve(task, port, host, seed, release_after) -> None:
     first closes it or sends nothing for --release-after seconds.
     """
     check_task_name(task, "--task")
-    import zmq  # noqa: PLC0415
+    import zmq
 
-    from agentchord.worlds.sim.serve import WorldServer, bind_host  # noqa: PLC0415
+    from agentchord.worlds.sim.serve import WorldServer, bind_host
 
     def ready(endpoint: str) -> None:
         click.echo(f"serving {task} on {endpoint} (Ctrl-C to stop; a trial idle for {release_after:g} s is released)")
@@ -112,13 +112,13 @@ def plan(instruction, task, seed, goal_path, reasoner, perception, output, rende
 
     Exit status 0 when a valid graph was written, 2 when the instruction cannot be planned.
     """
-    from agentchord.agents.exceptions import ReasonerError  # noqa: PLC0415
-    from agentchord.agents.observe import observe, task_regions  # noqa: PLC0415
-    from agentchord.agents.pipeline import make_reasoner, plan_task  # noqa: PLC0415
-    from agentchord.execution.trace import Trace  # noqa: PLC0415
-    from agentchord.graph.loader import dump_graph  # noqa: PLC0415
-    from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: PLC0415
-    from agentchord.worlds.sim.trial import open_world  # noqa: PLC0415
+    from agentchord.agents.exceptions import ReasonerError
+    from agentchord.agents.observe import observe, task_regions
+    from agentchord.agents.pipeline import make_reasoner, plan_task
+    from agentchord.execution.trace import Trace
+    from agentchord.graph.loader import dump_graph
+    from agentchord.worlds.sim.tasks import SIM_TASKS
+    from agentchord.worlds.sim.trial import open_world
 
     check_task_name(task, "--task")
     _check_plan_outputs(output, render_path, trace_path, goal_path)
@@ -129,7 +129,7 @@ def plan(instruction, task, seed, goal_path, reasoner, perception, output, rende
     world = open_world(task, seed)
     scene = observe(world, task_regions(sim_task), perception)
     if explain:
-        from agentchord.agents.rules.explain import explain_plan  # noqa: PLC0415
+        from agentchord.agents.rules.explain import explain_plan
 
         click.echo(explain_plan(instruction or "", scene, goal))
     try:
@@ -151,7 +151,7 @@ def plan(instruction, task, seed, goal_path, reasoner, perception, output, rende
         console.print(f"  success: judged by this graph's own goal ({graph.goal}), not the {task} task's check")
     console.print(f"graph: {output}")
     if render_path:
-        from agentchord.graph.render import render  # noqa: PLC0415
+        from agentchord.graph.render import render
 
         console.print(f"figure: {render(graph, render_path)}")
     if trace_path:
@@ -168,9 +168,9 @@ def _with_success(graph, task: str, goal, scene):
     own outcome keeps the task's check; another one (the bottle handed over in the pour scene) is
     judged by its goal spec and the goal node's constraints.
     """
-    from agentchord.execution.episode import planned_goal_tracker  # noqa: PLC0415
-    from agentchord.graph.models import Success  # noqa: PLC0415
-    from agentchord.worlds.sim.tasks import GoalTracker  # noqa: PLC0415
+    from agentchord.execution.episode import planned_goal_tracker
+    from agentchord.graph.models import Success
+    from agentchord.worlds.sim.tasks import GoalTracker
 
     own_goal = isinstance(planned_goal_tracker(task, goal, graph, scene), GoalTracker)
     spec = goal.model_dump(mode="json") if goal is not None and own_goal else None
@@ -178,8 +178,8 @@ def _with_success(graph, task: str, goal, scene):
 
 
 def _check_plan_outputs(output, render_path, trace_path, goal_path=None) -> None:
-    from agentchord.graph.loader import JSON_SUFFIXES, YAML_SUFFIXES  # noqa: PLC0415
-    from agentchord.graph.render import FORMATS  # noqa: PLC0415
+    from agentchord.graph.loader import JSON_SUFFIXES, YAML_SUFFIXES
+    from agentchord.graph.render import FORMATS
 
     check_outputs(("-o", output, YAML_SUFFIXES + JSON_SUFFIXES), ("--render", render_path, FORMATS), ("--trace", trace_path, ()),
                   inputs=(("--goal", goal_path),))

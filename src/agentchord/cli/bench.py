@@ -48,7 +48,7 @@ def _probabilities(ctx, param, value: str | None) -> list[float] | None:
 
 
 def _latency(ctx, param, value: str | None):
-    from agentchord.execution.reasoning import parse_latency  # noqa: PLC0415
+    from agentchord.execution.reasoning import parse_latency
 
     try:
         return parse_latency(value or "tokens")
@@ -59,20 +59,25 @@ def _latency(ctx, param, value: str | None):
 @click.command("bench")
 @click.option("--tasks", default=TABLE_I_TASKS, show_default=True,
               help="Comma-separated tasks (`agentchord tasks`), or paper (the paper's six), or all.")
-@click.option("--methods", default=None, help="Comma-separated methods (default: all seven, in the paper's order, AgentChord with its sequential plan beside it).")
+@click.option("--methods", default=None, help="Comma-separated methods (default: all seven, in the paper's order, "
+              "AgentChord with its sequential plan beside it).")
 @click.option("--p", "ps", callback=_probabilities, help="Drop probabilities, comma-separated (Table I: 0.05,0.10; Fig. 4: 0,0.05,0.1,0.2,0.3).")
 @click.option("--protocol", type=click.Choice(("real", "stress")), default=None, help="A disturbance protocol instead of --p (Table II: real).")
 @click.option("--trials", type=click.IntRange(1, 10000), default=20, show_default=True, help="Seeds per task, method and condition.")
 @click.option("--seed", "first_seed", type=click.IntRange(0, 2**31), default=0, show_default=True, help="Seeds run from here.")
-@click.option("--out", "out_dir", required=True, type=click.Path(file_okay=False), help="Sweep directory: records.jsonl, tables/, figures/. Rerun with the same --out to resume.")
-@click.option("--backend", type=click.Choice(("local", "ray")), default="local", show_default=True, help="local: a process pool over all cores; ray: episodes as Ray tasks.")
+@click.option("--out", "out_dir", required=True, type=click.Path(file_okay=False), help="Sweep directory: records.jsonl, tables/, figures/. "
+              "Rerun with the same --out to resume.")
+@click.option("--backend", type=click.Choice(("local", "ray")), default="local", show_default=True,
+              help="local: a process pool over all cores; ray: episodes as Ray tasks.")
 @click.option("--ray-address", default=None, help="Join this Ray cluster (e.g. ray://head:10001 or auto); default: a local Ray instance.")
 @click.option("--workers", type=click.IntRange(1, 256), default=None, help="Processes (local) or CPUs (local Ray); default: one per core.")
-@click.option("--latency", callback=_latency, default=None, help="The reasoning latency model: tokens (the default: 0.45 s to first token + output tokens / 120 per s + "
+@click.option("--latency", callback=_latency, default=None,
+              help="The reasoning latency model: tokens (the default: 0.45 s to first token + output tokens / 120 per s + "
                    "0.9 s per image, 4 calls at once; set any of ttft=,rate=,image=,concurrency=) or flat seconds per "
                    "call, e.g. plan=7,vqa=1.5,vlm=3.5 (the tables before the token model). Sources in docs/results.md.")
 @click.option("--vqa-miss", type=click.FloatRange(0.0, 1.0), default=0.0, show_default=True, help="Probability a VQA query misses a failure.")
-@click.option("--vqa-false-alarm", type=click.FloatRange(0.0, 1.0), default=0.0, show_default=True, help="Probability a VQA query reports a failure that is not there.")
+@click.option("--vqa-false-alarm", type=click.FloatRange(0.0, 1.0), default=0.0, show_default=True,
+              help="Probability a VQA query reports a failure that is not there.")
 @click.option("--doremi-every", type=click.IntRange(1, 10000), default=75, show_default=True, help="DoReMi's VQA period in control ticks (50 Hz).")
 @click.option("--reasoner", type=click.Choice(("rules", "llm")), default="rules", show_default=True,
               help="rules: the library graphs, planning calls charged the modelled latency; llm: every method plans "
@@ -86,20 +91,21 @@ def bench_command(tasks, methods, ps, protocol, trials, first_seed, out_dir, bac
     Table II: agentchord bench --tasks paper --protocol real --trials 20 --out out/table2
     Fig. 4:   agentchord bench --tasks single_arm_pour_water --p 0,0.05,0.1,0.2,0.3 --out out/stress
     """
-    from agentchord.bench.exceptions import BenchError  # noqa: PLC0415
-    from agentchord.bench.store import RecordStore  # noqa: PLC0415
-    from agentchord.bench.sweep import Condition, SweepConfig, describe, is_error, sweep_keys  # noqa: PLC0415
-    from agentchord.execution.methods import METHODS  # noqa: PLC0415
-    from agentchord.execution.reasoning import ReasoningConfig  # noqa: PLC0415
-    from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: PLC0415
+    from agentchord.bench.exceptions import BenchError
+    from agentchord.bench.store import RecordStore
+    from agentchord.bench.sweep import Condition, SweepConfig, describe, is_error, sweep_keys
+    from agentchord.execution.methods import METHODS
+    from agentchord.execution.reasoning import ReasoningConfig
+    from agentchord.worlds.sim.tasks import SIM_TASKS
 
-    from agentchord.bench.tables import TASK_TITLES  # noqa: PLC0415
+    from agentchord.bench.tables import TASK_TITLES
 
     aliases = {"all": list(SIM_TASKS), "paper": list(TASK_TITLES)}
     task_names = aliases.get(tasks.strip(), None) or _csv_list(tasks)
     unknown = [t for t in task_names if t not in SIM_TASKS]
     if unknown or not task_names:
-        raise click.BadParameter(f"unknown task(s) {', '.join(unknown) or '(none given)'} (tasks: {', '.join(SIM_TASKS)}, or paper, or all)", param_hint="--tasks")
+        raise click.BadParameter(f"unknown task(s) {', '.join(unknown) or '(none given)'} (tasks: {', '.join(SIM_TASKS)}, or paper, or all)",
+                                 param_hint="--tasks")
     method_names = list(METHODS) if methods is None else _csv_list(methods)
     unknown = [m for m in method_names if m not in METHODS]
     if unknown or not method_names:
@@ -110,8 +116,8 @@ def bench_command(tasks, methods, ps, protocol, trials, first_seed, out_dir, bac
         raise click.BadParameter("--ray-address needs --backend ray", param_hint="--ray-address")
     conditions = [Condition(protocol=protocol)] if protocol else [Condition(p=p) for p in (ps or [0.05, 0.10])]
     if reasoner == "llm":
-        from agentchord.agents.exceptions import ReasonerConfigError  # noqa: PLC0415
-        from agentchord.agents.llm import LlmConfig  # noqa: PLC0415
+        from agentchord.agents.exceptions import ReasonerConfigError
+        from agentchord.agents.llm import LlmConfig
 
         try:
             LlmConfig.from_env()  # the settings are checked before any episode runs
@@ -147,9 +153,9 @@ def bench_command(tasks, methods, ps, protocol, trials, first_seed, out_dir, bac
 
 
 def _run(todo, config, store, backend, ray_address, workers, console) -> None:
-    from agentchord.bench.backends import run_local, run_ray  # noqa: PLC0415
-    from agentchord.bench.exceptions import BackendError  # noqa: PLC0415
-    from agentchord.bench.sweep import is_error  # noqa: PLC0415
+    from agentchord.bench.backends import run_local, run_ray
+    from agentchord.bench.exceptions import BackendError
+    from agentchord.bench.sweep import is_error
 
     stream = run_ray(todo, config, ray_address, workers) if backend == "ray" else run_local(todo, config, workers)
     columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
@@ -172,11 +178,11 @@ def write_report(records: list[dict], out: Path, config, console: Console | None
 
     ``left_out`` episodes stopped on an internal error; the caption says so (the cells have fewer seeds).
     """
-    from agentchord.bench.figures import steps_figure, stress_figure  # noqa: PLC0415
-    from agentchord.bench.paired import REFERENCE, paired_csv, paired_markdown  # noqa: PLC0415
-    from agentchord.bench.sweep import describe  # noqa: PLC0415
-    from agentchord.bench.tables import ABLATION_METHODS, summary_csv, table_layout, table_markdown  # noqa: PLC0415
-    from agentchord.guard.outputs import atomic_write_bytes, atomic_write_text  # noqa: PLC0415
+    from agentchord.bench.figures import steps_figure, stress_figure
+    from agentchord.bench.paired import REFERENCE, paired_csv, paired_markdown
+    from agentchord.bench.sweep import describe
+    from agentchord.bench.tables import ABLATION_METHODS, summary_csv, table_layout, table_markdown
+    from agentchord.guard.outputs import atomic_write_bytes, atomic_write_text
 
     written: list[Path] = []
 
@@ -217,7 +223,7 @@ def write_report(records: list[dict], out: Path, config, console: Console | None
         write(out / "tables" / "paired.csv", paired_csv(records))
         if console is not None:
             console.print(paired, markup=False, highlight=False)
-    from agentchord.bench.pipeline import decomposition_markdown, early_failures_markdown  # noqa: PLC0415
+    from agentchord.bench.pipeline import decomposition_markdown, early_failures_markdown
 
     timing = decomposition_markdown(records) + "\n" + early_failures_markdown(records)
     write(out / "tables" / "timing.md", timing)
@@ -225,7 +231,7 @@ def write_report(records: list[dict], out: Path, config, console: Console | None
         console.print(timing, markup=False, highlight=False)
     if config.reasoner == "rules" and len(methods) > 1:
         # Modelled latencies only: a measured LLM call has no price to scale.
-        from agentchord.bench.latency import latency_csv, latency_markdown  # noqa: PLC0415
+        from agentchord.bench.latency import latency_csv, latency_markdown
 
         plan_s = config.reasoning.latency.reference_plan_s
         sensitivity = latency_markdown(records, plan_s, describe(config) + ".")
@@ -243,8 +249,8 @@ def write_report(records: list[dict], out: Path, config, console: Console | None
 
 
 def _csv(rows: list[list[str]]) -> str:
-    import csv  # noqa: PLC0415
-    import io  # noqa: PLC0415
+    import csv
+    import io
 
     buffer = io.StringIO()
     csv.writer(buffer).writerows(rows)

@@ -10,7 +10,7 @@ from agentchord.cli.support import BadInput, FiniteFloatRange, catches_sigterm
 
 
 def _kinds(ctx, param, value: str) -> tuple[str, ...]:
-    from agentchord.worlds.sim.disturbances import parse_kinds  # noqa: PLC0415
+    from agentchord.worlds.sim.disturbances import parse_kinds
 
     try:
         return parse_kinds(value)
@@ -41,7 +41,8 @@ def _size(ctx, param, value: str) -> tuple[int, int]:
 @click.option("--keep-failed", is_flag=True, help="Write failed episodes too.")
 @click.option("--seed", type=click.IntRange(0), default=0, show_default=True, help="First seed; the next episodes take the next seeds.")
 @click.option("--max-tries", type=click.IntRange(1), default=None, help="Seeds to run at most (default 10 x --episodes).")
-@click.option("--camera", "cameras", multiple=True, default=("top", "right_wrist"), show_default=True, help="Scene camera recorded (repeat for more; 'none' for no images).")
+@click.option("--camera", "cameras", multiple=True, default=("top", "right_wrist"), show_default=True,
+              help="Scene camera recorded (repeat for more; 'none' for no images).")
 @click.option("--size", default="320x240", show_default=True, callback=_size, help="Image size WIDTHxHEIGHT.")
 @catches_sigterm
 def record_command(task, episodes, out, p, disturb, protocol, only_recovered, keep_failed, seed, max_tries, cameras, size) -> None:
@@ -54,18 +55,18 @@ def record_command(task, episodes, out, p, disturb, protocol, only_recovered, ke
     command resumes the dataset with the next seed. Exit status 0 when --episodes episodes were
     written, 1 when fewer were.
     """
-    import sys  # noqa: PLC0415
+    import sys
 
-    from agentchord.tasks import library_tasks  # noqa: PLC0415
-    from agentchord.worlds.sim.disturbances import PRESETS  # noqa: PLC0415
-    from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: PLC0415
+    from agentchord.tasks import library_tasks
+    from agentchord.worlds.sim.disturbances import PRESETS
+    from agentchord.worlds.sim.tasks import SIM_TASKS
 
     if task not in SIM_TASKS:
         raise click.BadParameter(f"unknown task {task!r} (tasks: {', '.join(SIM_TASKS)})", param_hint="TASK")
     if task not in library_tasks():
         raise click.BadParameter(f"{task!r} has no library graph to record", param_hint="TASK")
     cameras = () if tuple(cameras) == ("none",) else tuple(cameras)
-    from agentchord.data.record import ResumeError, record_settings, recorded_state  # noqa: PLC0415
+    from agentchord.data.record import ResumeError, record_settings, recorded_state
 
     kinds = PRESETS.get(protocol or "", disturb)
     try:
@@ -73,13 +74,13 @@ def record_command(task, episodes, out, p, disturb, protocol, only_recovered, ke
                                                     cameras, size, "agentchord"))
     except ResumeError as exc:
         raise BadInput(f"--out {out}: {exc}") from None
-    from agentchord.worlds.sim.trial import open_world  # noqa: PLC0415
+    from agentchord.worlds.sim.trial import open_world
 
     known = open_world(task, seed).camera_names
     unknown = [c for c in cameras if c not in known]
     if unknown:
         raise click.BadParameter(f"no camera {unknown[0]!r} in the {task} scene (cameras: {', '.join(known)})", param_hint="--camera")
-    from agentchord.data.record import record  # noqa: PLC0415
+    from agentchord.data.record import record
 
     console = Console()
     if state is not None:

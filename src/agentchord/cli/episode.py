@@ -35,13 +35,13 @@ PROTOCOL_HELP = ("1-2 disturbances at random moments of each trial (ignores --p)
 
 def _protocol_kinds(protocol: str | None, disturb: tuple[str, ...]) -> tuple[str, ...]:
     """The disturbance kinds a protocol preset stands for (``custom`` and no protocol: ``--disturb``)."""
-    from agentchord.worlds.sim.disturbances import PRESETS  # noqa: PLC0415
+    from agentchord.worlds.sim.disturbances import PRESETS
 
     return PRESETS.get(protocol or "", disturb)
 
 
 def _kinds(ctx, param, value: str) -> tuple[str, ...]:
-    from agentchord.worlds.sim.disturbances import parse_kinds  # noqa: PLC0415
+    from agentchord.worlds.sim.disturbances import parse_kinds
 
     try:
         return parse_kinds(value)
@@ -57,7 +57,7 @@ WORLD_HELP = ("Drive the world served at this address (tcp://HOST:PORT or tcp://
 def _world_address(ctx, param, value: str | None) -> str | None:
     if value is None:
         return None
-    from agentchord.worlds.remote import RemoteWorldError, resolve_address, timeout_from_env  # noqa: PLC0415
+    from agentchord.worlds.remote import RemoteWorldError, resolve_address, timeout_from_env
 
     try:
         timeout_from_env()  # a bad $AGENTCHORD_WORLD_TIMEOUT is refused before any work, too
@@ -93,7 +93,7 @@ def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, inst
 
     Exit status 0 when the task succeeded, 1 when it failed, 2 on bad input.
     """
-    from agentchord.execution.episode import EpisodeSpec  # noqa: PLC0415
+    from agentchord.execution.episode import EpisodeSpec
 
     check_task_name(task, "TASK")
     if world is not None and video_path is not None:
@@ -117,7 +117,7 @@ def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, inst
         if video_path is None:
             return
         if "video" not in recorder:
-            from agentchord.worlds.sim.render import VideoRecorder  # noqa: PLC0415
+            from agentchord.worlds.sim.render import VideoRecorder
 
             recorder["video"] = VideoRecorder(executor.world, video_path, camera=camera)
             recorder["seen"] = 0
@@ -163,9 +163,9 @@ def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, inst
 def _load_graph_option(graph_path: str | None):
     if graph_path is None:
         return None
-    from agentchord.graph.exceptions import GraphFileError  # noqa: PLC0415
-    from agentchord.graph.loader import load_graph  # noqa: PLC0415
-    from agentchord.graph.validation import check_graph  # noqa: PLC0415
+    from agentchord.graph.exceptions import GraphFileError
+    from agentchord.graph.loader import load_graph
+    from agentchord.graph.validation import check_graph
 
     try:
         graph = load_graph(graph_path)
@@ -176,9 +176,9 @@ def _load_graph_option(graph_path: str | None):
         lines = "\n".join(f"{graph_path}: {p.path}: {p.message}" for p in problems)
         raise click.UsageError(f"the graph is not valid:\n{lines}")
     if graph.success.goal_spec is not None:
-        from pydantic import ValidationError  # noqa: PLC0415
+        from pydantic import ValidationError
 
-        from agentchord.agents.rules.goals import GoalSpec  # noqa: PLC0415
+        from agentchord.agents.rules.goals import GoalSpec
 
         try:
             GoalSpec.model_validate(graph.success.goal_spec)
@@ -191,10 +191,10 @@ def _load_graph_option(graph_path: str | None):
 
 def _run_or_explain(spec, on_tick=None, trace_path=None, graph_path=None):
     """Run an episode; a reasoner that cannot plan, or a graph that cannot run here, is bad input (exit 2)."""
-    from agentchord.agents.exceptions import ReasonerError  # noqa: PLC0415
-    from agentchord.execution.episode import run_episode  # noqa: PLC0415
-    from agentchord.graph.exceptions import GraphNotRunnableError  # noqa: PLC0415
-    from agentchord.worlds.remote import RemoteWorldError  # noqa: PLC0415
+    from agentchord.agents.exceptions import ReasonerError
+    from agentchord.execution.episode import run_episode
+    from agentchord.graph.exceptions import GraphNotRunnableError
+    from agentchord.worlds.remote import RemoteWorldError
 
     try:
         return run_episode(spec, on_tick=on_tick)
@@ -211,7 +211,7 @@ def _check_camera(task: str, camera: str, video_path) -> None:
     """Refuse an unknown --camera before the episode, not when its first frame is drawn."""
     if video_path is None:
         return
-    from agentchord.worlds.sim.trial import open_world  # noqa: PLC0415
+    from agentchord.worlds.sim.trial import open_world
 
     cameras = open_world(task, 0).camera_names
     if camera not in cameras:
@@ -228,7 +228,7 @@ def open_rerun(path: str | None, task: str):
     if path is None:
         return None
     try:
-        from agentchord.data.rerun_log import RerunLogger  # noqa: PLC0415
+        from agentchord.data.rerun_log import RerunLogger
 
         return RerunLogger(path, task)
     except ImportError as exc:
@@ -241,9 +241,9 @@ def _write_video(video, path) -> Path:
     A symlink is written through to its target (the link kept), as every other output is; a
     device or FIFO (``/dev/null``) gets the bytes written into it.
     """
-    import os  # noqa: PLC0415
-    import shutil  # noqa: PLC0415
-    import tempfile  # noqa: PLC0415
+    import os
+    import shutil
+    import tempfile
 
     given = Path(path)
     special = given.exists() and not given.is_file()
@@ -276,7 +276,7 @@ def _write_outputs(console: Console, outputs) -> None:
             continue
         try:
             console.print(f"{label}: {write()}")
-        except Exception as exc:  # noqa: BLE001 - whatever the writer raised, the other outputs still get written
+        except Exception as exc:  # whatever the writer raised, the other outputs still get written
             failed.append(f"cannot write {label} {path}: {exc}")
     if failed:
         raise BadInput("\n".join(failed))
@@ -325,7 +325,8 @@ def _print_episode(console: Console, result) -> None:
             console.print(f"{tick}  [red]unrecoverable[/red]: {event['obj']}: {event['reason']}")
         elif kind == "repair":
             state = "added" if event["accepted"] else f"rejected ({event.get('reason')})"
-            console.print(f"{tick}  [cyan]online repair[/cyan] after {event['edge']}: {event['observation']} -> {event['failure']} / {event['recovery']} {state}")
+            console.print(f"{tick}  [cyan]online repair[/cyan] after {event['edge']}: {event['observation']} -> "
+                          f"{event['failure']} / {event['recovery']} {state}")
         elif kind == "reasoner_call":
             status = "ok" if event["ok"] else f"failed: {event['error']}"
             console.print(f"{tick}  {event['agent']} ({event['reasoner']}): {status}, {1000 * event['latency_s']:.0f} ms")
@@ -345,7 +346,8 @@ def _print_episode(console: Console, result) -> None:
 @click.command()
 @click.option("--task", default="single_arm_pour_water", show_default=True)
 @click.option("--trials", type=click.IntRange(1, 10000), default=20, show_default=True)
-@click.option("--seed", "first_seed", type=click.IntRange(0, 2**31), default=0, show_default=True, help="Seeds run from here: --seed N --trials T runs seeds N .. N+T-1.")
+@click.option("--seed", "first_seed", type=click.IntRange(0, 2**31), default=0, show_default=True,
+              help="Seeds run from here: --seed N --trials T runs seeds N .. N+T-1.")
 @click.option("--p", "p", type=FiniteFloatRange(0.0, 1.0), default=0.1, show_default=True)
 @click.option("--disturb", default="drop", show_default=True, callback=_kinds, help=DISTURB_HELP)
 @click.option("--protocol", type=click.Choice(PROTOCOL_NAMES), is_flag=False, flag_value="custom", default=None,
@@ -362,10 +364,10 @@ def _print_episode(console: Console, result) -> None:
 def demo(task, trials, first_seed, p, disturb, protocol, perception, strategies, workers, planned, instruction, reasoner, json_path,
          world) -> None:
     """Seeded episodes of each strategy under random drops, then a table per strategy."""
-    from agentchord.bench.report import aggregate, paired_steps, print_tables  # noqa: PLC0415
-    from agentchord.bench.runner import run_many  # noqa: PLC0415
-    from agentchord.execution.episode import EpisodeSpec  # noqa: PLC0415
-    from agentchord.worlds.remote import RemoteWorldError  # noqa: PLC0415
+    from agentchord.bench.report import aggregate, paired_steps, print_tables
+    from agentchord.bench.runner import run_many
+    from agentchord.execution.episode import EpisodeSpec
+    from agentchord.worlds.remote import RemoteWorldError
 
     names = [s.strip() for s in strategies.split(",") if s.strip()]
     unknown = [s for s in names if s not in METHOD_NAMES]
@@ -381,7 +383,7 @@ def demo(task, trials, first_seed, p, disturb, protocol, perception, strategies,
     console.print(f"[bold]{task}[/bold]: {trials} seeded episodes per strategy; disturbances {', '.join(disturb)}, "
                   f"{schedule}; perception {perception}")
     if planned and instruction is None:
-        from agentchord.tasks import load_task_graph  # noqa: PLC0415
+        from agentchord.tasks import load_task_graph
 
         instruction = load_task_graph(task).instruction
     if instruction:
@@ -407,7 +409,8 @@ def demo(task, trials, first_seed, p, disturb, protocol, perception, strategies,
     print_tables(results, console, paired)
     if json_path:
         payload = {"task": task, "p": p, "trials": trials, "first_seed": first_seed, "disturb": list(disturb), "protocol": protocol,
-                   "perception": perception, "instruction": instruction, "reasoner": reasoner if instruction else None, "strategies": results, "paired_steps": paired,
+                   "perception": perception, "instruction": instruction, "reasoner": reasoner if instruction else None,
+                   "strategies": results, "paired_steps": paired,
                    "world": world, "runs": summaries}
         atomic_write_text(json_path, finite_json(payload, indent=2) + "\n")
         console.print(f"aggregates: {json_path}")

@@ -30,7 +30,7 @@ GRAPH_SUFFIXES = YAML_SUFFIXES + JSON_SUFFIXES
 def schema_command(kind: str) -> None:
     """Print the JSON Schema of task-graph files (KIND graph) or of goal specs (KIND goal)."""
     if kind == "goal":
-        from agentchord.agents.rules.goals import GoalSpec  # noqa: PLC0415
+        from agentchord.agents.rules.goals import GoalSpec
 
         click.echo(json.dumps(GoalSpec.model_json_schema(), indent=2))
         return
@@ -81,8 +81,8 @@ def check_command(files: tuple[Path, ...], task: str | None) -> None:
 
 def _scene_objects(task: str) -> list[str]:
     """The names the feature frame of ``task``'s scene holds (objects, cloth points)."""
-    from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: PLC0415
-    from agentchord.worlds.sim.trial import open_world  # noqa: PLC0415
+    from agentchord.worlds.sim.tasks import SIM_TASKS
+    from agentchord.worlds.sim.trial import open_world
 
     if task not in SIM_TASKS:
         raise click.BadParameter(f"unknown task {task!r} (tasks: {', '.join(SIM_TASKS)})", param_hint="--task")
@@ -191,7 +191,7 @@ def import_release_command(
     cannot be mapped is an error naming the file, the JSON path and the problem (exit 2).
     The mapping is documented in ``agentchord.graph.interop``.
     """
-    from agentchord.graph.interop import FrameMap, ReleaseImportError, import_release  # noqa: PLC0415
+    from agentchord.graph.interop import FrameMap, ReleaseImportError, import_release
 
     check_outputs(("-o", output, GRAPH_SUFFIXES), inputs=(("TASK_GRAPH", task_graph), ("RECOVERY_SPEC", recovery_spec)))
     try:
@@ -226,9 +226,9 @@ def import_release_command(
 
 def _warn_sim_objects(graph: TaskGraph) -> None:
     """Say so when the graph names objects that its simulated task's scene lacks."""
-    import numpy as np  # noqa: PLC0415
+    import numpy as np
 
-    from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: PLC0415
+    from agentchord.worlds.sim.tasks import SIM_TASKS
 
     task = SIM_TASKS.get(graph.task)
     if task is None:

@@ -78,8 +78,8 @@ class InternalError(click.ClickException):
 
 def _bad_input_types() -> tuple[type[BaseException], ...]:
     # Imported late: the handler must not make every command import the agents.
-    from agentchord.agents.exceptions import ReasonerError  # noqa: PLC0415
-    from agentchord.graph.exceptions import GraphFileError, GraphNotRunnableError, RenderError  # noqa: PLC0415
+    from agentchord.agents.exceptions import ReasonerError
+    from agentchord.graph.exceptions import GraphFileError, GraphNotRunnableError, RenderError
 
     return (InputError, GraphFileError, GraphNotRunnableError, RenderError, ReasonerError)
 
@@ -168,7 +168,7 @@ def write_error_log(error: BaseException) -> Path | None:
     Returns:
         The log file, or ``None`` when neither the log folder nor the temporary folder takes it.
     """
-    from agentchord import __version__  # noqa: PLC0415
+    from agentchord import __version__
 
     stamp = datetime.datetime.now().strftime("%Y%m%d-%H%M%S")
     text = (
@@ -267,7 +267,7 @@ PERCEPTION_NAMES = ("oracle", "rgbd")
 
 def check_task_name(task: str, param_hint: str) -> None:
     """Refuse a task that is not simulated, naming the ones that are (a usage error on ``param_hint``)."""
-    from agentchord.worlds.sim.tasks import SIM_TASKS  # noqa: PLC0415
+    from agentchord.worlds.sim.tasks import SIM_TASKS
 
     if task not in SIM_TASKS:
         raise click.BadParameter(f"unknown task {task!r} (tasks: {', '.join(SIM_TASKS)})", param_hint=param_hint)
@@ -277,9 +277,9 @@ def load_goal_option(goal_path: str | None):
     """The goal spec of ``--goal`` (None without the option); an unreadable or invalid file is a usage error."""
     if goal_path is None:
         return None
-    from agentchord.agents.rules.goals import GoalSpec  # noqa: PLC0415
-    from agentchord.graph.exceptions import GraphFileError  # noqa: PLC0415
-    from agentchord.graph.loader import load_model  # noqa: PLC0415
+    from agentchord.agents.rules.goals import GoalSpec
+    from agentchord.graph.exceptions import GraphFileError
+    from agentchord.graph.loader import load_model
 
     try:
         return load_model(goal_path, GoalSpec)
@@ -289,7 +289,7 @@ def load_goal_option(goal_path: str | None):
 
 def failed_calls_trace(error, trace_path) -> str:
     """Write the agents' calls of a failed plan (the replies that were refused) to the trace; say where."""
-    from agentchord.execution.trace import Trace  # noqa: PLC0415
+    from agentchord.execution.trace import Trace
 
     calls = list(getattr(error, "calls", None) or ([error.call] if getattr(error, "call", None) else []))
     if not trace_path or not calls:

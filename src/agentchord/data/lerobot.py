@@ -83,7 +83,7 @@ class DatasetWriter:
             ValueError: The dataset's features or fps differ, or it holds fewer episodes.
             OSError: A file cannot be read.
         """
-        import pyarrow.parquet as pq  # noqa: PLC0415
+        import pyarrow.parquet as pq
 
         writer = cls(root, fps, features, robot_type, exist_ok=True)
         shutil.rmtree(writer.root / "tmp", ignore_errors=True)
@@ -132,7 +132,7 @@ class DatasetWriter:
 
     def add_frame(self, frame: dict) -> None:
         """One frame: a value per user feature (images as (H, W, 3) uint8)."""
-        import imageio.v2 as imageio  # noqa: PLC0415
+        import imageio.v2 as imageio
 
         for key in self._data_keys():
             self._buffer[key].append(frame[key])
@@ -224,8 +224,8 @@ class DatasetWriter:
 
         Each file is written to a temporary file and renamed over the old one, ``info.json`` last.
         """
-        import pyarrow as pa  # noqa: PLC0415
-        import pyarrow.parquet as pq  # noqa: PLC0415
+        import pyarrow as pa
+        import pyarrow.parquet as pq
 
         (self.root / "meta").mkdir(exist_ok=True)
         features = {**self.features, **DEFAULT_FEATURES}
@@ -263,8 +263,8 @@ class DatasetWriter:
 
     def _write_tasks(self) -> None:
         """``meta/tasks.parquet``: the task texts as the (pandas) index, their ``task_index`` column."""
-        import pyarrow as pa  # noqa: PLC0415
-        import pyarrow.parquet as pq  # noqa: PLC0415
+        import pyarrow as pa
+        import pyarrow.parquet as pq
 
         tasks = sorted(self.tasks, key=self.tasks.get)
         table = pa.table({"task_index": pa.array([self.tasks[t] for t in tasks], pa.int64()),
@@ -282,7 +282,7 @@ class DatasetWriter:
 
 
 def _arrow_column(values: list, feature: dict):
-    import pyarrow as pa  # noqa: PLC0415
+    import pyarrow as pa
 
     dtype, shape = feature["dtype"], list(feature["shape"])
     if dtype == "string":

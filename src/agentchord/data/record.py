@@ -218,7 +218,7 @@ def record(task: str, episodes: int, out: str | Path, *, p: float = 0.0, disturb
     nodes = [n.id for n in graph.nodes]
     edges = [e.id for e in graph.edges]
     instruction = graph.instruction or task.replace("_", " ")
-    from agentchord.worlds.sim.trial import open_world  # noqa: PLC0415  (the scene's object names)
+    from agentchord.worlds.sim.trial import open_world  # the scene's object names
 
     settings = record_settings(task, p, disturb, protocol, only_recovered, keep_failed, seed, cameras, image_size, strategy)
     state = recorded_state(out, settings)

@@ -67,7 +67,7 @@ class RerunLogger:
 
     def __init__(self, path: str | Path, task: str, cameras: tuple[str, ...] = ("top",), image_every: int = 5,
                  image_size: tuple[int, int] = (240, 320)) -> None:
-        import rerun as rr  # noqa: PLC0415
+        import rerun as rr
 
         self.rr = rr
         self.path = Path(path)
@@ -214,7 +214,7 @@ def _rgba(shape: Shape) -> tuple[int, int, int, int]:
 
 def _log_shapes(rr, rec, path: str, shapes: list[Shape], label: str) -> None:
     """A marker's shapes as Rerun's ellipsoids, capsules (along +z, turned onto each segment) and arrows."""
-    from scipy.spatial.transform import Rotation  # noqa: PLC0415
+    from scipy.spatial.transform import Rotation
 
     ellipsoids = [s for s in shapes if s.kind == "ellipsoid"]
     capsules = [s for s in shapes if s.kind == "capsule"]
@@ -236,7 +236,7 @@ def _log_shapes(rr, rec, path: str, shapes: list[Shape], label: str) -> None:
 
 def read_recording(path: str | Path) -> dict[str, list]:
     """The entity paths of a ``.rrd`` file with their chunks' record batches (rerun's own reader)."""
-    from rerun.chunk import RrdReader  # noqa: PLC0415
+    from rerun.chunk import RrdReader
 
     out: dict[str, list] = {}
     for chunk in RrdReader(path).stream().to_chunks():

@@ -210,8 +210,8 @@ def planned_goal_tracker(task_name: str, goal: GoalSpec | None, graph: TaskGraph
 
 def _own_goal_outcome(task_name: str, scene: Scene) -> frozenset | None:
     """The outcome of the task library's instruction for ``task_name``, grounded in ``scene``."""
-    from agentchord.agents.exceptions import ReasonerError  # noqa: PLC0415
-    from agentchord.agents.rules.instructions import ground_instruction  # noqa: PLC0415
+    from agentchord.agents.exceptions import ReasonerError
+    from agentchord.agents.rules.instructions import ground_instruction
 
     try:
         return ground_instruction(load_task_graph(task_name).instruction, scene).outcome()
@@ -222,8 +222,8 @@ def _own_goal_outcome(task_name: str, scene: Scene) -> frozenset | None:
 def _baseline_context(spec: EpisodeSpec, task, world: World, graph: TaskGraph, first: Scene | None,
                       goal: GoalSpec | None) -> BaselineContext:
     """A baseline's re-planner (the project's agents, from the current observation) and progress watcher."""
-    from agentchord.agents.exceptions import ReasonerError  # noqa: PLC0415
-    from agentchord.agents.rules.instructions import ground_instruction  # noqa: PLC0415
+    from agentchord.agents.exceptions import ReasonerError
+    from agentchord.agents.rules.instructions import ground_instruction
 
     regions = task_regions(task)
     if first is None:

@@ -18,11 +18,11 @@ def make_extractor(mode: str, world: World, grasp_signal: Callable[[str], bool])
         GroundTruthUnavailableError: ``oracle`` on a world without ground truth.
     """
     if mode == "oracle":
-        from agentchord.features.oracle import OracleExtractor  # noqa: PLC0415
+        from agentchord.features.oracle import OracleExtractor
 
         return OracleExtractor(world, grasp_signal=grasp_signal)
     if mode == "rgbd":
-        from agentchord.features.rgbd import RgbdExtractor  # noqa: PLC0415  (imports the renderer)
+        from agentchord.features.rgbd import RgbdExtractor  # imports the renderer
 
         return RgbdExtractor(world, grasp_signal=grasp_signal)
     raise ValueError(f"unknown perception mode {mode!r} (choose from: {', '.join(PERCEPTION_MODES)})")

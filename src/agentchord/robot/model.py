@@ -31,7 +31,7 @@ def aloha_assets_dir() -> str:
         RobotModelError: gym-aloha is not installed, or its model files are missing.
     """
     try:
-        import gym_aloha  # noqa: PLC0415  (imported for its data files only)
+        import gym_aloha  # imported for its data files only
     except ImportError as exc:  # pragma: no cover - install problem
         raise RobotModelError("gym-aloha is not installed: run `make install` (it ships the ALOHA model)") from exc
     path = os.path.join(os.path.dirname(gym_aloha.__file__), "assets")

@@ -94,8 +94,8 @@ def measure_reach(
         reached, and one row ``(radius, height above the shoulder, residual)`` per sample.
     """
     # Imported here: mink and the robot model are only needed to re-measure.
-    from agentchord.solvers.poses import grasp_frame, pose_from_matrix  # noqa: PLC0415
-    from agentchord.solvers.ik import BimanualIK  # noqa: PLC0415
+    from agentchord.solvers.poses import grasp_frame, pose_from_matrix
+    from agentchord.solvers.ik import BimanualIK
 
     ik = BimanualIK(iterations=1, avoid_arm_collisions=False)
     home = ik.configuration.q.copy()

@@ -398,8 +398,8 @@ class SubgoalSolver:
     def _ik_residuals(self, solution: SubgoalSolution) -> dict[str, float]:
         """Position error of the arms' IK at the solution, side-grasp orientation (tool level)."""
         # Imported here: mink and the robot model are only needed when the check is asked for.
-        from agentchord.solvers.poses import grasp_frame, pose_from_matrix  # noqa: PLC0415
-        from agentchord.solvers.ik import BimanualIK  # noqa: PLC0415
+        from agentchord.solvers.poses import grasp_frame, pose_from_matrix
+        from agentchord.solvers.ik import BimanualIK
 
         if self._ik is None:
             self._ik = BimanualIK(iterations=1, avoid_arm_collisions=False)

@@ -221,6 +221,6 @@ class FixtureClient:
         Raises:
             FixtureError: No valid stored reply (see :meth:`FixtureBook.answer`).
         """
-        from openai.types.chat import ChatCompletion  # noqa: PLC0415 - only a fixture run needs it
+        from openai.types.chat import ChatCompletion  # only a fixture run needs it
 
         return ChatCompletion.model_validate(completion_body(self.book.answer(messages), messages, model))

@@ -181,7 +181,7 @@ class LlmReasoner:
             try:
                 completion = within(
                     limit,
-                    lambda: self._client.chat.completions.create(
+                    lambda limit=limit, mode=mode: self._client.chat.completions.create(
                         model=config.model, messages=messages, timeout=limit, **self._params(mode)
                     ),
                 )

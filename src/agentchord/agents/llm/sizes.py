@@ -46,8 +46,8 @@ class PromptSize:
 
 def prompt_size(request: object, mode: str = "json_schema") -> PromptSize:
     """The size of the prompt an LLM reasoner sends for ``request`` (an agent request)."""
-    from agentchord.agents.llm.messages import request_message, system_prompt  # noqa: PLC0415 - avoids a cycle
-    from agentchord.agents.llm.skills import skills_section  # noqa: PLC0415
+    from agentchord.agents.llm.messages import request_message, system_prompt  # avoids a cycle
+    from agentchord.agents.llm.skills import skills_section
 
     agent = request.agent  # type: ignore[attr-defined]
     system = system_prompt(agent, mode, request)  # type: ignore[arg-type]

@@ -67,7 +67,7 @@ def prompt_template(agent: str) -> str:
     return path.read_text(encoding="utf-8")
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def render_prompt(agent: str) -> str:
     """An agent's system prompt with every placeholder filled in.
 

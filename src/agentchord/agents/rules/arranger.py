@@ -129,9 +129,13 @@ class Arranger:
                 tipped = self._set_upright(edge, account, obj, busy)
                 if tipped is not None:
                     out.append(tipped)
-            out.append((FailureMode(name=f"{obj}_shifted", monitor=f"drift({obj}, {kb.drift_tolerance(obj_info):g})", window=kb.WINDOW, intent="re-approach", recovery=replay.id), replay))
+            shifted = FailureMode(name=f"{obj}_shifted", monitor=f"drift({obj}, {kb.drift_tolerance(obj_info):g})", window=kb.WINDOW,
+                                  intent="re-approach", recovery=replay.id)
+            out.append((shifted, replay))
             if self.watch_visibility:
-                out.append((FailureMode(name=f"{obj}_lost", monitor=f"lost_view({obj}, {kb.MIN_POINTS})", window=kb.WINDOW, intent="re-observe", recovery=replay.id), None))
+                lost = FailureMode(name=f"{obj}_lost", monitor=f"lost_view({obj}, {kb.MIN_POINTS})", window=kb.WINDOW,
+                                   intent="re-observe", recovery=replay.id)
+                out.append((lost, None))
         out += upright_in_hand(edge, account, after, self.objects)
         out += gripped_low(graph, edge, account)
         out += self._relations(graph, edge, account, after)

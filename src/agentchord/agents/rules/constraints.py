@@ -90,7 +90,8 @@ def _at_constraints(name: str, key: str, objects: dict[str, SceneObject], scene:
         return released + upright + [f"norm(xy({name}.pos - [{parts[0]}, {parts[1]}, 0.0])) - 0.03"]
     if kind == "rel":
         anchor, dx, dy = parts[0], parts[1], parts[2]
-        return released + [f"norm(xy({name}.pos - {anchor}.pos) - [{dx}, {dy}, 0.0]) - 0.03"] + ([f"tilt({name}) - 15"] if obj is not None and kb.is_flat(obj) else upright)
+        lying = [f"tilt({name}) - 15"] if obj is not None and kb.is_flat(obj) else upright
+        return released + [f"norm(xy({name}.pos - {anchor}.pos) - [{dx}, {dy}, 0.0]) - 0.03"] + lying
     if kind in ("in", "on"):
         return released + [over_footprint(name, objects[parts[0]])]
     return released

@@ -122,6 +122,6 @@ def explain_plan(instruction: str, scene: Scene, goal: GoalSpec | None = None) -
 
 def _phase_items(phase) -> list[tuple[str, dict]]:
     if isinstance(phase, dict):
-        return [(arm, step if isinstance(step, dict) else getattr(step, "model_dump", lambda: {"fn": str(step)})()) for arm, step in phase.items()]
+        return [(arm, step if isinstance(step, dict) else getattr(step, "model_dump", lambda step=step: {"fn": str(step)})()) for arm, step in phase.items()]
     dumped = phase.model_dump() if hasattr(phase, "model_dump") else {}
     return [(arm, step) for arm, step in dumped.items() if isinstance(step, dict) and "fn" in step]

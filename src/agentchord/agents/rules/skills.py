@@ -91,7 +91,8 @@ def ground(scene: Scene, goal: GoalSpec) -> list[Operator]:
 
 
 def _released(arm: str, name: str) -> frozenset[Fact]:
-    return frozenset({("holding", arm, name), ("lifted", arm), ("presented", arm, name), ("over", arm, name), ("handover_ready", arm, name), ("pour_ready", arm, "*", "*")})
+    return frozenset({("holding", arm, name), ("lifted", arm), ("presented", arm, name), ("over", arm, name),
+                      ("handover_ready", arm, name), ("pour_ready", arm, "*", "*")})
 
 
 def _one_arm_ops(

@@ -521,6 +521,6 @@ class ScriptedDisturbance:
         return event
 
 
-def ScriptedDrop(action: str, nth: int = 0, after: int = 20) -> ScriptedDisturbance:  # noqa: N802  (reads as a type)
+def ScriptedDrop(action: str, nth: int = 0, after: int = 20) -> ScriptedDisturbance:  # reads as a type
     """A drop during the ``nth`` run of ``action``, ``after`` ticks in."""
     return ScriptedDisturbance(action, "drop", nth, after)

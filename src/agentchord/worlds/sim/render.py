@@ -81,7 +81,7 @@ class VideoRecorder:
         )
 
     def _annotate(self, image: np.ndarray, caption: str) -> np.ndarray:
-        from PIL import Image, ImageDraw  # noqa: PLC0415  (pillow comes with imageio)
+        from PIL import Image, ImageDraw  # pillow comes with imageio
 
         canvas = Image.fromarray(image)
         draw = ImageDraw.Draw(canvas)
@@ -97,7 +97,7 @@ class VideoRecorder:
 
     def write(self) -> Path:
         """Encode the collected frames as an MP4 (ffmpeg ships with imageio-ffmpeg)."""
-        import imageio.v2 as imageio  # noqa: PLC0415
+        import imageio.v2 as imageio
 
         self.path.parent.mkdir(parents=True, exist_ok=True)
         fps = CONTROL_HZ // self.every

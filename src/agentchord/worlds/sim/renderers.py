@@ -58,7 +58,7 @@ def _load_triton_first() -> None:
     if not _TRITON_LOADED:
         _TRITON_LOADED = True
         if importlib.util.find_spec("triton") is not None:
-            import triton  # noqa: F401, PLC0415
+            import triton  # noqa: F401
 
 
 def open_renderer(model: mujoco.MjModel, height: int, width: int) -> mujoco.Renderer:

@@ -178,7 +178,7 @@ class WorldServer:
             if handler is None:
                 raise ProtocolError(f"unknown op {op!r} (ops: hello, open, step, camera, sim, close)")
             return {"ok": True, **handler(request)}
-        except Exception as exc:  # noqa: BLE001  (every error goes back to the client)
+        except Exception as exc:  # every error goes back to the client
             return {"ok": False, "type": type(exc).__name__, "error": str(exc)}
 
     def _world(self, request: dict[str, Any]) -> SimWorld:

@@ -13,7 +13,7 @@ from typing import Protocol
 
 import numpy as np
 
-from agentchord.features.frame import FeatureFrame, ObjectFeatures, tilt_deg  # noqa: F401  (re-exported for the task modules)
+from agentchord.features.frame import FeatureFrame, ObjectFeatures, tilt_deg  # re-exported for the task modules
 from agentchord.worlds.sim.scene import SceneSpec
 from agentchord.worlds.sim.world import SimWorld
 

@@ -146,7 +146,7 @@ class GoalTracker:
         return ""
 
     def _constraints(self, frame: FeatureFrame) -> list[str]:
-        from agentchord.expr import Vocabulary, compile_expr  # noqa: PLC0415
+        from agentchord.expr import Vocabulary, compile_expr
 
         vocabulary = Vocabulary(frozenset(frame.objects))
         failed = []
