@@ -11,7 +11,7 @@ from agentchord.execution.strategies import make_strategy
 from agentchord.tasks import load_task_graph
 from agentchord.worlds.sim.disturbances import KINDS, PRESETS, ScriptedDisturbance, ScriptedDrop
 from agentchord.worlds.sim.tasks import SIM_TASKS
-from agentchord.worlds.sim.tasks.base import Verdict
+from agentchord.harness import Verdict
 from agentchord.worlds.sim.trial import open_world
 
 TASK = "single_arm_pour_water"

@@ -10,7 +10,8 @@ from agentchord.features.oracle import OracleExtractor
 from agentchord.graph.progress import forward_filter, nominal_path
 from agentchord.graph.validation import check_graph
 from agentchord.tasks import load_task_graph
-from agentchord.worlds.sim.disturbances import DisturbanceEvent, ScriptedDrop
+from agentchord.harness import DisturbanceEvent
+from agentchord.worlds.sim.disturbances import ScriptedDrop
 from agentchord.worlds.sim.tasks import SIM_TASKS
 from agentchord.worlds.sim.tasks.rearrange_table import TARGET_OFFSET, long_axis_yaw_deg, yaw_error_deg
 from agentchord.worlds.sim.world import SimWorld

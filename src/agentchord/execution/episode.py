@@ -13,7 +13,7 @@ from agentchord.execution.baselines.progress import GoalEvents
 from agentchord.execution.background import ScriptedPlan, ThreadedPlan
 from agentchord.execution.baselines.strategies import BaselineContext
 from agentchord.execution.executor import Executor, ExecutorConfig
-from agentchord.execution.harness import SuccessTracker
+from agentchord.harness import Disturbance, SuccessTracker
 from agentchord.execution.methods import PIPELINED_METHODS, is_baseline, make_method
 from agentchord.execution.reasoning import ReasoningConfig
 from agentchord.execution.repair import Repairer
@@ -23,7 +23,7 @@ from agentchord.graph.models import TaskGraph
 from agentchord.tasks import load_task_graph
 from agentchord.worlds.protocol import World
 from agentchord.worlds.remote import RemoteWorld
-from agentchord.worlds.sim.disturbances import Disturbance, ProtocolDisturbances, RandomDisturbances
+from agentchord.worlds.sim.disturbances import ProtocolDisturbances, RandomDisturbances
 from agentchord.worlds.sim.tasks import SIM_TASKS, judge_by_goal
 from agentchord.worlds.sim.trial import open_world
 

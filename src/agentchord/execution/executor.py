@@ -29,7 +29,7 @@ from agentchord.execution.background import ScriptedPlan, ThreadedPlan
 from agentchord.execution.binding import Binding, HoldMemory
 from agentchord.execution.edge_program import EdgeProgram
 from agentchord.execution.feasibility import FeasibilityChecker, first_grasps, off_table
-from agentchord.execution.harness import Disturbance, SuccessTracker
+from agentchord.harness import Disturbance, SuccessTracker
 from agentchord.execution.ledger import DisturbanceLedger
 from agentchord.execution.motion_watch import MotionWatch
 from agentchord.execution.planning import PlanSchedule

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from agentchord.execution.harness import DisturbanceEvent
+from agentchord.harness import DisturbanceEvent
 from agentchord.worlds.protocol import CONTROL_HZ
 
 

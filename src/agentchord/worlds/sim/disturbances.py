@@ -32,18 +32,15 @@ Presets (:data:`PRESETS`): ``real`` = perturb + pull (the paper's Table II),
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
 from agentchord.features.frame import FeatureFrame
+from agentchord.harness import DisturbanceEvent, RunningAction
 from agentchord.worlds.sim.hand import OUT_S, set_down_path
 from agentchord.worlds.sim.scene import TABLE_FRICTION
 from agentchord.worlds.sim.world import CONTROL_HZ, SimWorld
-
-if TYPE_CHECKING:
-    from agentchord.actions.base import ArmAction
 
 #: Every disturbance kind, in a fixed order (the order seeded choices index into).
 KINDS = ("drop", "pull", "perturb", "shift", "knock")
@@ -80,25 +77,6 @@ SHIFT_DISTANCE = (0.05, 0.08)
 PUSH_ACCEL = 3.0
 #: Only an object at least this much taller than wide can be knocked over (not a plate, not a tray).
 KNOCK_MIN_ASPECT = 1.2
-
-
-@dataclass
-class DisturbanceEvent:
-    """One injected disturbance.
-
-    Attributes:
-        tick: Tick it happened.
-        kind: One of :data:`KINDS`.
-        obj: The object that was dropped, pulled, pushed or knocked.
-        arm: The arm that lost its object ("" when no arm is involved).
-        action: The atomic action that was running ("" when none was).
-    """
-
-    tick: int
-    kind: str
-    obj: str
-    arm: str = ""
-    action: str = ""
 
 
 def _held_by(frame: FeatureFrame, arm: str) -> list[str]:
@@ -260,7 +238,7 @@ def _horizontal(rng: np.random.Generator) -> np.ndarray:
 
 
 def inject(kind: str, world: SimWorld, frame: FeatureFrame, rng: np.random.Generator,
-           arm: str = "", action: ArmAction | None = None,
+           arm: str = "", action: RunningAction | None = None,
            direction: tuple[float, float, float] | None = None,
            spot: tuple[float, float] | None = None, lying: bool | None = None) -> DisturbanceEvent | None:
     """Apply one disturbance of ``kind`` now, if it applies to the current state.
@@ -336,21 +314,6 @@ def inject(kind: str, world: SimWorld, frame: FeatureFrame, rng: np.random.Gener
     raise ValueError(f"unknown disturbance kind {kind!r} (kinds: {', '.join(KINDS)})")
 
 
-class Disturbance(Protocol):
-    """What the executor drives: told of action starts and ends, applied every tick."""
-
-    events: list[DisturbanceEvent]
-
-    def action_started(self, arm: str, action: ArmAction, expected_ticks: int, tick: int) -> None:
-        """An atomic action started on ``arm``."""
-
-    def action_ended(self, arm: str) -> None:
-        """The action on ``arm`` ended or was interrupted."""
-
-    def apply(self, world: SimWorld, frame: FeatureFrame) -> DisturbanceEvent | None:
-        """Inject what is due now."""
-
-
 def parse_kinds(text: str) -> tuple[str, ...]:
     """``"drop,shift"`` -> ``("drop", "shift")``.
 
@@ -388,9 +351,9 @@ class RandomDisturbances:
             raise ValueError(f"disturbance probability must be in [0, 1], got {self.p}")
         parse_kinds(",".join(self.kinds))
         self._rng = np.random.default_rng([self.seed, 0xD209])
-        self._pending: dict[str, tuple[int, str, ArmAction]] = {}
+        self._pending: dict[str, tuple[int, str, RunningAction]] = {}
 
-    def action_started(self, arm: str, action: ArmAction, expected_ticks: int, tick: int) -> None:
+    def action_started(self, arm: str, action: RunningAction, expected_ticks: int, tick: int) -> None:
         """Draw whether, when and what disturbs this action."""
         # Always draw all three so the stream stays aligned across strategies.
         hit, moment, pick = self._rng.random() < self.p, self._rng.random(), self._rng.random()
@@ -444,9 +407,9 @@ class ProtocolDisturbances:
         count = int(self._rng.integers(1, 3))
         moments = sorted(int(t) for t in self._rng.integers(*self.window, size=count))
         self._due = [(t, self.kinds[int(self._rng.integers(len(self.kinds)))]) for t in moments]
-        self._running: dict[str, ArmAction] = {}
+        self._running: dict[str, RunningAction] = {}
 
-    def action_started(self, arm: str, action: ArmAction, expected_ticks: int, tick: int) -> None:
+    def action_started(self, arm: str, action: RunningAction, expected_ticks: int, tick: int) -> None:
         """Remember what each arm is doing (the target of perturb and shift)."""
         self._running[arm] = action
 
@@ -494,9 +457,9 @@ class ScriptedDisturbance:
         parse_kinds(self.kind)
         self._rng = np.random.default_rng([self.seed, 0x5C41])
         self._seen = 0
-        self._due: tuple[str, int, ArmAction] | None = None
+        self._due: tuple[str, int, RunningAction] | None = None
 
-    def action_started(self, arm: str, action: ArmAction, expected_ticks: int, tick: int) -> None:
+    def action_started(self, arm: str, action: RunningAction, expected_ticks: int, tick: int) -> None:
         """Arm the disturbance when the chosen run of the chosen action starts."""
         if action.name != self.action:
             return

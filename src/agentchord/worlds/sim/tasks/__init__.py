@@ -9,7 +9,8 @@ from __future__ import annotations
 import importlib
 import pkgutil
 
-from agentchord.worlds.sim.tasks.base import SimTask, SuccessTracker, Verdict
+from agentchord.harness import SuccessTracker, Verdict
+from agentchord.worlds.sim.tasks.base import SimTask
 from agentchord.worlds.sim.tasks.goal_tracker import GoalTracker
 
 

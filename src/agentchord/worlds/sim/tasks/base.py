@@ -8,39 +8,14 @@ feature frames of the episode. The task *graph* lives in the task library
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
 
 from agentchord.features.frame import FeatureFrame, ObjectFeatures, tilt_deg  # re-exported for the task modules
+from agentchord.harness import SuccessTracker
 from agentchord.worlds.sim.scene import SceneSpec
 from agentchord.worlds.sim.world import SimWorld
-
-
-@dataclass
-class Verdict:
-    """Whether the task succeeded, and why not.
-
-    Attributes:
-        success: Whether it succeeded.
-        reason: What holds, or what does not.
-        settling: It failed only because something is still moving: judged again once at rest.
-    """
-
-    success: bool
-    reason: str
-    settling: bool = False
-
-
-class SuccessTracker(Protocol):
-    """Watches an episode's frames and judges its end state."""
-
-    def observe(self, frame: FeatureFrame) -> None:
-        """Watch one tick (for events that must happen during the episode)."""
-
-    def verdict(self, frame: FeatureFrame, world: SimWorld) -> Verdict:
-        """Judge the end state."""
 
 
 class SimTask(Protocol):

@@ -20,7 +20,8 @@ import numpy as np
 
 from agentchord.features.frame import FeatureFrame
 from agentchord.worlds.sim.scene import ClothSpec, SceneSpec
-from agentchord.worlds.sim.tasks.base import Verdict, uniform
+from agentchord.harness import Verdict
+from agentchord.worlds.sim.tasks.base import uniform
 from agentchord.worlds.sim.world import SimWorld
 
 #: Bottom corner -> the top corner it is folded onto, and the arm that folds it.

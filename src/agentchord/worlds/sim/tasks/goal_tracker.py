@@ -18,7 +18,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from agentchord.features.frame import FeatureFrame
-from agentchord.worlds.sim.tasks.base import Verdict, pouring, resting_on_table
+from agentchord.harness import Verdict
+from agentchord.worlds.sim.tasks.base import pouring, resting_on_table
 from agentchord.worlds.sim.tasks.rearrange_table import yaw_error_deg
 from agentchord.worlds.sim.world import SimWorld
 

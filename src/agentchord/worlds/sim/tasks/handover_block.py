@@ -20,7 +20,8 @@ import numpy as np
 
 from agentchord.features.frame import FeatureFrame
 from agentchord.worlds.sim.scene import ObjectSpec, SceneSpec
-from agentchord.worlds.sim.tasks.base import Verdict, resting_on_table, tilt_deg, uniform
+from agentchord.harness import Verdict
+from agentchord.worlds.sim.tasks.base import resting_on_table, tilt_deg, uniform
 from agentchord.worlds.sim.world import SimWorld
 
 #: Centre (x, y) of the target region on the right half of the table (m); the library

@@ -13,7 +13,8 @@ import numpy as np
 
 from agentchord.features.frame import FeatureFrame, level_tilt_deg
 from agentchord.worlds.sim.scene import ObjectSpec, SceneSpec
-from agentchord.worlds.sim.tasks.base import Verdict, resting_on_table, uniform
+from agentchord.harness import Verdict
+from agentchord.worlds.sim.tasks.base import resting_on_table, uniform
 from agentchord.worlds.sim.world import SimWorld
 
 #: Target of each utensil's centre, relative to the plate's centre (m), and the arm that moves it.

@@ -17,7 +17,8 @@ import numpy as np
 
 from agentchord.features.frame import FeatureFrame
 from agentchord.worlds.sim.scene import ObjectSpec, SceneSpec
-from agentchord.worlds.sim.tasks.base import Verdict, tilt_deg, uniform
+from agentchord.harness import Verdict
+from agentchord.worlds.sim.tasks.base import tilt_deg, uniform
 from agentchord.worlds.sim.world import SimWorld
 
 #: Where the tray must end (x, y, m): the designated forward position, 10-16 cm ahead of its start.

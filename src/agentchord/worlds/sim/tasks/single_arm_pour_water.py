@@ -8,7 +8,8 @@ import numpy as np
 
 from agentchord.features.frame import FeatureFrame
 from agentchord.worlds.sim.scene import ObjectSpec, SceneSpec
-from agentchord.worlds.sim.tasks.base import Verdict, pouring, resting_on_table, tilt_deg, uniform
+from agentchord.harness import Verdict
+from agentchord.worlds.sim.tasks.base import pouring, resting_on_table, tilt_deg, uniform
 from agentchord.worlds.sim.world import SimWorld
 
 
