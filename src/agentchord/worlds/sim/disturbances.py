@@ -208,8 +208,8 @@ def _carry_height(world: SimWorld, frame: FeatureFrame, obj: str, start: np.ndar
         other_pos, other_matrix = world.object_pose(name)
         resting_on = other_pos[2] - _half_extent_along(other, other_matrix, up) > bottom + LOAD_ABOVE
         if resting_on and np.linalg.norm(other_pos[:2] - here[:2]) < _footprint(spec):
-            # Lifted over its own load, a tray pulled with the capsule in it threw the capsule off the
-            # table (planned coffee tray, real protocol, seed 2).
+            # Lifted over its own load: a tray pulled with a capsule in it would throw the capsule
+            # off the table.
             continue
         if _distance_to_segment(other_pos[:2], start, spot) < _footprint(other) + reach + CARRY_PASS_CLEARANCE:
             tops.append(other_pos[2] + _half_extent_along(other, other_matrix, up))
@@ -288,8 +288,8 @@ def inject(kind: str, world: SimWorld, frame: FeatureFrame, rng: np.random.Gener
             return None
         if not _resting(world, target) and not any(obj == target for _, obj in frame.holding):
             # Not one lying on nothing but the robot's fingers (a pull set it down there) or falling
-            # off them: pushed so, no table friction held it and the bottle went off the table (real
-            # protocol, single-arm pour, seed 32). One the other hand holds (a hand-over) is pushed in that hand.
+            # off them: pushed so, no table friction holds it and it goes off the table (a bottle
+            # did, in a single-arm pour). One the other hand holds (a hand-over) is pushed in that hand.
             return None
         _slide(world, target, push_dir, float(rng.uniform(*PERTURB_DISTANCE)))
         return DisturbanceEvent(world.tick, kind, target, arm, name)
