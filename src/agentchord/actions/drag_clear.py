@@ -1,10 +1,10 @@
 """Drag an object pressed against a neighbour away from it, so that a top grasp's fingers fit.
 
 An object pushed flush against another leaves no room on that side for an open finger: a fork
-against the plate's rim (planned rearrange table, stress seed 2). Where no slide or turn of the
-grasp clears the neighbour (:mod:`~agentchord.actions.finger_clearance`), the finger comes down on
-it and the tool stops short. Then the tip of one open finger is pressed lightly on the object's top,
-near its edge on the neighbour's side, and the hand slides away: the finger's friction (1.5) beats
+against the plate's rim. Where no slide or turn of the grasp clears the neighbour
+(:mod:`~agentchord.actions.finger_clearance`), the finger comes down on it and the tool stops
+short. Then the tip of one open finger is pressed lightly on the object's top, near its edge on
+the neighbour's side, and the hand slides away: the finger's friction (1.5) beats
 the table's (at most 1.2 for the objects here), and the object comes along. The grasp then looks
 again (:class:`~agentchord.actions.grasp.Grasp`, at most :attr:`~agentchord.actions.grasp.Grasp.DRAGS`
 times).
@@ -161,8 +161,8 @@ def plan_drag(frame: FeatureFrame, obj: str, blockers: tuple[str, ...]) -> DragP
     rotation = top_down_rotation(np.array([-away[1], away[0], 0.0]))
     # The pressing finger's tip (its inner edge) near the object's edge on the neighbour's side: the
     # press then holds the object down against the drag's tipping moment. Pressed on its centre line,
-    # a fork 1.6 cm wide and 1.1 cm thick rolled onto its edge instead of sliding (planned rearrange,
-    # stress seed 2: pressed 2-3 mm from its edge it slid 4 cm; 4-5 mm from it, it rolled). Forks and spoons
+    # a fork 1.6 cm wide and 1.1 cm thick rolled onto its edge instead of sliding (pressed 2-3 mm
+    # from its edge it slid 4 cm; 4-5 mm from it, it rolled). Forks and spoons
     # pressed against the plate, 7 places x 4 scenes: all 28 taken after the drag, 26 still flat.
     tip_offset = min(0.0, -0.5 * _chord(feats, away) + EDGE_MARGIN + 0.5 * TIP_THICKNESS)
     press = feats.pos + (tip_offset + FINGER_ACROSS[0] + 0.5 * TIP_THICKNESS) * away

@@ -4,14 +4,13 @@ whose fingers clear the neighbours.
 A top grasp closes its fingers across the object's narrow side. Open, each finger is a
 2.4 cm x 6.1 cm plate beside the object, 3.5 cm from the tool centre. An object pushed
 against another (a fork against the plate's rim, a capsule against the tray's handle) puts
-a finger on the neighbour: it lands there and the tool stops ~1.8 cm above the grasp
-(stress protocol: rearrange seeds 2 and 15, coffee tray seed 13). Then the grasp slides
-along a long object's length, or turns about a short one, to the nearest choice whose
-fingers clear what stands beside it.
+a finger on the neighbour: it lands there and the tool stops ~1.8 cm above the grasp. Then
+the grasp slides along a long object's length, or turns about a short one, to the nearest
+choice whose fingers clear what stands beside it.
 
 A side grasp's fingers are followed from the pre-grasp to the grasp point
 (:func:`side_approach_blocking`): a bottle lying beside a cup is swept into and pushed, and the cup
-caught off centre (stress protocol, dual-arm pour seed 8); the grasp action picks a clear one.
+caught off centre; the grasp action picks a clear one.
 
 An empty hand's straight move to a pre-grasp that would sweep the open fingers into a neighbour
 goes over it instead (:func:`crossing_over`).
@@ -136,7 +135,7 @@ def side_approach_blocking(
     the fingers' sample points lie in each.
 
     No clearance is kept: a finger passing a neighbour's side at a few millimetres does not move it
-    (stress protocol, single-arm pour, seed 9: 3 mm beside the cup, the grasp holds as planned).
+    (3 mm beside a standing cup, the grasp holds as planned).
     """
     steps = max(2, int(np.ceil(float(np.linalg.norm(point - pre)) / SWEEP_STEP)) + 1)
     points = np.vstack([open_finger_points(pre + s * (point - pre), rotation) for s in np.linspace(0.0, 1.0, steps)])
@@ -175,9 +174,8 @@ def crossing_over(frame: FeatureFrame, obj: str, start: PoseTarget, goal: PoseTa
     from ``start`` in its orientation, then level to over ``goal`` turning to its orientation, from
     where a straight move down ends at ``goal``. The lowest such crossing whose every leg is clear.
 
-    Single-arm pour, stress seed 38: the straight line from where the hand let a bottle go to the
-    fallen bottle's pre-grasp passed over the cup standing beside it; the fingers struck its rim
-    and the cup went off the table.
+    The straight line from where the hand let a bottle go to the fallen bottle's pre-grasp passed
+    over a cup standing beside it; the fingers struck its rim and the cup went off the table.
 
     Args:
         frame: The current features.

@@ -396,8 +396,8 @@ class Grasp(ArmAction):
 
         A regrasp often starts with the hand right over the object (it dropped or was set upright
         under the hand): the straight line down to the pre-grasp drives the gripper into its top and
-        knocks it over (Table II, dual-arm pour, seed 1). Then the tool first moves level to above
-        the pre-grasp, clear of the top, and the approach descends from there, beside the object.
+        knocks it over. Then the tool first moves level to above the pre-grasp, clear of the top,
+        and the approach descends from there, beside the object.
         """
         start = robot.commanded_pose(self.arm).pos
         feats = robot.frame.objects[self.args.obj]
@@ -469,9 +469,9 @@ class Grasp(ArmAction):
 
         Where the open fingers would come down on a neighbour, the grasp point slides along the
         axis to the nearest one whose fingers clear it (:func:`clear_top_grasp`, as a top grasp):
-        single-arm pour, real seed 58, a bottle pulled out of the hand came to lie against the cup,
-        and a finger came down on the cup's rim three times, 6 cm above the grasp. With
-        ``keep_slide`` the slide chosen at the attempt's first look is kept.
+        a bottle pulled out of the hand came to lie against the cup, and a finger came down on
+        the cup's rim three times, 6 cm above the grasp. With ``keep_slide`` the slide chosen at
+        the attempt's first look is kept.
         """
         rotation, point = fallen_grasp_frame(robot.frame.objects[self.args.obj])
         top_dir = rotation[:, 2]

@@ -128,8 +128,8 @@ def approach(
             through nothing (None: not checked).
     """
     if (yield from _follow_line(robot, arm, goal, speed)):
-        # Lost on the way (rearrange, stress seed 35: the wrist-rotate joint at its limit as a
-        # tilted tool turned top-down, the tool 12 cm under the line, down on the fork, and the
+        # Lost on the way (the wrist-rotate joint at its limit as a tilted tool turned top-down
+        # over a fork on its edge: the tool 12 cm under the line, down on the fork, and the
         # arm whipped back when it broke free): through home, where the goal is reached from there.
         q_goal = solve_from_scratch(
             robot.scratch_ik(), robot.ik.configuration.q.copy(), arm, [goal] if then is None else [goal, then],

@@ -175,10 +175,10 @@ class Back(ArmAction):
         """The lowest pose straight above the tool from which the way home sweeps no finger through
         an object; None where the way home from here is clear, or no rise makes it so.
 
-        Measured before this check (stress protocol, seeds 0-7, 30, 32): the way home from a side
-        place's retreat passed the fingers through the bottle or block just set down in 9 of the 30
-        episodes of the pours and the handover (none of the other three tasks' 30); at the empty-hand speed that knocked the block
-        off its spot and left it rocking (handover seeds 30, 32).
+        Measured before this check, under disturbances of every kind: the way home from a side
+        place's retreat passed the fingers through the bottle or block just set down in 9 of 30
+        episodes of the pours and the handover (none of 30 of the other three tasks); at the
+        empty-hand speed that knocked a handed-over block off its spot and left it rocking.
         """
         frame = robot.frame
         if not swept_hits(frame, None, list(joint_path(robot, self.arm, HOME_Q).tool_poses)):

@@ -30,8 +30,8 @@ HANDOFF_EXTRA_MARGINS = (0.0, 0.02, 0.04, 0.06, 0.08)
 #: with its bottom at least this high (m) while it turns.
 LEVEL_IN_HAND_DEG = 4.0
 #: ... and at most this tilted (deg): more is a hold across the object (a fork, a bottle lying), not askew.
-#: A hand-over grasp pushed as it closed held the block at 39 deg (handover, real protocol seed 43);
-#: the bound was the upright tolerance (25 deg) and the block, set down askew, leant on the fingers.
+#: A hand-over grasp pushed as it closed held the block at 39 deg; the bound was the upright
+#: tolerance (25 deg) and the block, set down askew, leant on the fingers.
 UPRIGHT_IN_HAND_MAX_DEG = 50.0
 LEVEL_CLEARANCE = 0.02
 #: Finger gap beyond the object's width (m) when releasing it inside a rim.
@@ -147,10 +147,10 @@ class Place(ArmAction):
     def _handoff_target(self, robot: RobotController) -> np.ndarray:
         """Where to set the object down for the other arm: the nearest spot both arms reach.
 
-        The reach shell was measured for side grasps; a top-down tool reaches less far (the coffee
-        tray's capsule, stress seed 22: set down 0.60 m from the taker's shoulder, its grasp 2 cm
-        short). An object the taker will take from above gets a spot the IK confirms, moved towards
-        the middle of the taker's shell until one is; none confirmed, the nearest spot it is.
+        The reach shell was measured for side grasps; a top-down tool reaches less far (a capsule
+        set down 0.60 m from the taker's shoulder: its grasp fell 2 cm short). An object the taker
+        will take from above gets a spot the IK confirms, moved towards the middle of the taker's
+        shell until one is; none confirmed, the nearest spot it is.
         """
         frame, taker = robot.frame, self.args.within_reach
         feats = frame.objects[self.args.obj]

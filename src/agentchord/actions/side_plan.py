@@ -5,9 +5,9 @@ or at the yaw the graph asks for, to a share of the object's height. Two things 
 way. An object beside the arm's own base puts the pre-grasp, 8 cm further back, where the elbow
 folds past its limit: then a shorter or higher pre-grasp, or a higher grasp point
 (:data:`REACH_VARIANTS`). An object lying beside this one puts the open fingers in it on their
-way in (stress protocol, dual-arm pour seed 8: the cup's grasps pushed a bottle lying beside it
-and closed on the cup off centre): then the approach turned about the object, or a grasp higher
-up, over a neighbour lying on its side (:data:`CLEAR_TURNS_DEG`, :data:`CLEAR_HEIGHT`).
+way in (the cup's grasps pushed a bottle lying beside it and closed on the cup 3.9 cm off
+centre): then the approach turned about the object, or a grasp higher up, over a neighbour
+lying on its side (:data:`CLEAR_TURNS_DEG`, :data:`CLEAR_HEIGHT`).
 
 The plan is a pure function of the frame and the arm's configuration: the same on every frame
 that shows the same scene, so feasibility checks and the grasp itself agree.
@@ -145,10 +145,10 @@ class SidePlanner:
         Tried nearest first: the approach turned about the object (:data:`CLEAR_TURNS_DEG`; not
         when the graph asked for a yaw), then, where what is in the way lies on its side, a higher
         grasp over it (:data:`CLEAR_HEIGHT`) with each turn. A neighbour standing beside the object
-        is only nudged by the passing fingers and slides (Table I, dual-arm pour seed 6: the
-        bottle's grasp 1.8 cm into the cup beside it holds as asked); one lying there rolls ahead
-        of them and the object is caught off centre (stress, dual-arm pour seed 8). The rule reads
-        the scene alone, so every method's grasps choose alike.
+        is only nudged by the passing fingers and slides (a bottle's grasp sweeping 1.8 cm into
+        the cup standing behind it holds as asked); one lying there rolls ahead of them and the
+        object is caught off centre. The rule reads the scene alone, so every method's grasps
+        choose alike.
         """
         turns = (0.0,) + (CLEAR_TURNS_DEG if self.args.yaw is None else ())
         heights: tuple[float | None, ...] = (None,)

@@ -1,8 +1,8 @@
 """Tipping a thin object put down on its edge flat: the open fingers push its top edge over.
 
 A fork or a spoon that fell on its edge is taken from above along its length, across its
-thickness, and so is put down on its edge (rearrange, stress seed 35: "not lying flat (tilt
-90 deg)"). Turning it flat in the hand does not work with this gripper: with the fingers one
+thickness, and so is put down on its edge, which the goal reads as "not lying flat (tilt
+90 deg)". Turning it flat in the hand does not work with this gripper: with the fingers one
 above the other its housing is 7 cm under the tool centre, and a fork let go there tips off
 the lower finger and lands on its edge again (the utensils' rolling friction holds one
 leaning at 48 deg). So it is set down on its edge, short of its spot by as far as it will

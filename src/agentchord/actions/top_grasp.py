@@ -25,8 +25,8 @@ FINGERTIP_REACH = 0.039
 def lies_on_side(feats: ObjectFeatures) -> bool:
     """Whether an object lies on its side (its axis near horizontal), not upright or upside down.
 
-    Rearrange stress seed 45: a fork that flipped over when dropped (tilt 180 deg) was taken for a
-    lying cylinder as tall as the fork is long, and the fingers closed 5 cm above it.
+    A fork that flipped over when dropped (tilt 180 deg) was taken for a lying cylinder as tall as
+    the fork is long, and the fingers closed 5 cm above it.
     """
     return level_tilt_deg(feats.axis) >= FALLEN_DEG
 
@@ -35,9 +35,9 @@ def on_its_edge(feats: ObjectFeatures) -> bool:
     """Whether a flat object (:data:`FLAT_SHARE`: a fork, a spoon, a card) lies on its side, standing
     on an edge, not flat; a bottle or a capsule lying down (a cylinder on its round side) does not.
 
-    Coffee tray, real seed 84: a capsule 2.7 cm tall and 3.3 cm across, lying on its side beside the
-    tray's handle, passed the older test (its axis merely its shortest side). It was taken across
-    its flat ends, and a finger came down on the handle three times.
+    A capsule 2.7 cm tall and 3.3 cm across, lying on its side beside the tray's handle, passed
+    the older test (its axis merely its shortest side). It was taken across its flat ends, and a
+    finger came down on the handle three times.
     """
     return lies_on_side(feats) and float(feats.extent[2]) < FLAT_SHARE * float(max(feats.extent[0], feats.extent[1]))
 
@@ -45,9 +45,9 @@ def on_its_edge(feats: ObjectFeatures) -> bool:
 def long_axis(feats: ObjectFeatures) -> np.ndarray:
     """An object's long direction: its axis if it lies on its side, else its longer horizontal side.
 
-    A flat object on its edge lies along the longer of its sides, whichever of them is level (rearrange,
-    stress seed 35: a fork on its edge against the plate, taken along its thickness, with the fingers
-    across its 14 cm length).
+    A flat object on its edge lies along the longer of its sides, whichever of them is level (a
+    fork on its edge against the plate was taken along its thickness, with the fingers across its
+    14 cm length).
     """
     rot = _matrix(feats.quat)
     if on_its_edge(feats):

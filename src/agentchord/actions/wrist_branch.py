@@ -6,9 +6,9 @@ near 0 (here: *unflipped*). Pitching the tool through the wrist's singularity (w
 where the roll and rotate axes line up) swaps the live IK's branch: a straight-line move from a
 side posture to a tool pointing down ends with the roll near pi, and the turn of a fallen object
 upright in hand crosses back, the solver swinging roll and rotate through pi in ~0.2 s with the
-measured joints up to 0.7 rad behind. Measured on the real-world protocol's pours (seeds 0-19):
-every fallen grasp was taken flipped, and the whip at the crossing pivoted the object between the
-finger pads, leaving it 8-20 degrees askew in 8 of 16 (a pour from such a hold misses the cup).
+measured joints up to 0.7 rad behind. Measured on pours under pushes and pulls: every fallen
+grasp was taken flipped, and the whip at the crossing pivoted the object between the finger
+pads, leaving it 8-20 degrees askew in 8 of 16 (a pour from such a hold misses the cup).
 A straight joint-space move on the unflipped branch passes wrist angle 0 smoothly: over the
 object with the empty hand, then, holding it, to upright.
 """

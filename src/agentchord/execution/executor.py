@@ -350,10 +350,9 @@ class Executor(RecoverySwitching, PlanArrivals):
         """The verdict on the goal; None while it fails with the scene still moving, which may yet come to rest.
 
         A verdict taken on the tick the last edge ends can catch a single cloth vertex jittering at
-        16 cm/s in a towel that is otherwise at rest (Table II, fold towel, seed 16), or a bottle
-        knocked over a few ticks before the arm got home, still falling (24 deg and on its way
-        down). The judge waits, the arms holding still, up to ``settle_ticks``; those ticks count
-        as the episode's.
+        16 cm/s in a towel that is otherwise at rest, or a bottle knocked over a few ticks before
+        the arm got home, still falling (24 deg and on its way down). The judge waits, the arms
+        holding still, up to ``settle_ticks``; those ticks count as the episode's.
         """
         verdict = self.tracker.verdict(self.frame, self.world)
         if verdict.settling or (not verdict.success and self.motion.moving()):

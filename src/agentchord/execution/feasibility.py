@@ -61,8 +61,8 @@ def _both_corners(frame: FeatureFrame, held: str, wanted: str) -> bool:
     """Whether ``held`` and ``wanted`` are both a cloth's corners (point features).
 
     A hand pinching one corner is not busy for another: the grasp opens it first. A corner that
-    slipped onto its neighbour is re-pinched with it (fold towel, real protocol seed 47: the left hand
-    "held" the top-left corner the bottom-left one had been laid on).
+    slipped onto its neighbour is re-pinched with it (the left hand "held" the top-left corner the
+    bottom-left one had been laid on, and its grasp of the bottom-left one was refused).
     """
     return frame.objects[held].is_point and frame.objects[wanted].is_point
 
@@ -190,9 +190,9 @@ class FeasibilityChecker:
         the very object and does not let it go in an earlier step (wherever it moves, the object goes
         with it).
 
-        Single-arm pour under drops, DoReMi's seed 6: the bottle, dropped onto the right arm's open
-        fingers, rode home on them; a re-plan's left-arm grasp of it there, beside the right hand, was
-        taken as feasible (the right arm only going home), and the left arm was held back three times.
+        A bottle dropped onto the right arm's open fingers rode home on them; a re-plan's left-arm
+        grasp of it there, beside the right hand, was taken as feasible (the right arm only going
+        home), and the left arm was held back three times.
         """
         holders = {arm for arm, obj in self.robot.frame.holding if arm != grasp.arm and obj == grasp.args.obj}
         keeps_it = any(not releases_first(program, grasp, arm) for arm in holders)

@@ -154,8 +154,8 @@ class RecoverySwitching:
 
         A merge node's constraints need not read what its recovery was for: "bottle held beside the
         cup" says nothing of the cup standing. Skipping there while the cup lies on its side only
-        fires the next edge's monitor again, counted against the failure budget for nothing (p = 0.3,
-        single-arm seeds 10 and 11 ended so). Only monitors of the scene alone count: one that reads an arm
+        fires the next edge's monitor again, counted against the failure budget for nothing until it
+        ran out and ended the episode. Only monitors of the scene alone count: one that reads an arm
         (a closed-gripper monitor of an object the edge is about to grasp) reads as violated until the
         edge opens the hand, and the binding judges holds. Drift is measured from where the objects
         are now, as that edge would measure it from its start.

@@ -2,7 +2,7 @@
 
 Stages, each resuming what is on disk (``benchmarks/table3_policy.py`` is the command line):
 
-- ``record``: nominal episodes (seeds 0, 1, ..., undisturbed) and recovery episodes (seeds 1000 on,
+- ``record``: nominal episodes (seeds from 0 on, undisturbed) and recovery episodes (seeds from 1000 on,
   the cup shifted on the protocol schedule, only episodes whose recovery merged back), no cameras.
   ``record.json`` says per episode its seed, frames, recovery frames and recovery edges, and which
   recovery episodes recover from the cup moved after the grasp (the training sets' recovery demos).

@@ -82,15 +82,15 @@ def handoff_spot(
         ok &= gap >= radius + _footprint(frame, name) + OBJECT_CLEARANCE
         in_the_way |= _in_approach_corridor(spots, other.pos[:2], _footprint(frame, name), radius)
     for point in carried_to:
-        # Dual-arm pour, real seed 54: set down under where the left arm then held the cup, the bottle
-        # was knocked over by it, out of the right arm's reach.
+        # A bottle set down under where the left arm then held the cup was knocked over by it, out
+        # of the right arm's reach.
         in_the_way |= np.linalg.norm(spots - np.asarray(point[:2], dtype=float), axis=1) < radius + CARRIED_CLEARANCE
     ok &= np.linalg.norm(spots - frame.arms[taker].ee[:2], axis=1) >= TOOL_CLEARANCE
     if not ok.any():
         raise NoHandoffSpotError(obj, placer, taker)
     # Set down in the way an arm's hand comes to another object, it is knocked over when that object
-    # is taken next (dual-arm pour, stress seed 38: the bottle set down 8 cm from the cup, on the left
-    # shoulder's side, was struck by the left hand going to take the cup). Such spots only where no other is.
+    # is taken next (a bottle set down 8 cm from the cup, on the left shoulder's side, was struck by
+    # the left hand going to take the cup). Such spots only where no other is.
     if (ok & ~in_the_way).any():
         ok &= ~in_the_way
     candidates = spots[ok]

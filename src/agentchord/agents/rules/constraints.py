@@ -104,7 +104,7 @@ def over_footprint(name: str, host: SceneObject) -> str:
     misalignment). A wide one (carried by
     both arms by its ends) is long: its footprint is a rectangle in its own frame, less the
     handles at its ends. The disc would read a capsule slid along a tray, still inside it, as out
-    (planned coffee tray, real protocol, seed 2: 6.7 cm from the centre of a tray 23 cm long inside).
+    (one 6.7 cm from the centre of a tray 23 cm long inside).
     """
     half = [0.5 * host.extent[0], 0.5 * host.extent[1]]
     if not kb.is_wide(host):

@@ -86,7 +86,8 @@ def evaluate(entry: dict, where: Scene, plan: bool = True) -> Outcome:
 
     Args:
         entry: The corpus entry.
-        where: The entry's task's scene (seed 0, oracle perception: the corpus is labelled in these).
+        where: The entry's task's default scene (the first seed's layout, oracle perception): the
+            corpus is labelled in these.
         plan: Also compose the nominal graph (else the goal alone is judged).
     """
     expected = GoalSpec(goals=entry["goal"]) if "goal" in entry else None

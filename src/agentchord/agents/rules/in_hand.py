@@ -26,8 +26,8 @@ def redone_slips(graph: TaskGraph, recovery: Edge) -> list[FailureMode]:
 
     A recovery from the same source to the same target whose holding arm makes only that edge's own
     calls (a re-approach to a shifted host) carries the object the same way, under the same upright
-    bound: a slip then is the same failure (dual-arm pour, stress protocol, seed 89: the bottle
-    turned 24 deg in the hand while it was brought to the cup again, and was poured from there).
+    bound: a slip then is the same failure (a bottle turned 24 deg in the hand while it was brought
+    to a moved cup again, and was poured from there).
     """
     out = []
     for nominal in graph.nominal_edges():
@@ -60,8 +60,8 @@ def slipped(edge: Edge, before: Account, arm: str, obj: str, limit_deg: float) -
 
 def gripped_low(graph: TaskGraph, edge: Edge, before: Account) -> list[tuple[FailureMode, Edge]]:
     """The giver of a hand-over holding the bar low (a fallen bar is taken by its middle): the
-    receiver's fingers, taken low too, find no room beside it, and the bar drops in the hand-over
-    (planned handover, real protocol, seed 10). Set it down standing, take it high again."""
+    receiver's fingers, taken low too, find no room beside it, and the bar drops in the hand-over.
+    Set it down standing, take it high again."""
     path = nominal_path(graph)
     later = [graph.edge(e) for e in path[path.index(edge.id):]]
     out = []

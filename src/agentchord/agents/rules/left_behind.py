@@ -90,8 +90,8 @@ def left_behind_branches(graph: TaskGraph, edge: Edge, objects: dict[str, SceneO
         bound = upright_bounds.get(obj)
         if kb.is_tall(info) and bound is not None:
             # Past the target's own bound, not only knocked flat: a bottle pushed against the cup as the
-            # arm left leaned 17 deg there, and the goal failed with nothing left to run (planned
-            # single-arm pour, stress protocol, seed 7). 2 deg over it: a released bottle settles.
+            # arm left leaned 17 deg there, and the goal failed with nothing left to run. 2 deg over
+            # it: a released bottle settles.
             modes.append(FailureMode(name=f"{obj}_knocked", monitor=f"tipped({obj}, {bound + LEAN_MARGIN_DEG:g})", window=kb.WINDOW,
                                      intent="set upright", recovery=recovery))
         at_spot = [c for c in target if f"{obj}.pos" in c and not _names_another(c, obj, objects)]

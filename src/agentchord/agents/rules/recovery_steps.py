@@ -49,8 +49,8 @@ def _poses_itself(call: ActionCall) -> bool:
     """Whether ``call`` brings the arm to a pose of its own, whatever came before.
 
     A cloth corner's place does not: its straight way from where the corner was taken again drags
-    the cloth across the table. It is brought over its spot the nominal way first (planned fold,
-    real protocol, seed 15: laid 5-7 cm off its top corner four times over).
+    the cloth across the table (a corner laid so ended 5-7 cm off its top corner, four times over).
+    It is brought over its spot the nominal way first.
     """
     return call.fn in POSING and not (call.fn == "place" and kb.is_cloth_corner(str(call.args.get("obj", ""))))
 

@@ -193,8 +193,8 @@ def set_down_path(
     down = np.array([spot[0], spot[1], rest_height + RELEASE_CLEARANCE])
     carry = [Waypoint(above, rest_rotation, CARRY_S)]
     if over is not None and over > min(out[2], above[2]):
-        # A person lifts a bottle over the cup rather than sweeping it through (stress, p = 0.3,
-        # single-arm pour seed 4: the straight carry knocked the cup over).
+        # A person lifts a bottle over the cup rather than sweeping it through (a straight carry
+        # knocked the cup over).
         lift = max(over, out[2], above[2])
         carry = [
             Waypoint(np.array([out[0], out[1], lift]), rotation, RISE_S),
