@@ -62,12 +62,12 @@ def plan_case(name: str, record: bool = False) -> tuple[TaskGraph, list]:
 def run_episodes(task: str, graph: TaskGraph, seeds: list[int], protocol: str | None) -> list[dict]:
     """One episode per seed of ``graph`` on ``task``; each summary with its seed."""
     from agentchord.execution.episode import EpisodeSpec, run_episode
-    from agentchord.worlds.sim.disturbances import PRESETS
+    from agentchord.harness import DisturbanceSetting
 
+    setting = DisturbanceSetting.from_options(protocol=protocol)
     out = []
     for seed in seeds:
-        disturb = PRESETS[protocol] if protocol else ("drop",)
-        spec = EpisodeSpec(task=task, seed=seed, graph=graph, disturb=disturb, protocol=protocol is not None)
+        spec = EpisodeSpec(task=task, seed=seed, graph=graph, disturbances=setting)
         start = time.perf_counter()
         result = run_episode(spec)
         kinds = [f"{e['kind']} {e['obj']}" for e in result.trace.events if e["event"] == "disturbance"]

@@ -3,6 +3,7 @@ back only where it would reach the grasp alone."""
 
 import pytest
 
+from agentchord.harness import DisturbanceSetting
 from agentchord.actions import grasp as grasp_module
 from agentchord.actions.base import Status
 from agentchord.actions.controller import RobotController
@@ -63,9 +64,8 @@ def test_misses_and_hold_backs_are_counted_apart(pour_scene, outcomes, status, r
 
 def _episode(task, seed, protocol):
     from agentchord.execution.episode import EpisodeSpec, run_episode
-    from agentchord.worlds.sim.disturbances import PRESETS
 
-    return run_episode(EpisodeSpec(task, seed=seed, protocol=True, disturb=PRESETS[protocol]))
+    return run_episode(EpisodeSpec(task, seed=seed, disturbances=DisturbanceSetting.from_options(protocol=protocol)))
 
 
 def _plain_reach_above(self, robot):

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from agentchord.harness import DisturbanceSetting
 from agentchord.actions.base import Status
 from agentchord.actions.controller import RobotController
 from agentchord.actions.finger_clearance import swept_hits
@@ -136,14 +137,13 @@ def test_a_fallen_grasp_goes_over_a_neighbour_its_straight_approach_would_strike
     # rim; the fingers struck it and the cup went off the table. The hand now goes over it.
     from agentchord.actions import grasp as grasp_module
     from agentchord.execution.episode import EpisodeSpec, run_episode
-    from agentchord.worlds.sim.disturbances import PRESETS
 
     if not crosses_over:
         monkeypatch.setattr(grasp_module, "crossing_over", lambda *args: None)
         # The straight move also loses the live IK's line on the way, and the approach's detour
         # through home (motion.LINE_LOST) would then go round the cup: keep to the line, as before.
         monkeypatch.setattr(motion, "LINE_LOST", np.inf)
-    result = run_episode(EpisodeSpec("single_arm_pour_water", seed=38, protocol=True, disturb=PRESETS["stress"]))
+    result = run_episode(EpisodeSpec("single_arm_pour_water", seed=38, disturbances=DisturbanceSetting.from_options(protocol="stress")))
     if crosses_over:
         assert result.success, result.reason
     else:
@@ -159,11 +159,10 @@ def test_a_fallen_grasp_slides_along_the_object_where_a_finger_would_come_down_o
     from agentchord.actions import grasp as grasp_module
     from agentchord.actions.finger_clearance import TopGraspChoice
     from agentchord.execution.episode import EpisodeSpec, run_episode
-    from agentchord.worlds.sim.disturbances import PRESETS
 
     if not slides:
         monkeypatch.setattr(grasp_module, "clear_top_grasp", lambda *args: TopGraspChoice())
-    result = run_episode(EpisodeSpec("single_arm_pour_water", seed=58, protocol=True, disturb=PRESETS["real"]))
+    result = run_episode(EpisodeSpec("single_arm_pour_water", seed=58, disturbances=DisturbanceSetting.from_options(protocol="real")))
     if slides:
         assert result.success, result.reason
     else:
@@ -457,7 +456,6 @@ def test_a_cloth_corner_pinched_off_its_point_is_held(seed):
     # it: the fingers touch the cloth near the point); before, the off-centre check let go of it
     # three times and the episode failed ("towel_bl is held 2.8 cm off the grasp point").
     from agentchord.execution.episode import EpisodeSpec, run_episode
-    from agentchord.worlds.sim.disturbances import PRESETS
 
-    result = run_episode(EpisodeSpec("fold_towel", seed=seed, protocol=True, disturb=PRESETS["real"]))
+    result = run_episode(EpisodeSpec("fold_towel", seed=seed, disturbances=DisturbanceSetting.from_options(protocol="real")))
     assert result.success, result.reason

@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from agentchord.harness import DisturbanceSetting
 from agentchord.actions.controller import RobotController
 from agentchord.actions.make_way import NEAREST_TO_SHOULDER, STEP_BACK, make_way, step_back_pose
 from agentchord.features.oracle import OracleExtractor
@@ -102,7 +103,6 @@ def _episode(task, seed, protocol, monkeypatch, switched_off=None):
     """Run a protocol episode, with a make_way helper (as the grasp calls it) switched off."""
     from agentchord.actions import grasp as grasp_module
     from agentchord.execution.episode import EpisodeSpec, run_episode
-    from agentchord.worlds.sim.disturbances import PRESETS
 
     if switched_off is not None:
         def never(*args, **kwargs):
@@ -110,7 +110,7 @@ def _episode(task, seed, protocol, monkeypatch, switched_off=None):
             yield
 
         monkeypatch.setattr(grasp_module, switched_off, never)
-    return run_episode(EpisodeSpec(task, seed=seed, protocol=True, disturb=PRESETS[protocol]))
+    return run_episode(EpisodeSpec(task, seed=seed, disturbances=DisturbanceSetting.from_options(protocol=protocol)))
 
 
 @pytest.mark.parametrize("makes_way", [True, False])

@@ -117,7 +117,7 @@ def test_the_issue_instructions_plan_end_to_end(task, instruction):
 def test_a_sample_succeeds_when_run(task, instruction):
     from agentchord.execution.episode import EpisodeSpec, run_episode
 
-    result = run_episode(EpisodeSpec(task=task, p=0.0, seed=0, instruction=instruction))
+    result = run_episode(EpisodeSpec(task=task, seed=0, instruction=instruction))
     assert result.success, result.reason
 
 

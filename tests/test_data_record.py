@@ -12,16 +12,19 @@ pa = pytest.importorskip("pyarrow")
 pq = pytest.importorskip("pyarrow.parquet")
 
 from agentchord.data.record import record
+from agentchord.harness import DisturbanceSetting
 from agentchord.tasks import load_task_graph
 
 TASK = "single_arm_pour_water"
+#: The cup shifted on the protocol schedule (the recovery episodes of Table III).
+SHIFTS = DisturbanceSetting(kinds=("shift",), protocol="custom")
 
 
 @pytest.fixture(scope="module")
 def dataset(tmp_path_factory) -> Path:
     root = tmp_path_factory.mktemp("data") / "pour"
     # The cup shifted at the protocol's seeded moments: seeds 0 and 1 recover and succeed.
-    report = record(TASK, 2, root, protocol=True, disturb=("shift",), only_recovered=True, cameras=("top",),
+    report = record(TASK, 2, root, disturbances=SHIFTS, only_recovered=True, cameras=("top",),
                     image_size=(48, 64))
     assert len(report.written) == 2
     return root
@@ -106,7 +109,7 @@ def _read_ffmpeg(path: Path) -> np.ndarray:
 
 
 def test_same_seed_same_episode(dataset: Path, tmp_path: Path) -> None:
-    again = record(TASK, 1, tmp_path / "again", protocol=True, disturb=("shift",), only_recovered=True, cameras=())
+    again = record(TASK, 1, tmp_path / "again", disturbances=SHIFTS, only_recovered=True, cameras=())
     assert again.written[0]["seed"] == 0
     first = _frames(dataset)
     second = _frames(tmp_path / "again")

@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from agentchord.harness import DisturbanceSetting
 from agentchord.execution.baselines.vqa import SimulatedVqa
 from agentchord.execution.episode import EpisodeSpec, run_episode
 from agentchord.execution.reasoning import LatencyModel, ReasoningConfig
@@ -23,7 +24,7 @@ def _events(result, kind: str) -> list[dict]:
 
 
 def _run(method: str, seed: int, p: float = 0.05):
-    return run_episode(EpisodeSpec(TASK, strategy=method, p=p, seed=seed, reasoning=ReasoningConfig()))
+    return run_episode(EpisodeSpec(TASK, strategy=method, disturbances=DisturbanceSetting(p=p), seed=seed, reasoning=ReasoningConfig()))
 
 
 def test_simulated_vqa_answers_the_truth_then_flips_with_its_rates():
@@ -53,7 +54,7 @@ def test_latency_model_parses_and_refuses():
 
 def test_sequential_agentchord_and_its_ablation_wait_for_the_three_agents():
     flat = ReasoningConfig(latency=LatencyModel())
-    runs = {m: run_episode(EpisodeSpec(TASK, strategy=m, p=0.05, seed=0, reasoning=flat))
+    runs = {m: run_episode(EpisodeSpec(TASK, strategy=m, disturbances=DisturbanceSetting(p=0.05), seed=0, reasoning=flat))
             for m in ("agentchord-sequential", "agentchord-bt")}
     for result in runs.values():
         # The ablation's monitors are the arranger's failure modes: it is asked too (paper App. E-C).

@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from agentchord.harness import DisturbanceSetting
 from agentchord.execution.binding import RECENT_HOLD_TICKS, Binding, Hold, HoldMemory
 from agentchord.execution.edge_program import EdgeProgram
 from agentchord.features.frame import make_static_frame
@@ -104,10 +105,9 @@ def test_a_recovery_waits_for_a_person_to_set_a_pulled_object_down(wait_ticks):
     # their failure budget, real protocol seed 15.)
     from agentchord.execution.episode import EpisodeSpec, run_episode
     from agentchord.execution.executor import ExecutorConfig
-    from agentchord.worlds.sim.disturbances import PRESETS
 
     config = None if wait_ticks is None else ExecutorConfig(bind_rigid_wait_ticks=wait_ticks)
-    result = run_episode(EpisodeSpec("single_arm_pour_water", seed=48, protocol=True, disturb=PRESETS["real"], config=config))
+    result = run_episode(EpisodeSpec("single_arm_pour_water", seed=48, disturbances=DisturbanceSetting.from_options(protocol="real"), config=config))
     if wait_ticks is None:
         assert result.success, result.reason
         assert max(b["waited_ticks"] for b in result.trace.of("recovery_bound")) > 100

@@ -9,7 +9,8 @@ from agentchord.execution.episode import EpisodeSpec, run_episode
 from agentchord.execution.executor import Executor, ExecutorConfig
 from agentchord.execution.strategies import make_strategy
 from agentchord.tasks import load_task_graph
-from agentchord.worlds.sim.disturbances import KINDS, PRESETS, ScriptedDisturbance, ScriptedDrop
+from agentchord.harness import KINDS, DisturbanceSetting
+from agentchord.worlds.sim.disturbances import ScriptedDisturbance, ScriptedDrop
 from agentchord.worlds.sim.tasks import SIM_TASKS
 from agentchord.harness import Verdict
 from agentchord.worlds.sim.trial import open_world
@@ -68,7 +69,7 @@ def test_a_hold_that_comes_back_as_it_was_resumes_the_interrupted_edge(after):
 def test_a_hold_caught_again_lower_in_the_hand_is_regrasped_not_resumed():
     # Seed 10, p = 0.05: the drop as the grasp lifts lets the bottle slide 5 cm down the fingers before
     # they close on it again; carried on, the pour misses. That hold is not the one that was lost.
-    result = run_episode(EpisodeSpec(TASK, p=0.05, seed=10))
+    result = run_episode(EpisodeSpec(TASK, disturbances=DisturbanceSetting(p=0.05), seed=10))
     assert result.success, result.reason
     assert result.trace.of("failure_cleared") == []
     assert "e1_r_bottle_dropped" in result.path
@@ -82,7 +83,7 @@ def test_a_utensil_that_falls_where_it_was_being_placed_is_let_go_of_not_picked_
         if executor.program is not None and executor.program.edge_id == "e3_r_spoon_dropped":
             heights.append(float(executor.frame.objects["spoon"].pos[2]))
 
-    result = run_episode(EpisodeSpec("rearrange_table", p=0.05, seed=0), on_tick=watch)
+    result = run_episode(EpisodeSpec("rearrange_table", disturbances=DisturbanceSetting(p=0.05), seed=0), on_tick=watch)
     assert result.success, result.reason
     assert "e3_r_spoon_dropped" in result.path and heights
     assert max(heights) < 0.03  # never lifted off the table again
@@ -108,7 +109,7 @@ def test_agentchord_recovers_in_fewer_steps_than_backtracking_for_the_same_drop(
 
 
 def test_same_seed_gives_the_same_trace():
-    traces = [run_episode(EpisodeSpec(TASK, p=0.3, seed=5)).trace.events for _ in range(2)]
+    traces = [run_episode(EpisodeSpec(TASK, disturbances=DisturbanceSetting(p=0.3), seed=5)).trace.events for _ in range(2)]
     assert traces[0] == traces[1]
     assert any(e["event"] == "disturbance" for e in traces[0])
 
@@ -280,11 +281,11 @@ def test_the_bottle_taken_again_is_not_carried_to_a_cup_still_lying_there():
     # is pulled from the hand as the cup's righting begins. Taken again, the bottle went on to the
     # lying cup (it struck it and slipped, and the episode ran out of time); the continuation edge
     # now watches the cup, and the cup is set upright first.
-    result = run_episode(EpisodeSpec(TASK, seed=4, disturb=PRESETS["stress"], protocol=True))
+    result = run_episode(EpisodeSpec(TASK, seed=4, disturbances=DisturbanceSetting.from_options(protocol="stress")))
     assert result.success, result.reason
     assert _cup_tipped_switches(result) == [("e2", "e2_r_cup_tipped"), ("r_bottle_regrasped_to_v2", "r_bottle_regrasped_r_cup_tipped")]
     # Without the watch, the same episode fails.
-    blind = run_episode(EpisodeSpec(TASK, seed=4, disturb=PRESETS["stress"], protocol=True, graph=_continuation_blind_to_the_cup()))
+    blind = run_episode(EpisodeSpec(TASK, seed=4, disturbances=DisturbanceSetting.from_options(protocol="stress"), graph=_continuation_blind_to_the_cup()))
     assert not blind.success
 
 
@@ -295,7 +296,7 @@ def test_a_recovery_is_not_skipped_to_a_merge_node_the_next_edge_fails_at_once(s
     # lies: e3_r_cup_tipped runs, and cup_tipped fires once on e3, not again after a skip to v2.
     # (The library graph's continuation edge now catches the lying cup before v2: the graph
     # without that watch keeps the case the guard is for.)
-    result = run_episode(EpisodeSpec(TASK, seed=4, p=0.3, disturb=KINDS, graph=_continuation_blind_to_the_cup()))
+    result = run_episode(EpisodeSpec(TASK, seed=4, disturbances=DisturbanceSetting(p=0.3, kinds=KINDS), graph=_continuation_blind_to_the_cup()))
     assert result.success, result.reason
     assert _cup_tipped_switches(result) == [("e2", "e2_r_cup_tipped"), ("e3", "e3_r_cup_tipped")]
     assert result.trace.of("subgoal_met") == []
@@ -310,7 +311,7 @@ def test_a_recovery_is_skipped_to_its_merge_node_once_not_round_and_round(monkey
     from agentchord.execution.switching import RecoverySwitching
 
     monkeypatch.setattr(RecoverySwitching, "_leaving_fails_at_once", lambda self, node_id: False)
-    result = run_episode(EpisodeSpec(TASK, seed=4, p=0.3, disturb=KINDS, graph=_continuation_blind_to_the_cup()))
+    result = run_episode(EpisodeSpec(TASK, seed=4, disturbances=DisturbanceSetting(p=0.3, kinds=KINDS), graph=_continuation_blind_to_the_cup()))
     assert _cup_tipped_switches(result)[:3] == [("e2", "e2_r_cup_tipped"), ("e3", "e3_r_cup_tipped"), ("e3", "e3_r_cup_tipped")]
     skips = [m for m in result.trace.of("subgoal_met") if m["edge"] == "e3_r_cup_tipped"]
     assert skips and skips[0]["node"] == "v2"

@@ -9,7 +9,7 @@ from gymnasium.utils.env_checker import check_env
 
 import agentchord.gym
 from agentchord.gym.aloha import joint_action
-from agentchord.gym.env import AgentChordEnv, disturbance_kinds
+from agentchord.gym.env import AgentChordEnv, disturbance_setting
 from agentchord.worlds.sim.tasks import SIM_TASKS
 
 
@@ -68,12 +68,14 @@ def test_a_shift_disturbance_moves_an_object_at_its_seeded_moment() -> None:
     assert np.abs(moved[-1, 14:] - quiet[-1, 14:]).max() > 0.02
 
 
-def test_disturbance_kinds() -> None:
-    assert disturbance_kinds(None) == ()
-    assert disturbance_kinds("real") == ("perturb", "pull")
-    assert disturbance_kinds("drop,shift") == ("drop", "shift")
+def test_disturbance_setting() -> None:
+    assert disturbance_setting(None) is None
+    real = disturbance_setting("real", (10, 20))
+    assert (real.kinds, real.protocol, real.window) == (("perturb", "pull"), "real", (10, 20))
+    assert disturbance_setting("drop,shift").kinds == ("drop", "shift") == disturbance_setting(["drop", "shift"]).kinds
+    assert disturbance_setting("drop,shift").protocol == "custom"
     with pytest.raises(ValueError):
-        disturbance_kinds("teleport")
+        disturbance_setting("teleport")
 
 
 def test_replaying_an_agentchord_episode_succeeds_in_the_env() -> None:

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from agentchord.harness import DisturbanceSetting
 from agentchord.actions.base import Status
 from agentchord.actions.controller import RobotController
 from agentchord.actions.library import make_action
@@ -233,11 +234,10 @@ def test_a_hand_off_is_not_set_down_where_the_cup_is_held_next(kept_clear, monke
     # over by the left arm at (-0.10, 0.72); the left arm then took the cup and held it at (-0.12, 0.72),
     # knocking the bottle over, out of the right arm's reach.
     from agentchord.execution import edge_program
-    from agentchord.worlds.sim.disturbances import PRESETS
 
     if not kept_clear:
         monkeypatch.setattr(edge_program, "_link_handoffs_to_later_moves", lambda steps: None)
-    result = run_episode(EpisodeSpec("dual_arm_pour_water", seed=54, protocol=True, disturb=PRESETS["real"]))
+    result = run_episode(EpisodeSpec("dual_arm_pour_water", seed=54, disturbances=DisturbanceSetting.from_options(protocol="real")))
     assert result.trace.of("recovery_bound")[0]["edge"] == "e5_r_bottle_dropped_via_left"
     assert result.success == kept_clear, result.reason
 
@@ -248,13 +248,12 @@ def test_a_bottle_that_turns_in_the_hand_while_brought_to_the_cup_again_is_resea
     # re-approach (e3_r_cup_shifted) brings the bottle to it again, and the bottle turns 24 deg in
     # the hand on the way. Watched for the slip as e3 is, it is set down and taken again before the
     # pour; unwatched, the pour starts from the tilted hold and misses the cup.
-    from agentchord.worlds.sim.disturbances import PRESETS
 
     graph = load_task_graph("dual_arm_pour_water")
     if not watched:
         edge = graph.edge("e3_r_cup_shifted")
         edge.failures = [f for f in edge.failures if f.name != "bottle_slipped"]
-    result = run_episode(EpisodeSpec("dual_arm_pour_water", seed=89, protocol=True, disturb=PRESETS["stress"], graph=graph))
+    result = run_episode(EpisodeSpec("dual_arm_pour_water", seed=89, disturbances=DisturbanceSetting.from_options(protocol="stress"), graph=graph))
     assert result.success is watched, result.reason
     if not watched:
         assert "never reached a pouring orientation" in result.reason

@@ -13,7 +13,7 @@ from agentchord.features.oracle import OracleExtractor
 from agentchord.graph.progress import forward_filter, nominal_path
 from agentchord.graph.validation import check_graph
 from agentchord.tasks import load_task_graph
-from agentchord.harness import DisturbanceEvent
+from agentchord.harness import DisturbanceEvent, DisturbanceSetting
 from agentchord.worlds.sim.disturbances import ScriptedDrop
 from agentchord.worlds.sim.tasks import SIM_TASKS
 from agentchord.worlds.sim.tasks.handover_block import TARGET_RADIUS, TARGET_XY, HandoverTracker
@@ -180,11 +180,10 @@ def test_a_block_taken_askew_at_the_hand_over_is_set_upright_in_hand_before_it_i
     # was dragged over by the retreat (then out of both arms' reach: "unrecoverable", until the
     # approach's detour where the live IK loses its line took it from there).
     from agentchord.actions import place
-    from agentchord.worlds.sim.disturbances import PRESETS
 
     if max_tilt is not None:
         monkeypatch.setattr(place, "UPRIGHT_IN_HAND_MAX_DEG", max_tilt)
-    result = run_episode(EpisodeSpec(TASK, seed=43, protocol=True, disturb=PRESETS["real"]))
+    result = run_episode(EpisodeSpec(TASK, seed=43, disturbances=DisturbanceSetting.from_options(protocol="real")))
     knocked_at_the_place = [d for d in result.trace.of("failure_detected") if d["edge"] == "e5"]
     if max_tilt is None:
         assert result.success, result.reason
@@ -201,11 +200,10 @@ def test_a_block_pushed_out_of_the_left_arms_reach_during_its_first_grasp_is_tak
     # could fire. Taken as that monitor's failure, the pre-compiled recovery's right-arm alternative
     # takes it; without that rule the episode ended with the skill's failure.
     from agentchord.execution.strategies import RecoveryStrategy
-    from agentchord.worlds.sim.disturbances import PRESETS
 
     if not taken_as_anticipated:
         monkeypatch.setattr(RecoveryStrategy, "on_program_failure", lambda self, executor, program: None)
-    result = run_episode(EpisodeSpec(TASK, seed=52, protocol=True, disturb=PRESETS["real"]))
+    result = run_episode(EpisodeSpec(TASK, seed=52, disturbances=DisturbanceSetting.from_options(protocol="real")))
     if taken_as_anticipated:
         assert result.success, result.reason
         assert result.trace.of("action_failed")[0]["edge"] == "e1"

@@ -10,7 +10,7 @@ from agentchord.features.oracle import OracleExtractor
 from agentchord.graph.progress import forward_filter, nominal_path
 from agentchord.graph.validation import check_graph
 from agentchord.tasks import load_task_graph
-from agentchord.harness import DisturbanceEvent
+from agentchord.harness import DisturbanceEvent, DisturbanceSetting
 from agentchord.worlds.sim.disturbances import ScriptedDrop
 from agentchord.worlds.sim.tasks import SIM_TASKS
 from agentchord.worlds.sim.tasks.rearrange_table import TARGET_OFFSET, long_axis_yaw_deg, yaw_error_deg
@@ -162,14 +162,13 @@ def test_a_fork_that_flipped_over_is_grasped_lying_flat(level, monkeypatch):
     # grasp aimed 5 cm above it and the fingers closed on nothing three times.
     from agentchord.actions import top_grasp
     from agentchord.features.frame import tilt_deg
-    from agentchord.worlds.sim.disturbances import PRESETS
 
     if not level:
         monkeypatch.setattr(top_grasp, "level_tilt_deg", tilt_deg)
         # Taken as lying on its side, a flat fork would now be taken as one on its edge, at its own
         # height (top_grasp.on_its_edge): keep the old reading, a bottle lying down.
         monkeypatch.setattr(top_grasp, "on_its_edge", lambda feats: False)
-    result = run_episode(EpisodeSpec(TASK, seed=45, protocol=True, disturb=PRESETS["stress"]))
+    result = run_episode(EpisodeSpec(TASK, seed=45, disturbances=DisturbanceSetting.from_options(protocol="stress")))
     if level:
         assert result.success, result.reason
     else:

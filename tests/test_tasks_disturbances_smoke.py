@@ -4,7 +4,8 @@ import pytest
 
 from agentchord.execution.episode import EpisodeSpec, run_episode
 from agentchord.tasks import library_tasks
-from agentchord.worlds.sim.disturbances import KINDS, ScriptedDisturbance
+from agentchord.harness import KINDS, DisturbanceSetting
+from agentchord.worlds.sim.disturbances import ScriptedDisturbance
 from agentchord.worlds.sim.tasks import SIM_TASKS
 
 TASKS = sorted(set(SIM_TASKS) & set(library_tasks()))
@@ -14,7 +15,7 @@ TASKS = sorted(set(SIM_TASKS) & set(library_tasks()))
 @pytest.mark.parametrize("kind", KINDS)
 @pytest.mark.parametrize("task", TASKS)
 def test_task_runs_to_a_verdict_under_each_disturbance_kind(task, kind):
-    result = run_episode(EpisodeSpec(task, p=0.3, seed=1, disturb=(kind,)))
+    result = run_episode(EpisodeSpec(task, disturbances=DisturbanceSetting(p=0.3, kinds=(kind,)), seed=1))
     # Success is not guaranteed under heavy disturbance; a verdict with a reason is.
     assert result.reason
     assert all(e["kind"] == kind for e in result.trace.of("disturbance"))
@@ -28,7 +29,7 @@ def _recoveries(result) -> list[str]:
 def test_a_bottle_pushed_askew_in_its_grasp_is_set_down_and_taken_again():
     # Real-world protocol, seed 10: the bottle is pushed while the fingers close and ends 21 deg askew
     # in the hand; a pour from that hold misses the cup. The anticipated slipped-grasp branch fires.
-    result = run_episode(EpisodeSpec("single_arm_pour_water", seed=10, protocol=True, disturb=("perturb", "pull")))
+    result = run_episode(EpisodeSpec("single_arm_pour_water", seed=10, disturbances=DisturbanceSetting(kinds=("perturb", "pull"), protocol="custom")))
     assert result.success, result.reason
     assert "e2_r_bottle_slipped" in _recoveries(result)
 
@@ -56,7 +57,7 @@ def test_a_bottle_knocked_over_as_it_is_taken_again_is_taken_as_a_fallen_one():
     # Stress protocol, seed 19: the bottle pulled out of the hand during the pour is set down upright;
     # the regrasp's approach knocks it over and used to close on it lying, carrying it across the
     # fingers to a pour that never came. The grasp now sees it fell and takes it as a fallen one.
-    result = run_episode(EpisodeSpec("dual_arm_pour_water", seed=19, protocol=True, disturb=KINDS))
+    result = run_episode(EpisodeSpec("dual_arm_pour_water", seed=19, disturbances=DisturbanceSetting(kinds=KINDS, protocol="custom")))
     assert result.success, result.reason
     assert _recoveries(result) == ["e4_r_bottle_dropped"]
 
@@ -67,7 +68,7 @@ def test_a_fork_pushed_against_the_plate_is_taken_farther_along_its_length():
     # moved): the fork, placed, is pushed against the plate's rim. Taken at its centre, a finger
     # comes down on the rim and the tool stops 1.5 cm above the grasp ("stopped short"); the grasp
     # slides along the fork.
-    result = run_episode(EpisodeSpec("rearrange_table", seed=86, protocol=True, disturb=KINDS))
+    result = run_episode(EpisodeSpec("rearrange_table", seed=86, disturbances=DisturbanceSetting(kinds=KINDS, protocol="custom")))
     assert result.success, result.reason
     assert _recoveries(result) == ["e4_r_fork_moved"]
 
@@ -76,12 +77,12 @@ def test_a_capsule_dropped_against_the_tray_handle_is_taken_with_the_fingers_tur
     # Stress protocol, seed 13: the capsule drops against the tray's handle; taken with the fingers
     # closing toward the handle, one finger came down on it three times ("fingers closed but capsule
     # is not held") and the right arm could not reach. The fingers now turn off the handle.
-    result = run_episode(EpisodeSpec("setup_coffee_tray", seed=13, protocol=True, disturb=KINDS))
+    result = run_episode(EpisodeSpec("setup_coffee_tray", seed=13, disturbances=DisturbanceSetting(kinds=KINDS, protocol="custom")))
     assert result.success, result.reason
     assert _recoveries(result) == ["e2_r_capsule_dropped"]
 
 
-HEAVY = {"p": 0.3, "disturb": KINDS}
+HEAVY = {"disturbances": DisturbanceSetting(p=0.3, kinds=KINDS)}
 
 
 def _pour_node(result, node: str) -> dict:
@@ -122,7 +123,7 @@ def test_an_arm_that_falls_short_of_a_pushed_object_is_not_blamed_on_the_other_a
     # the arm stops short with its links 5 cm clear of the other arm's; the reason used to say "the
     # other arm was in the way".
     _top_grasps_at_the_centre(monkeypatch, report_blocked=False)
-    result = run_episode(EpisodeSpec("rearrange_table", seed=86, protocol=True, disturb=KINDS))
+    result = run_episode(EpisodeSpec("rearrange_table", seed=86, disturbances=DisturbanceSetting(kinds=KINDS, protocol="custom")))
     assert not result.success
     assert "stopped short of the grasp of fork" in result.reason
     assert "in the way" not in result.reason
@@ -133,7 +134,7 @@ def test_fingers_that_come_down_on_a_neighbour_are_named_in_the_reason(monkeypat
     # the fork away from the plate: the reason says what they came down on.
     _top_grasps_at_the_centre(monkeypatch, report_blocked=True)
     monkeypatch.setattr("agentchord.actions.grasp.Grasp.DRAGS", 0)
-    result = run_episode(EpisodeSpec("rearrange_table", seed=86, protocol=True, disturb=KINDS))
+    result = run_episode(EpisodeSpec("rearrange_table", seed=86, disturbances=DisturbanceSetting(kinds=KINDS, protocol="custom")))
     assert not result.success
     assert "the open fingers came down on plate beside fork" in result.reason
 
@@ -141,7 +142,7 @@ def test_fingers_that_come_down_on_a_neighbour_are_named_in_the_reason(monkeypat
 def test_a_fork_the_fingers_come_down_beside_is_dragged_off_the_plate_and_taken(monkeypatch):
     # The same again with the drag (actions/drag_clear.py): the fork is dragged clear and taken.
     _top_grasps_at_the_centre(monkeypatch, report_blocked=True)
-    result = run_episode(EpisodeSpec("rearrange_table", seed=86, protocol=True, disturb=KINDS))
+    result = run_episode(EpisodeSpec("rearrange_table", seed=86, disturbances=DisturbanceSetting(kinds=KINDS, protocol="custom")))
     assert result.success, result.reason
 
 
@@ -196,7 +197,7 @@ def test_a_recovery_whose_scene_changed_under_it_is_bound_once_more():
     # Stress protocol, seed 2: the cup drops at its spot and lands placed (the regrasp only opens the
     # hand); then it is knocked over before the place step, which finds it neither held nor placed.
     # The recovery is bound again from there and this time takes the cup again.
-    result = run_episode(EpisodeSpec("dual_arm_pour_water", seed=2, protocol=True, disturb=KINDS))
+    result = run_episode(EpisodeSpec("dual_arm_pour_water", seed=2, disturbances=DisturbanceSetting(kinds=KINDS, protocol="custom")))
     assert result.success, result.reason
     failed = result.trace.of("recovery_failed")
     assert [f["edge"] for f in failed] == ["e6_r_cup_dropped"]

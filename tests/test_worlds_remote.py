@@ -12,6 +12,7 @@ import zmq
 import pytest
 from click.testing import CliRunner
 
+from agentchord.harness import DisturbanceSetting
 from agentchord.cli import main
 from agentchord.execution.episode import EpisodeSpec, run_episode
 from agentchord.execution.executor import ExecutorConfig
@@ -153,8 +154,8 @@ def test_run_refuses_video_and_bad_addresses_with_the_world_option(tmp_path):
 # ---------------------------------------------------------------------------- end to end, slow
 @pytest.mark.slow
 @pytest.mark.parametrize(("task", "seed", "options"), [
-    ("single_arm_pour_water", 3, {"p": 0.1}),
-    ("handover_block", 2, {"protocol": True, "disturb": ("perturb", "pull")}),
+    ("single_arm_pour_water", 3, {"disturbances": DisturbanceSetting(p=0.1)}),
+    ("handover_block", 2, {"disturbances": DisturbanceSetting.from_options(disturb=("perturb", "pull"), protocol="custom")}),
 ])
 def test_same_seed_same_episode_local_and_remote(task, seed, options):
     address, stop, thread = serve_in_thread(task)

@@ -5,7 +5,8 @@ import pytest
 
 from agentchord.actions.library import make_action
 from agentchord.execution.episode import EpisodeSpec, run_episode
-from agentchord.worlds.sim.disturbances import KINDS, ProtocolDisturbances, RandomDisturbances, ScriptedDisturbance, parse_kinds
+from agentchord.harness import KINDS, DisturbanceSetting, parse_kinds
+from agentchord.worlds.sim.disturbances import ProtocolDisturbances, RandomDisturbances, ScriptedDisturbance
 
 TASK = "single_arm_pour_water"
 
@@ -65,13 +66,13 @@ def test_protocol_injects_one_or_two_disturbances_identically_for_both_strategie
         assert 1 <= len(schedule._due) <= 2
         counts.append(len(schedule._due))
     assert ProtocolDisturbances(7)._due == ProtocolDisturbances(7)._due
-    firsts = [run_episode(EpisodeSpec(TASK, strategy=s, seed=1, protocol=True, disturb=KINDS)).trace.of("disturbance")[:1]
+    firsts = [run_episode(EpisodeSpec(TASK, strategy=s, seed=1, disturbances=DisturbanceSetting(kinds=KINDS, protocol="custom"))).trace.of("disturbance")[:1]
               for s in ("agentchord", "agentchord-bt")]
     assert firsts[0] == firsts[1] and firsts[0]
 
 
 def test_presets_name_the_papers_protocols():
-    from agentchord.worlds.sim.disturbances import PRESETS
+    from agentchord.harness import PRESETS
 
     assert PRESETS["real"] == ("perturb", "pull") and PRESETS["stress"] == KINDS
 

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 
 from agentchord.execution.episode import EpisodeSpec, run_episode
 from agentchord.execution.reasoning import ReasoningConfig
+from agentchord.harness import DisturbanceSetting
 
 #: Version of the record layout (a record names it; a reader refuses another).
 RECORD_VERSION = 1
@@ -46,6 +47,11 @@ class Condition:
             return f"protocol={self.protocol}"
         short = f"{self.p:g}"
         return f"p={short}" if float(short) == self.p else f"p={self.p!r}"
+
+    @property
+    def setting(self) -> DisturbanceSetting:
+        """The disturbance setting it stands for (drops at ``p``, or the protocol preset's kinds)."""
+        return DisturbanceSetting.from_options(p=0.0 if self.protocol else self.p, protocol=self.protocol)
 
     @classmethod
     def from_label(cls, label: str) -> Condition:
@@ -113,18 +119,15 @@ def sweep_keys(tasks: list[str], methods: list[str], conditions: list[Condition]
 
 def episode_spec(key: EpisodeKey, config: SweepConfig) -> EpisodeSpec:
     """The episode a key names, under the sweep's config."""
-    from agentchord.worlds.sim.disturbances import PRESETS
-
     from agentchord.tasks import load_task_graph
 
     condition = key.condition
-    disturb = PRESETS[condition.protocol] if condition.protocol else ("drop",)
     # With an LLM the plan is made (and timed) in the episode, from the instruction of the graph
     # the rules run; the rules' graph is the task library's (their calls are modelled).
     instruction = load_task_graph(key.task).instruction if config.reasoner == "llm" else None
     return EpisodeSpec(
-        task=key.task, strategy=key.method, p=condition.p, seed=key.seed, disturb=disturb,
-        protocol=condition.protocol is not None, perception=config.perception, reasoning=config.reasoning,
+        task=key.task, strategy=key.method, seed=key.seed, disturbances=condition.setting,
+        perception=config.perception, reasoning=config.reasoning,
         instruction=instruction, reasoner=config.reasoner,
     )
 

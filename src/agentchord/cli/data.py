@@ -10,7 +10,7 @@ from agentchord.cli.support import BadInput, FiniteFloatRange, catches_sigterm
 
 
 def _kinds(ctx, param, value: str) -> tuple[str, ...]:
-    from agentchord.worlds.sim.disturbances import parse_kinds
+    from agentchord.harness import parse_kinds
 
     try:
         return parse_kinds(value)
@@ -57,8 +57,8 @@ def record_command(task, episodes, out, p, disturb, protocol, only_recovered, ke
     """
     import sys
 
+    from agentchord.cli.support import disturbance_setting
     from agentchord.tasks import library_tasks
-    from agentchord.worlds.sim.disturbances import PRESETS
     from agentchord.worlds.sim.tasks import SIM_TASKS
 
     if task not in SIM_TASKS:
@@ -68,9 +68,9 @@ def record_command(task, episodes, out, p, disturb, protocol, only_recovered, ke
     cameras = () if tuple(cameras) == ("none",) else tuple(cameras)
     from agentchord.data.record import ResumeError, record_settings, recorded_state
 
-    kinds = PRESETS.get(protocol or "", disturb)
+    disturbances = disturbance_setting(p, disturb, protocol)
     try:
-        state = recorded_state(out, record_settings(task, p, kinds, protocol is not None, only_recovered, keep_failed, seed,
+        state = recorded_state(out, record_settings(task, disturbances, only_recovered, keep_failed, seed,
                                                     cameras, size, "agentchord"))
     except ResumeError as exc:
         raise BadInput(f"--out {out}: {exc}") from None
@@ -94,7 +94,7 @@ def record_command(task, episodes, out, p, disturb, protocol, only_recovered, ke
                           f"{entry['recovery_frames']} recovery frames")
 
     try:
-        report = record(task, episodes, out, p=p, disturb=kinds, protocol=protocol is not None, only_recovered=only_recovered,
+        report = record(task, episodes, out, disturbances=disturbances, only_recovered=only_recovered,
                         keep_failed=keep_failed, seed=seed, max_tries=max_tries, cameras=cameras, image_size=size,
                         progress=progress)
     except ResumeError as exc:

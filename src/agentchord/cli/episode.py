@@ -16,6 +16,7 @@ from agentchord.cli.support import (
     BadInput,
     FiniteFloatRange,
     check_outputs,
+    disturbance_setting,
     check_task_name,
     failed_calls_trace,
     load_goal_option,
@@ -33,15 +34,8 @@ PROTOCOL_HELP = ("1-2 disturbances at random moments of each trial (ignores --p)
                  "real-world protocol, Table II), 'stress' = all five kinds; bare --protocol (= custom) uses --disturb.")
 
 
-def _protocol_kinds(protocol: str | None, disturb: tuple[str, ...]) -> tuple[str, ...]:
-    """The disturbance kinds a protocol preset stands for (``custom`` and no protocol: ``--disturb``)."""
-    from agentchord.worlds.sim.disturbances import PRESETS
-
-    return PRESETS.get(protocol or "", disturb)
-
-
 def _kinds(ctx, param, value: str) -> tuple[str, ...]:
-    from agentchord.worlds.sim.disturbances import parse_kinds
+    from agentchord.harness import parse_kinds
 
     try:
         return parse_kinds(value)
@@ -140,8 +134,7 @@ def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, inst
         caption = f"{task}  node {executor.node}  edge {program.edge_id if program else '-'} ({program.kind if program else ''})"
         video.capture(caption)
 
-    disturb = _protocol_kinds(protocol, disturb)
-    spec = EpisodeSpec(task=task, strategy=strategy, p=p, seed=seed, graph=graph, disturb=disturb, protocol=protocol is not None,
+    spec = EpisodeSpec(task=task, strategy=strategy, seed=seed, graph=graph, disturbances=disturbance_setting(p, disturb, protocol),
                        perception=perception, instruction=instruction, goal=goal, reasoner=reasoner, repair=repair,
                        world=world)
     # Ctrl-C or SIGTERM (@catches_sigterm) release the renderer; _write_video leaves no temporary file.
@@ -378,9 +371,9 @@ def demo(task, trials, first_seed, p, disturb, protocol, perception, strategies,
         raise click.BadParameter("one remote world runs one episode at a time: use --workers 1 with --world", param_hint="--workers")
     check_outputs(("--json", json_path, ()))
     console = Console()
-    disturb = _protocol_kinds(protocol, disturb)
+    setting = disturbance_setting(p, disturb, protocol)
     schedule = f"1-2 disturbances per trial ({protocol} protocol)" if protocol else f"probability p = {p} per atomic action"
-    console.print(f"[bold]{task}[/bold]: {trials} seeded episodes per strategy; disturbances {', '.join(disturb)}, "
+    console.print(f"[bold]{task}[/bold]: {trials} seeded episodes per strategy; disturbances {', '.join(setting.kinds)}, "
                   f"{schedule}; perception {perception}")
     if planned and instruction is None:
         from agentchord.tasks import load_task_graph
@@ -390,7 +383,7 @@ def demo(task, trials, first_seed, p, disturb, protocol, perception, strategies,
         console.print(f"graphs planned per episode by the {reasoner} reasoner from: {instruction!r}")
     if world is not None:
         console.print(f"world: {world} (one episode at a time)")
-    specs = [EpisodeSpec(task=task, strategy=name, p=p, seed=seed, disturb=disturb, protocol=protocol is not None,
+    specs = [EpisodeSpec(task=task, strategy=name, seed=seed, disturbances=setting,
                          perception=perception, instruction=instruction, reasoner=reasoner, world=world)
              for name in names for seed in range(first_seed, first_seed + trials)]
     summaries: dict[str, list[dict]] = {name: [] for name in names}
@@ -408,7 +401,7 @@ def demo(task, trials, first_seed, p, disturb, protocol, perception, strategies,
     paired = paired_steps(summaries)
     print_tables(results, console, paired)
     if json_path:
-        payload = {"task": task, "p": p, "trials": trials, "first_seed": first_seed, "disturb": list(disturb), "protocol": protocol,
+        payload = {"task": task, "p": p, "trials": trials, "first_seed": first_seed, "disturb": list(setting.kinds), "protocol": protocol,
                    "perception": perception, "instruction": instruction, "reasoner": reasoner if instruction else None,
                    "strategies": results, "paired_steps": paired,
                    "world": world, "runs": summaries}

@@ -301,3 +301,13 @@ def failed_calls_trace(error, trace_path) -> str:
         return f"\n(the agents' calls, refused replies included: {trace.write(trace_path)})"
     except OSError as exc:
         return f"\n(the agents' calls could not be written to {trace_path}: {exc})"
+
+
+def disturbance_setting(p: float, disturb: tuple[str, ...], protocol: str | None):
+    """The :class:`~agentchord.harness.DisturbanceSetting` of ``--p``, ``--disturb`` and ``--protocol``."""
+    from agentchord.harness import DisturbanceSetting
+
+    try:
+        return DisturbanceSetting.from_options(p, disturb, protocol)
+    except ValueError as exc:
+        raise click.BadParameter(str(exc)) from exc

@@ -29,6 +29,7 @@ from agentchord.guard.outputs import atomic_write_text
 from agentchord.gym.aloha import JOINT_NAMES, environment_names, environment_state, joint_action, joint_state
 from agentchord.gym.cameras import RgbCameras
 from agentchord.tasks import load_task_graph
+from agentchord.harness import UNDISTURBED, DisturbanceSetting
 from agentchord.worlds.protocol import CONTROL_HZ
 
 #: Cameras recorded by default (ALOHA's high camera and the right wrist).
@@ -85,11 +86,11 @@ def recorded_state(out: str | Path, settings: dict) -> dict | None:
     return meta
 
 
-def record_settings(task: str, p: float, disturb: tuple[str, ...], protocol: bool, only_recovered: bool,
+def record_settings(task: str, disturbances: DisturbanceSetting, only_recovered: bool,
                     keep_failed: bool, seed: int, cameras: tuple[str, ...], image_size: tuple[int, int],
                     strategy: str) -> dict:
     """What decides a recording's episodes: a resumed recording must have the same."""
-    return {"task": task, "p": float(p), "disturb": list(disturb), "protocol": bool(protocol),
+    return {"task": task, "p": float(disturbances.p), "disturb": list(disturbances.kinds), "protocol": disturbances.protocol is not None,
             "only_recovered": bool(only_recovered), "keep_failed": bool(keep_failed), "first_seed": int(seed),
             "cameras": list(cameras), "image_size": list(image_size), "strategy": strategy}
 
@@ -190,8 +191,8 @@ class EpisodeRecorder:
             self._renderer = None
 
 
-def record(task: str, episodes: int, out: str | Path, *, p: float = 0.0, disturb: tuple[str, ...] = ("drop",),
-           protocol: bool = False, only_recovered: bool = False, keep_failed: bool = False, seed: int = 0,
+def record(task: str, episodes: int, out: str | Path, *, disturbances: DisturbanceSetting = UNDISTURBED,
+           only_recovered: bool = False, keep_failed: bool = False, seed: int = 0,
            max_tries: int | None = None, cameras: tuple[str, ...] = DEFAULT_CAMERAS,
            image_size: tuple[int, int] = (240, 320), strategy: str = "agentchord",
            progress: Callable[[int, dict | None, str], None] | None = None) -> RecordReport:
@@ -203,7 +204,7 @@ def record(task: str, episodes: int, out: str | Path, *, p: float = 0.0, disturb
         episodes: Episodes to write.
         out: The dataset directory: new, empty, or a recording of the same settings to go on with
             (its episodes kept, the seeds after the last one tried run).
-        p, disturb, protocol: The disturbances, as ``agentchord run`` takes them.
+        disturbances: How the episodes are disturbed (``agentchord run``'s ``--p``, ``--disturb``, ``--protocol``).
         only_recovered: Write only episodes with at least one recovery that merged back.
         keep_failed: Write failed episodes too.
         cameras: Scene cameras recorded.
@@ -220,7 +221,7 @@ def record(task: str, episodes: int, out: str | Path, *, p: float = 0.0, disturb
     instruction = graph.instruction or task.replace("_", " ")
     from agentchord.worlds.sim.trial import open_world  # the scene's object names
 
-    settings = record_settings(task, p, disturb, protocol, only_recovered, keep_failed, seed, cameras, image_size, strategy)
+    settings = record_settings(task, disturbances, only_recovered, keep_failed, seed, cameras, image_size, strategy)
     state = recorded_state(out, settings)
     env_names = environment_names(open_world(task, seed))
     frames_features = features(env_names, cameras, image_size)
@@ -242,7 +243,7 @@ def record(task: str, episodes: int, out: str | Path, *, p: float = 0.0, disturb
     def save(complete: bool = False) -> None:
         writer.checkpoint()
         meta = {"task": task, "instruction": instruction, "nodes": nodes, "edges": edges,
-                "disturbances": {"p": p, "kinds": list(disturb), "protocol": protocol}, "strategy": strategy,
+                "disturbances": {"p": disturbances.p, "kinds": list(disturbances.kinds), "protocol": disturbances.protocol is not None}, "strategy": strategy,
                 "settings": settings, "next_seed": current, "complete": complete,
                 "skipped": [list(s) for s in report.skipped],
                 "episodes": report.written}
@@ -254,7 +255,7 @@ def record(task: str, episodes: int, out: str | Path, *, p: float = 0.0, disturb
             save()  # a dataset of no episode yet: from here on, the folder can always be resumed
         while len(report.written) < episodes and current < seed + tries:
             recorder = EpisodeRecorder(writer, cameras, image_size, nodes, edges)
-            spec = EpisodeSpec(task=task, strategy=strategy, p=p, seed=current, disturb=disturb, protocol=protocol)
+            spec = EpisodeSpec(task=task, strategy=strategy, seed=current, disturbances=disturbances)
             try:
                 result = run_episode(spec, on_tick=recorder)
             finally:

@@ -13,7 +13,7 @@ from agentchord.execution.baselines.progress import GoalEvents
 from agentchord.execution.background import ScriptedPlan, ThreadedPlan
 from agentchord.execution.baselines.strategies import BaselineContext
 from agentchord.execution.executor import Executor, ExecutorConfig
-from agentchord.harness import Disturbance, SuccessTracker
+from agentchord.harness import UNDISTURBED, Disturbance, DisturbanceSetting, SuccessTracker
 from agentchord.execution.methods import PIPELINED_METHODS, is_baseline, make_method
 from agentchord.execution.reasoning import ReasoningConfig
 from agentchord.execution.repair import Repairer
@@ -23,7 +23,7 @@ from agentchord.graph.models import TaskGraph
 from agentchord.tasks import load_task_graph
 from agentchord.worlds.protocol import World
 from agentchord.worlds.remote import RemoteWorld
-from agentchord.worlds.sim.disturbances import ProtocolDisturbances, RandomDisturbances
+from agentchord.worlds.sim.disturbances import schedule
 from agentchord.worlds.sim.tasks import SIM_TASKS, judge_by_goal
 from agentchord.worlds.sim.trial import open_world
 
@@ -36,14 +36,11 @@ class EpisodeSpec:
         task: Simulated task name.
         strategy: A method of :data:`~agentchord.execution.methods.METHODS`: ``agentchord``,
             ``agentchord-bt`` or a baseline (``inner-monologue``, ``doremi``, ``rekep``, ``code-as-monitor``).
-        p: Drop probability per atomic action.
         seed: Seeds the scene (object instances, poses) and the disturbance schedule.
         graph: The graph to run; None = the task library's graph.
         config: Budgets.
-        disturb: Disturbance kinds drawn (``drop`` is the paper's simulated one).
-        protocol: The paper's real-world protocol: one or two disturbances of the
-            ``disturb`` kinds at random moments, whatever ``p``.
-        disturbance: A disturbance schedule to use instead (tests, scripted demos).
+        disturbances: How the episode is disturbed (random per-action draws at ``p``, or a
+            protocol); the seed draws its schedule.
         perception: ``oracle`` or ``rgbd`` features.
         repairer: Online repair of unanticipated failures (None: none, unless planned).
         instruction: Plan the graph from this instruction with ``reasoner`` on the
@@ -61,12 +58,10 @@ class EpisodeSpec:
 
     task: str
     strategy: str = "agentchord"
-    p: float = 0.0
     seed: int = 0
     graph: TaskGraph | None = None
     config: ExecutorConfig | None = None
-    disturb: tuple[str, ...] = ("drop",)
-    protocol: bool = False
+    disturbances: DisturbanceSetting = UNDISTURBED
     perception: str = "oracle"
     disturbance: Disturbance | None = None
     repairer: Repairer | None = None
@@ -85,11 +80,7 @@ class EpisodeSpec:
 
     def make_disturbance(self) -> Disturbance | None:
         """The seeded disturbance schedule this spec asks for."""
-        if self.disturbance is not None:
-            return self.disturbance
-        if self.protocol:
-            return ProtocolDisturbances(self.seed, self.disturb)
-        return RandomDisturbances(self.p, self.seed, self.disturb) if self.p > 0 else None
+        return self.disturbance if self.disturbance is not None else schedule(self.disturbances, self.seed)
 
 
 def run_episode(spec: EpisodeSpec, on_tick: Callable[[Executor], None] | None = None) -> EpisodeResult:
@@ -97,7 +88,7 @@ def run_episode(spec: EpisodeSpec, on_tick: Callable[[Executor], None] | None = 
 
     Raises:
         KeyError: Unknown task.
-        ValueError: Unknown strategy or a probability outside [0, 1].
+        ValueError: Unknown strategy.
         GraphNotRunnableError: The graph fails ``graph check`` or names objects the scene lacks.
         RemoteWorldError: The remote world did not answer or refused the trial.
     """
@@ -151,6 +142,8 @@ def _run_in(world: World, spec: EpisodeSpec, on_tick: Callable[[Executor], None]
         strategy=strategy,
         tracker=tracker,
         disturbance=spec.make_disturbance(),
+        disturbances=spec.disturbances if spec.disturbance is None else None,
+        seed=spec.seed,
         config=spec.config,
         on_tick=on_tick,
         perception=spec.perception,
@@ -158,8 +151,6 @@ def _run_in(world: World, spec: EpisodeSpec, on_tick: Callable[[Executor], None]
         background=background,
     )
     result = executor.run()
-    start = next(e for e in result.trace.events if e["event"] == "episode_start")
-    start.update({"seed": spec.seed, "p": spec.p})
     # The agents' calls came before the first tick: they open the trace.
     result.trace.events[:0] = [{"tick": 0, "event": "reasoner_call", **call.to_trace_event()} for call in calls]
     return result

@@ -29,7 +29,7 @@ from agentchord.execution.background import ScriptedPlan, ThreadedPlan
 from agentchord.execution.binding import Binding, HoldMemory
 from agentchord.execution.edge_program import EdgeProgram
 from agentchord.execution.feasibility import FeasibilityChecker, first_grasps, off_table
-from agentchord.harness import Disturbance, SuccessTracker
+from agentchord.harness import Disturbance, DisturbanceSetting, SuccessTracker
 from agentchord.execution.ledger import DisturbanceLedger
 from agentchord.execution.motion_watch import MotionWatch
 from agentchord.execution.planning import PlanSchedule
@@ -94,6 +94,8 @@ class Executor(RecoverySwitching, PlanArrivals):
             repair; the episode goes on from the unmet sub-goal as before).
         background: The rest of a pipelined plan asked while the robot moves (an LLM's arranger and
             conductor); ``graph`` is then the composed graph it starts on.
+        disturbances: The setting ``disturbance`` was drawn from (None: a scripted schedule, or none).
+        seed: The trial's seed (its scene and its schedule). Both go into the trace's ``episode_start``.
     """
 
     def __init__(
@@ -108,12 +110,16 @@ class Executor(RecoverySwitching, PlanArrivals):
         perception: str = "oracle",
         repairer: Repairer | None = None,
         background: ThreadedPlan | ScriptedPlan | None = None,
+        disturbances: DisturbanceSetting | None = None,
+        seed: int | None = None,
     ) -> None:
         filtered = forward_filter(graph)
         self.world = world
         self.strategy = strategy
         self.tracker = tracker
         self.disturbance = disturbance
+        self.disturbance_setting = disturbances
+        self.seed = seed
         self.config = config or ExecutorConfig()
         self.on_tick = on_tick
         self.repairer = repairer
@@ -229,7 +235,10 @@ class Executor(RecoverySwitching, PlanArrivals):
     def run(self) -> EpisodeResult:
         """Execute until the goal, a failure or a budget ends the episode."""
         wall0 = time.perf_counter()
-        self.trace.add(self.world.tick, "episode_start", task=self.graph.task, strategy=self.strategy.name, start=self.graph.start)
+        setting = self.disturbance_setting
+        self.trace.add(self.world.tick, "episode_start", task=self.graph.task, strategy=self.strategy.name, start=self.graph.start,
+                       seed=self.seed, p=setting.p if setting is not None else 0.0,
+                       disturbances=setting.to_dict() if setting is not None else None)
         self.strategy.begin(self)
         first_motion_s = self.reasoning_s + self.compute_s
         outcome = self._arrive(self.graph.start)

@@ -16,7 +16,8 @@ from agentchord.gym.aloha import JOINT_NAMES, arm_commands, environment_state, j
 from agentchord.gym.cameras import RgbCameras
 from agentchord.robot.aloha import ARM_JOINTS, ARM_PREFIX
 from agentchord.worlds.protocol import CONTROL_HZ
-from agentchord.worlds.sim.disturbances import PRESETS, ProtocolDisturbances, parse_kinds
+from agentchord.harness import PRESETS, PROTOCOL_WINDOW, Disturbance, DisturbanceSetting
+from agentchord.worlds.sim.disturbances import schedule
 from agentchord.worlds.sim.tasks import SIM_TASKS
 from agentchord.worlds.sim.trial import open_world
 
@@ -26,17 +27,18 @@ OBS_TYPES = ("state", "pixels_state")
 STATE_BOUND = 10.0
 
 
-def disturbance_kinds(disturb) -> tuple[str, ...]:
-    """``None`` -> (); a preset (``real``, ``stress``), ``"drop,shift"`` or a sequence of kinds -> the kinds.
+def disturbance_setting(disturb, window: tuple[int, int] = PROTOCOL_WINDOW) -> DisturbanceSetting | None:
+    """``None`` -> None (undisturbed); a preset (``real``, ``stress``), ``"drop,shift"`` or a sequence of
+    kinds -> the protocol setting (1-2 disturbances per trial within ``window``), as ``--protocol`` makes it.
 
     Raises:
         ValueError: An unknown kind.
     """
     if not disturb:
-        return ()
-    if isinstance(disturb, str):
-        return PRESETS.get(disturb) or parse_kinds(disturb)
-    return parse_kinds(",".join(disturb))
+        return None
+    if isinstance(disturb, str) and disturb in PRESETS:
+        return DisturbanceSetting.from_options(protocol=disturb, window=window)
+    return DisturbanceSetting.from_options(disturb=disturb, protocol="custom", window=window)
 
 
 class AgentChordEnv(gym.Env):
@@ -63,7 +65,7 @@ class AgentChordEnv(gym.Env):
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": CONTROL_HZ}
 
-    def __init__(self, task: str, disturb=None, window: tuple[int, int] = (60, 650), obs_type: str = "state",
+    def __init__(self, task: str, disturb=None, window: tuple[int, int] = PROTOCOL_WINDOW, obs_type: str = "state",
                  cameras: tuple[str, ...] = ("top",), image_size: tuple[int, int] = (240, 320), max_steps: int = 2000,
                  render_mode: str | None = None) -> None:
         if task not in SIM_TASKS:
@@ -73,8 +75,7 @@ class AgentChordEnv(gym.Env):
         if render_mode not in (None, "rgb_array"):
             raise ValueError(f"unknown render_mode {render_mode!r} (rgb_array or None)")
         self.task = task
-        self.kinds = disturbance_kinds(disturb)
-        self.window = window
+        self.disturbances = disturbance_setting(disturb, window)
         self.obs_type = obs_type
         self.cameras = tuple(cameras)
         self.image_size = image_size
@@ -84,7 +85,7 @@ class AgentChordEnv(gym.Env):
         self.world_seed = 0
         self._images: RgbCameras | None = None
         self._render_camera: RgbCameras | None = None
-        self.disturbance: ProtocolDisturbances | None = None
+        self.disturbance: Disturbance | None = None
         self.tracker = None
         self.extractor = None
         self.success = False
@@ -119,9 +120,8 @@ class AgentChordEnv(gym.Env):
         world = self.world
         self.extractor = make_extractor("oracle", world, lambda arm: world.commands[arm].grip >= 0.5)
         self.tracker = SIM_TASKS[self.task].success_tracker()
-        self.disturbance = None
-        if self.kinds:
-            self.disturbance = ProtocolDisturbances(trial, self.kinds, window=self.window)
+        self.disturbance = schedule(self.disturbances, trial) if self.disturbances is not None else None
+        if self.disturbance is not None:
             for arm in ARM_PREFIX:  # no atomic actions here: either arm may be the one disturbed
                 self.disturbance.action_started(arm, None, 0, 0)
         self.success = False

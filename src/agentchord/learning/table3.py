@@ -26,6 +26,8 @@ from pathlib import Path
 
 import numpy as np
 
+from agentchord.harness import DisturbanceSetting
+
 TASK = "single_arm_pour_water"
 ENV_ID = "agentchord/SingleArmPourWater-v0"
 NOMINAL_SEED, RECOVERED_SEED, EVAL_SEED = 0, 1000, 5000
@@ -132,7 +134,7 @@ def stage_record(out: Path, n_nominal: int, n_cup: int, log=print) -> dict:
         timings[name] = timings.get(name, 0.0) + time.perf_counter() - t
 
     run("nominal", n_nominal, seed=NOMINAL_SEED)
-    recovered = {"seed": RECOVERED_SEED, "protocol": True, "disturb": ("shift",), "only_recovered": True}
+    recovered = {"seed": RECOVERED_SEED, "disturbances": DisturbanceSetting(kinds=("shift",), protocol="custom"), "only_recovered": True}
     summary = episode_summary(dirs["recovered"]) if (dirs["recovered"] / "meta/agentchord.json").exists() else None
     while summary is None or len(summary["cup_recovery_episodes"]) < n_cup:
         have = len(summary["episodes"]) if summary else 0

@@ -37,15 +37,19 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from agentchord.features.frame import FeatureFrame
-from agentchord.harness import DisturbanceEvent, RunningAction
+from agentchord.harness import (
+    KINDS,
+    PROTOCOL_WINDOW,
+    Disturbance,
+    DisturbanceEvent,
+    DisturbanceSetting,
+    RunningAction,
+    parse_kinds,
+)
 from agentchord.worlds.sim.hand import OUT_S, set_down_path
 from agentchord.worlds.sim.scene import TABLE_FRICTION
 from agentchord.worlds.sim.world import CONTROL_HZ, SimWorld
 
-#: Every disturbance kind, in a fixed order (the order seeded choices index into).
-KINDS = ("drop", "pull", "perturb", "shift", "knock")
-#: Protocol presets: the paper's real-world protocol (Table II) and the all-kinds stress test.
-PRESETS: dict[str, tuple[str, ...]] = {"real": ("perturb", "pull"), "stress": KINDS}
 #: How long a gripper fault forces the fingers open (ticks at 50 Hz).
 FAULT_TICKS = 12
 #: ... and a pull: until the person's hand has taken the object out of the fingers (its first phase).
@@ -314,19 +318,6 @@ def inject(kind: str, world: SimWorld, frame: FeatureFrame, rng: np.random.Gener
     raise ValueError(f"unknown disturbance kind {kind!r} (kinds: {', '.join(KINDS)})")
 
 
-def parse_kinds(text: str) -> tuple[str, ...]:
-    """``"drop,shift"`` -> ``("drop", "shift")``.
-
-    Raises:
-        ValueError: An unknown kind or an empty list.
-    """
-    kinds = tuple(k.strip() for k in text.split(",") if k.strip())
-    unknown = [k for k in kinds if k not in KINDS]
-    if unknown or not kinds:
-        raise ValueError(f"unknown disturbance kind(s) {unknown or text!r} (kinds: {', '.join(KINDS)})")
-    return kinds
-
-
 @dataclass
 class RandomDisturbances:
     """With probability ``p`` per atomic action, one disturbance at a random moment within it.
@@ -397,7 +388,7 @@ class ProtocolDisturbances:
 
     seed: int
     kinds: tuple[str, ...] = KINDS
-    window: tuple[int, int] = (60, 650)
+    window: tuple[int, int] = PROTOCOL_WINDOW
     patience: int = 100
     events: list[DisturbanceEvent] = field(default_factory=list)
 
@@ -487,3 +478,10 @@ class ScriptedDisturbance:
 def ScriptedDrop(action: str, nth: int = 0, after: int = 20) -> ScriptedDisturbance:  # reads as a type
     """A drop during the ``nth`` run of ``action``, ``after`` ticks in."""
     return ScriptedDisturbance(action, "drop", nth, after)
+
+
+def schedule(setting: DisturbanceSetting, seed: int) -> Disturbance | None:
+    """The seeded schedule of ``setting`` for the episode of ``seed`` (None: undisturbed)."""
+    if setting.protocol is not None:
+        return ProtocolDisturbances(seed, setting.kinds, setting.window)
+    return RandomDisturbances(setting.p, seed, setting.kinds) if setting.p > 0 else None
