@@ -19,11 +19,11 @@ from rich.console import Console
 from rich.table import Table
 
 from agentchord.actions.controller import RobotController
-from agentchord.execution.episode import EpisodeSpec, run_episode
+from agentchord.episode import EpisodeSpec, run_episode
 from agentchord.features.oracle import OracleExtractor
 from agentchord.solvers.ik import PoseTarget
-from agentchord.worlds.sim.tasks import SIM_TASKS
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.sim.tasks import SIM_TASKS
+from agentchord.sim.world import SimWorld
 
 TASK = "single_arm_pour_water"
 

@@ -17,9 +17,9 @@ from rich.table import Table
 from agentchord.expr import Vocabulary, compile_expr
 from agentchord.features.oracle import OracleExtractor
 from agentchord.monitor import EdgeMonitors
-from agentchord.tasks import load_task_graph
-from agentchord.worlds.sim.tasks import SIM_TASKS
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.library import load_task_graph
+from agentchord.sim.tasks import SIM_TASKS
+from agentchord.sim.world import SimWorld
 
 
 def main() -> None:

@@ -29,8 +29,8 @@ from rich.table import Table
 
 from agentchord.features.rgbd import PERCEPTION_CAMERAS, RgbdExtractor
 from agentchord.features.segmentation import LabelSegmenter, NoisySegmenter
-from agentchord.worlds.sim.tasks import SIM_TASKS
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.sim.tasks import SIM_TASKS
+from agentchord.sim.world import SimWorld
 
 TASK = "single_arm_pour_water"
 TARGET_CENTRE_MM = 5.0

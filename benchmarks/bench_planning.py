@@ -18,9 +18,9 @@ from rich.table import Table
 from agentchord.agents.observe import observe, task_regions
 from agentchord.agents.pipeline import make_reasoner, plan_task
 from agentchord.agents.reasoner import ConductRequest
-from agentchord.tasks import load_task_graph
-from agentchord.worlds.sim.tasks import SIM_TASKS
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.library import load_task_graph
+from agentchord.sim.tasks import SIM_TASKS
+from agentchord.sim.world import SimWorld
 
 #: The paper's six tasks (their library instruction) and two instructions no library graph has.
 CASES = [(task, load_task_graph(task).instruction) for task in (

@@ -16,8 +16,8 @@ from rich.console import Console
 from rich.table import Table
 
 from agentchord.bench.runner import run_many
-from agentchord.execution.episode import EpisodeSpec
-from agentchord.worlds.sim.disturbances import ScriptedDrop
+from agentchord.episode import EpisodeSpec
+from agentchord.sim.disturbances import ScriptedDrop
 
 TASK = "single_arm_pour_water"
 #: (label, atomic action, which run of it, ticks into it): one drop on each bottle-holding edge.

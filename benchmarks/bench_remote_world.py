@@ -27,10 +27,10 @@ import numpy as np
 from rich.console import Console
 from rich.table import Table
 
-from agentchord.execution.episode import EpisodeSpec, run_episode
+from agentchord.episode import EpisodeSpec, run_episode
 from agentchord.worlds.protocol import ArmCommand
 from agentchord.worlds.remote import RemoteWorld
-from agentchord.worlds.sim.trial import open_world
+from agentchord.sim.trial import open_world
 
 
 def start_server(task: str) -> tuple[subprocess.Popen, str]:

@@ -29,13 +29,13 @@ from rich.table import Table
 
 from agentchord.actions.controller import RobotController
 from agentchord.execution.edge_program import EdgeProgram
-from agentchord.execution.episode import EpisodeSpec, run_episode
+from agentchord.episode import EpisodeSpec, run_episode
 from agentchord.execution.executor import Executor
 from agentchord.features.oracle import OracleExtractor
 from agentchord.monitor import EdgeMonitors
-from agentchord.worlds.sim.tasks import SIM_TASKS
-from agentchord.worlds.sim.trial import open_world, scene_rng
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.sim.tasks import SIM_TASKS
+from agentchord.sim.trial import open_world, scene_rng
+from agentchord.sim.world import SimWorld
 
 TASKS = "single_arm_pour_water,fold_towel"
 #: The tick's timed parts: (name, class, method). ``RobotController.step`` times the IK and the

@@ -29,7 +29,7 @@ from agentchord.agents.replies import (
 )
 from agentchord.execution.baselines.replies import stages_reply
 from agentchord.graph.progress import forward_filter
-from agentchord.tasks import load_task_graph
+from agentchord.library import load_task_graph
 
 TASKS = ("single_arm_pour_water", "dual_arm_pour_water", "rearrange_table", "handover_block", "fold_towel", "setup_coffee_tray")
 

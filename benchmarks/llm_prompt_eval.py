@@ -26,8 +26,8 @@ from agentchord.agents.pipeline import plan_task
 from agentchord.agents.reasoner import ArrangeRequest, ComposeRequest, ConductRequest
 from agentchord.graph.loader import dump_graph, load_graph
 from agentchord.graph.models import Success, TaskGraph
-from agentchord.worlds.sim.tasks import SIM_TASKS
-from agentchord.worlds.sim.trial import open_world
+from agentchord.sim.tasks import SIM_TASKS
+from agentchord.sim.trial import open_world
 
 #: Where the cases live.
 CASES_DIR = Path(__file__).resolve().parents[1] / "tests" / "data" / "llm"
@@ -61,7 +61,7 @@ def plan_case(name: str, record: bool = False) -> tuple[TaskGraph, list]:
 
 def run_episodes(task: str, graph: TaskGraph, seeds: list[int], protocol: str | None) -> list[dict]:
     """One episode per seed of ``graph`` on ``task``; each summary with its seed."""
-    from agentchord.execution.episode import EpisodeSpec, run_episode
+    from agentchord.episode import EpisodeSpec, run_episode
     from agentchord.harness import DisturbanceSetting
 
     setting = DisturbanceSetting.from_options(protocol=protocol)

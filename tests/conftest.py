@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from agentchord.worlds.sim.tasks import SIM_TASKS
+from agentchord.sim.tasks import SIM_TASKS
 
 
 @pytest.fixture
@@ -18,6 +18,6 @@ def pour_scene():
 def straight_carry(monkeypatch):
     """A person's pull carried in a straight line, as before carries went over what stands in the way:
     the scene some regression tests were met in (the lifted carry no longer knocks the cup there)."""
-    import agentchord.worlds.sim.disturbances as disturbances
+    import agentchord.sim.disturbances as disturbances
 
     monkeypatch.setattr(disturbances, "_carry_height", lambda *args, **kwargs: None)

@@ -15,9 +15,9 @@ from agentchord.actions.library import make_action
 from agentchord.actions.top_grasp import plain_top_grasp
 from agentchord.features.frame import make_static_frame
 from agentchord.features.oracle import OracleExtractor
-from agentchord.worlds.sim.tasks import SIM_TASKS
-from agentchord.worlds.sim.trial import scene_rng
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.sim.tasks import SIM_TASKS
+from agentchord.sim.trial import scene_rng
+from agentchord.sim.world import SimWorld
 
 #: A yaw of 90 deg: the fork's own x axis (its length) along world y.
 ALONG_Y = (np.cos(np.pi / 4), 0.0, 0.0, np.sin(np.pi / 4))

@@ -10,7 +10,7 @@ from agentchord.actions.controller import RobotController
 from agentchord.actions.grasp import Grasp, GraspMissed, HeldBackByOtherArm
 from agentchord.actions.library import make_action
 from agentchord.features.oracle import OracleExtractor
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.sim.world import SimWorld
 
 
 def _nothing(*args, **kwargs):
@@ -63,7 +63,7 @@ def test_misses_and_hold_backs_are_counted_apart(pour_scene, outcomes, status, r
 
 
 def _episode(task, seed, protocol):
-    from agentchord.execution.episode import EpisodeSpec, run_episode
+    from agentchord.episode import EpisodeSpec, run_episode
 
     return run_episode(EpisodeSpec(task, seed=seed, disturbances=DisturbanceSetting.from_options(protocol=protocol)))
 
@@ -94,7 +94,7 @@ def test_an_arm_that_would_not_reach_the_grasp_alone_is_not_held_back(asks_the_a
     # (the right arm alone does not reach it), the grasp fails at once and the left arm takes the
     # bottle. Taken as held back, the left arm steps back, the right one tries again, and the bottle
     # is knocked out of the left arm's reach.
-    import agentchord.worlds.sim.disturbances as disturbances
+    import agentchord.sim.disturbances as disturbances
 
     # The scene as it was met: the person carried the pulled bottle straight, not lifted over the cup.
     monkeypatch.setattr(disturbances, "_carry_height", lambda *args, **kwargs: None)

@@ -17,7 +17,7 @@ from agentchord.actions.move import BACK_OPEN_WIDTH
 from agentchord.features.frame import make_static_frame, tilt_deg
 from agentchord.features.oracle import OracleExtractor
 from agentchord.robot.aloha import HOME_Q
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.sim.world import SimWorld
 
 
 def _setup(scene):
@@ -136,7 +136,7 @@ def test_a_fallen_grasp_goes_over_a_neighbour_its_straight_approach_would_strike
     # from where the hand let it go. The straight move to the fallen grasp's pre-grasp crossed the cup's
     # rim; the fingers struck it and the cup went off the table. The hand now goes over it.
     from agentchord.actions import grasp as grasp_module
-    from agentchord.execution.episode import EpisodeSpec, run_episode
+    from agentchord.episode import EpisodeSpec, run_episode
 
     if not crosses_over:
         monkeypatch.setattr(grasp_module, "crossing_over", lambda *args: None)
@@ -158,7 +158,7 @@ def test_a_fallen_grasp_slides_along_the_object_where_a_finger_would_come_down_o
     # along the bottle, clear of the cup, the right arm takes it.
     from agentchord.actions import grasp as grasp_module
     from agentchord.actions.finger_clearance import TopGraspChoice
-    from agentchord.execution.episode import EpisodeSpec, run_episode
+    from agentchord.episode import EpisodeSpec, run_episode
 
     if not slides:
         monkeypatch.setattr(grasp_module, "clear_top_grasp", lambda *args: TopGraspChoice())
@@ -424,7 +424,7 @@ def test_a_hand_off_spot_is_one_the_taker_reaches_with_the_top_down_grasp_it_wil
     side-grasp reach shell, so the right arm set it down where it lay, where the left arm's top-down
     grasp ends 2 cm short. The IK-confirmed spot is 2 cm nearer the left arm, and the left arm takes it."""
     from agentchord.actions import place
-    from agentchord.worlds.sim.tasks import SIM_TASKS
+    from agentchord.sim.tasks import SIM_TASKS
 
     if not confirmed:
         monkeypatch.setattr(place, "_top_grasp_reaches", lambda *args: True)
@@ -455,7 +455,7 @@ def test_a_cloth_corner_pinched_off_its_point_is_held(seed):
     # lies on the cloth) is pinched 2.6-2.8 cm from its point. The hold is a hold (the frame reports
     # it: the fingers touch the cloth near the point); before, the off-centre check let go of it
     # three times and the episode failed ("towel_bl is held 2.8 cm off the grasp point").
-    from agentchord.execution.episode import EpisodeSpec, run_episode
+    from agentchord.episode import EpisodeSpec, run_episode
 
     result = run_episode(EpisodeSpec("fold_towel", seed=seed, disturbances=DisturbanceSetting.from_options(protocol="real")))
     assert result.success, result.reason

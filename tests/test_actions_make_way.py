@@ -8,7 +8,7 @@ from agentchord.actions.controller import RobotController
 from agentchord.actions.make_way import NEAREST_TO_SHOULDER, STEP_BACK, make_way, step_back_pose
 from agentchord.features.oracle import OracleExtractor
 from agentchord.solvers.ik import PoseTarget
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.sim.world import SimWorld
 
 
 @pytest.fixture
@@ -102,7 +102,7 @@ def test_a_free_arm_steps_back_after_the_blocked_arm_backs_off(robot):
 def _episode(task, seed, protocol, monkeypatch, switched_off=None):
     """Run a protocol episode, with a make_way helper (as the grasp calls it) switched off."""
     from agentchord.actions import grasp as grasp_module
-    from agentchord.execution.episode import EpisodeSpec, run_episode
+    from agentchord.episode import EpisodeSpec, run_episode
 
     if switched_off is not None:
         def never(*args, **kwargs):

@@ -7,8 +7,8 @@ from agentchord.actions import motion
 from agentchord.actions.controller import RobotController
 from agentchord.features.oracle import OracleExtractor
 from agentchord.solvers.poses import top_down_rotation
-from agentchord.worlds.sim.tasks import SIM_TASKS
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.sim.tasks import SIM_TASKS
+from agentchord.sim.world import SimWorld
 
 #: The left arm's joints after a place's retreat was cut short (rearrange, stress seed 35): the
 #: tool tilted 34 deg below level, pointing right and forward.

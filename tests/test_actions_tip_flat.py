@@ -13,9 +13,9 @@ from agentchord.actions.top_grasp import on_its_edge
 from agentchord.features.frame import level_tilt_deg, make_static_frame
 from agentchord.features.oracle import OracleExtractor
 from agentchord.solvers.poses import top_down_rotation
-from agentchord.worlds.sim.tasks import SIM_TASKS
-from agentchord.worlds.sim.tasks.rearrange_table import TARGET_OFFSET, yaw_error_deg
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.sim.tasks import SIM_TASKS
+from agentchord.sim.tasks.rearrange_table import TARGET_OFFSET, yaw_error_deg
+from agentchord.sim.world import SimWorld
 
 #: A fork on its edge: its length (local x) along world y, its width (local y) up, its faces
 #: (local z, its axis) looking along world x.

@@ -38,7 +38,7 @@ from agentchord.agents.llm import (
 from agentchord.agents.prompts import nominal_part, prompt_names, render_prompt
 from agentchord.expr import FUNCTIONS, TEMPLATES
 from agentchord.graph.models import ActionCall, TaskGraph
-from agentchord.tasks import load_task_graph
+from agentchord.library import load_task_graph
 
 BASE = 0.01  # back-off base in tests: fast
 

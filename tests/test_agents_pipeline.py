@@ -6,9 +6,9 @@ import pytest
 
 from agentchord.agents.pipeline import ReasonerRepairer, make_reasoner, plan_task
 from agentchord.agents.exceptions import ReasonerConfigError
-from agentchord.execution.episode import EpisodeSpec, run_episode
+from agentchord.episode import EpisodeSpec, run_episode
 from agentchord.graph.validation import check_graph
-from agentchord.tasks import load_task_graph
+from agentchord.library import load_task_graph
 from test_agents_rules_composer import scene_of
 
 

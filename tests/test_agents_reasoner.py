@@ -25,7 +25,7 @@ from agentchord.agents.prompts import nominal_part
 from agentchord.execution.trace import Trace
 from agentchord.features.frame import make_static_frame
 from agentchord.graph.models import ActionCall, Node, TaskGraph
-from agentchord.tasks import load_task_graph
+from agentchord.library import load_task_graph
 
 
 @pytest.fixture(scope="module")

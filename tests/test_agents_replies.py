@@ -13,7 +13,7 @@ from agentchord.agents.replies import (
     stream_order,
     streamed_tokens,
 )
-from agentchord.tasks import load_task_graph
+from agentchord.library import load_task_graph
 
 
 def _graph(task="single_arm_pour_water"):

@@ -7,8 +7,8 @@ from agentchord.agents.rules.arm_switch import add_arm_switch_alternatives, arm_
 from agentchord.graph.models import Edge
 from agentchord.graph.progress import forward_filter
 from agentchord.graph.validation import check_graph
-from agentchord.tasks import load_task_graph
-from agentchord.worlds.sim.tasks import SIM_TASKS
+from agentchord.library import load_task_graph
+from agentchord.sim.tasks import SIM_TASKS
 
 LIBRARY = ("single_arm_pour_water", "dual_arm_pour_water", "rearrange_table", "handover_block", "setup_coffee_tray", "fold_towel")
 

@@ -14,7 +14,7 @@ from agentchord.agents.rules.arranger import Arranger
 from agentchord.expr import Vocabulary, compile_expr
 from agentchord.features.frame import make_static_frame
 from agentchord.graph.progress import forward_filter
-from agentchord.tasks import load_task_graph
+from agentchord.library import load_task_graph
 from test_agents_rules_composer import scene_of
 
 

@@ -13,9 +13,9 @@ from agentchord.agents.rules.composer import compose
 from agentchord.agents.rules.constraints import over_footprint
 from agentchord.agents.rules.facts import poured_into
 from agentchord.agents.rules.goals import GoalSpec
-from agentchord.tasks import load_task_graph
-from agentchord.worlds.sim.tasks import SIM_TASKS
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.library import load_task_graph
+from agentchord.sim.tasks import SIM_TASKS
+from agentchord.sim.world import SimWorld
 
 
 def scene_of(task: str, seed: int = 1):

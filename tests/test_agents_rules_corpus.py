@@ -17,8 +17,8 @@ import numpy as np
 
 from agentchord.agents.observe import observe, task_regions
 from agentchord.agents.scene import Scene
-from agentchord.worlds.sim.tasks import SIM_TASKS
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.sim.tasks import SIM_TASKS
+from agentchord.sim.world import SimWorld
 from agentchord.agents.rules import corpus
 from agentchord.agents.rules.instructions import ground_instruction
 

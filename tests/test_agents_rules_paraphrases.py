@@ -24,8 +24,8 @@ from agentchord.agents.rules.feasibility import goal_problems
 from agentchord.agents.rules.goals import GoalSpec
 from agentchord.agents.rules.instructions import ground_instruction
 from agentchord.graph.validation import check_graph
-from agentchord.worlds.sim.tasks import SIM_TASKS
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.sim.tasks import SIM_TASKS
+from agentchord.sim.world import SimWorld
 
 CASES = yaml.safe_load((Path(__file__).parent / "data" / "paraphrases.yaml").read_text())["cases"]
 PAPER_TASKS = ("single_arm_pour_water", "dual_arm_pour_water", "rearrange_table", "handover_block", "setup_coffee_tray", "fold_towel")
@@ -115,7 +115,7 @@ def test_the_issue_instructions_plan_end_to_end(task, instruction):
 @pytest.mark.slow
 @pytest.mark.parametrize(("task", "instruction"), ISSUE, ids=[f"{t}: {i[:40]}" for t, i in ISSUE])
 def test_a_sample_succeeds_when_run(task, instruction):
-    from agentchord.execution.episode import EpisodeSpec, run_episode
+    from agentchord.episode import EpisodeSpec, run_episode
 
     result = run_episode(EpisodeSpec(task=task, seed=0, instruction=instruction))
     assert result.success, result.reason

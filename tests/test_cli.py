@@ -103,8 +103,8 @@ def test_plan_with_the_llm_reasoner_against_a_replay_server(tmp_path, monkeypatc
     from agentchord.agents.pipeline import plan_task
     from agentchord.agents.rules import RulesReasoner
     from agentchord.graph.loader import load_graph
-    from agentchord.worlds.sim.tasks import SIM_TASKS
-    from agentchord.worlds.sim.world import SimWorld
+    from agentchord.sim.tasks import SIM_TASKS
+    from agentchord.sim.world import SimWorld
 
     sim = SIM_TASKS["blocks_and_cup"]
     scene = observe(SimWorld(sim.sample_scene(np.random.default_rng([0, 0x5CE7E]))), task_regions(sim))
@@ -172,7 +172,7 @@ HANDOVER = "hand the bottle to the left arm, then put it down"
 def test_plan_writes_what_success_means_for_the_graph(tmp_path):
     import yaml
 
-    from agentchord.tasks import load_task_graph
+    from agentchord.library import load_task_graph
 
     own, other = tmp_path / "own.yaml", tmp_path / "other.yaml"
     runner = CliRunner()
@@ -191,7 +191,7 @@ def test_plan_writes_what_success_means_for_the_graph(tmp_path):
 def test_a_graph_whose_goal_spec_is_invalid_is_refused(tmp_path):
     import yaml
 
-    from agentchord.tasks import library_path
+    from agentchord.library import library_path
 
     data = yaml.safe_load(library_path("single_arm_pour_water").read_text())
     data["success"] = {"judge": "goal", "goal_spec": {"goals": [{"kind": "levitated", "obj": "bottle"}]}}

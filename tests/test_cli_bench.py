@@ -101,9 +101,9 @@ def test_an_llm_sweep_plans_every_episode_and_charges_what_the_calls_measured(tm
     from agentchord.agents.observe import observe, task_regions
     from agentchord.agents.pipeline import plan_task
     from agentchord.agents.rules import RulesReasoner
-    from agentchord.tasks import load_task_graph
-    from agentchord.worlds.sim.tasks import SIM_TASKS
-    from agentchord.worlds.sim.trial import open_world
+    from agentchord.library import load_task_graph
+    from agentchord.sim.tasks import SIM_TASKS
+    from agentchord.sim.trial import open_world
 
     task = "single_arm_pour_water"
     rules = RulesReasoner()

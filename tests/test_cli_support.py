@@ -66,7 +66,7 @@ def test_the_commands_refuse_two_outputs_on_one_path(tmp_path, args):
 
 
 def test_run_refuses_to_write_over_its_graph(tmp_path):
-    from agentchord.tasks import library_path
+    from agentchord.library import library_path
 
     graph = tmp_path / "g.yaml"
     graph.write_text(library_path(POUR).read_text())
@@ -104,7 +104,7 @@ SIGTERM_DURING_VIDEO = textwrap.dedent("""
 
     class Executor:  # what run's video hook reads of the executor
         def __init__(self):
-            from agentchord.worlds.sim.trial import open_world
+            from agentchord.sim.trial import open_world
             self.world = open_world("single_arm_pour_water", 0)
             self.trace = type("T", (), {"events": []})()
             self.program = None

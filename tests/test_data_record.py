@@ -13,7 +13,7 @@ pq = pytest.importorskip("pyarrow.parquet")
 
 from agentchord.data.record import record
 from agentchord.harness import DisturbanceSetting
-from agentchord.tasks import load_task_graph
+from agentchord.library import load_task_graph
 
 TASK = "single_arm_pour_water"
 #: The cup shifted on the protocol schedule (the recovery episodes of Table III).
@@ -210,7 +210,7 @@ def _short_episodes(monkeypatch, interrupt_at=None):
     """Episodes of 6 ticks (the recorder and writer as they are); ``interrupt_at``: (seed, tick) of a Ctrl-C."""
     import agentchord.data.record as record_module
     from agentchord.execution.trace import Trace
-    from agentchord.worlds.sim.trial import open_world
+    from agentchord.sim.trial import open_world
 
     def run_episode(spec, on_tick):
         world = open_world(TASK, spec.seed)

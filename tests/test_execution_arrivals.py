@@ -4,9 +4,9 @@ import copy
 
 import pytest
 
-from agentchord.execution.episode import EpisodeSpec, run_episode
+from agentchord.episode import EpisodeSpec, run_episode
 from agentchord.execution.reasoning import ReasoningConfig, TokenLatencyModel
-from agentchord.worlds.sim.disturbances import ScriptedDisturbance, ScriptedDrop
+from agentchord.sim.disturbances import ScriptedDisturbance, ScriptedDrop
 
 TASK = "single_arm_pour_water"
 

@@ -10,13 +10,13 @@ from agentchord.agents.observe import observe, task_regions
 from agentchord.agents.pipeline import plan_task
 from agentchord.agents.rules import RulesReasoner
 from agentchord.execution.background import ScriptedPlan, ThreadedPlan
-from agentchord.execution.episode import EpisodeSpec, run_episode
+from agentchord.episode import EpisodeSpec, run_episode
 from agentchord.execution.reasoning import ReasoningConfig
 from agentchord.graph.models import TaskGraph
-from agentchord.tasks import load_task_graph
-from agentchord.worlds.sim.disturbances import ScriptedDrop
-from agentchord.worlds.sim.tasks import SIM_TASKS
-from agentchord.worlds.sim.trial import open_world
+from agentchord.library import load_task_graph
+from agentchord.sim.disturbances import ScriptedDrop
+from agentchord.sim.tasks import SIM_TASKS
+from agentchord.sim.trial import open_world
 
 TASK = "single_arm_pour_water"
 DELAY_S = 2.0

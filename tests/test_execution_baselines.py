@@ -5,7 +5,7 @@ import pytest
 
 from agentchord.harness import DisturbanceSetting
 from agentchord.execution.baselines.vqa import SimulatedVqa
-from agentchord.execution.episode import EpisodeSpec, run_episode
+from agentchord.episode import EpisodeSpec, run_episode
 from agentchord.execution.reasoning import LatencyModel, ReasoningConfig
 
 TASK = "single_arm_pour_water"
@@ -69,7 +69,7 @@ def test_sequential_agentchord_and_its_ablation_wait_for_the_three_agents():
 def test_pipelined_agentchord_moves_once_the_first_edge_is_grounded():
     from agentchord.execution.planning import pipelined_schedule
     from agentchord.graph.progress import forward_filter
-    from agentchord.tasks import load_task_graph
+    from agentchord.library import load_task_graph
 
     result = _run("agentchord", 0)
     schedule = pipelined_schedule(forward_filter(load_task_graph(TASK)).graph, ReasoningConfig().latency)
@@ -121,7 +121,7 @@ def test_step_constraints_follow_the_graph_run_now_whatever_its_address():
     from types import SimpleNamespace
 
     from agentchord.execution.baselines.strategies import DoReMiStrategy
-    from agentchord.tasks import load_task_graph
+    from agentchord.library import load_task_graph
 
     strategy = DoReMiStrategy()
     executor = SimpleNamespace(graph=load_task_graph(TASK))

@@ -103,7 +103,7 @@ def test_a_recovery_waits_for_a_person_to_set_a_pulled_object_down(wait_ticks):
     # fetches it. (A cloth's corners are not waited for longer: hanging from the other hand they
     # never rest, and the fold towel's regrasps took the long wait at every slip and ran out of
     # their failure budget, real protocol seed 15.)
-    from agentchord.execution.episode import EpisodeSpec, run_episode
+    from agentchord.episode import EpisodeSpec, run_episode
     from agentchord.execution.executor import ExecutorConfig
 
     config = None if wait_ticks is None else ExecutorConfig(bind_rigid_wait_ticks=wait_ticks)

@@ -5,15 +5,15 @@ import pytest
 from agentchord.actions.base import Status
 from agentchord.agents.rules.arm_switch import arm_switch_alternative
 from agentchord.execution.edge_program import EdgeProgram
-from agentchord.execution.episode import EpisodeSpec, run_episode
+from agentchord.episode import EpisodeSpec, run_episode
 from agentchord.execution.executor import Executor, ExecutorConfig
 from agentchord.execution.strategies import make_strategy
-from agentchord.tasks import load_task_graph
+from agentchord.library import load_task_graph
 from agentchord.harness import KINDS, DisturbanceSetting
-from agentchord.worlds.sim.disturbances import ScriptedDisturbance, ScriptedDrop
-from agentchord.worlds.sim.tasks import SIM_TASKS
+from agentchord.sim.disturbances import ScriptedDisturbance, ScriptedDrop
+from agentchord.sim.tasks import SIM_TASKS
 from agentchord.harness import Verdict
-from agentchord.worlds.sim.trial import open_world
+from agentchord.sim.trial import open_world
 
 TASK = "single_arm_pour_water"
 
@@ -144,7 +144,7 @@ def test_cup_shifted_while_the_bottle_approaches_or_pours_is_followed(action, ed
 # --- feasibility, arm binding and unrecoverable objects (the real-world protocol) ---------------
 
 def test_a_pulled_object_out_of_the_busy_arms_reach_is_taken_by_the_other_arm():
-    from agentchord.worlds.sim.disturbances import ScriptedDisturbance
+    from agentchord.sim.disturbances import ScriptedDisturbance
 
     pull = ScriptedDisturbance("move_to_obj", "pull", after=15, seed=2, spot=(-0.3, 0.8), lying=False)
     result = run_episode(EpisodeSpec("single_arm_pour_water", seed=2, disturbance=pull))
@@ -155,7 +155,7 @@ def test_a_pulled_object_out_of_the_busy_arms_reach_is_taken_by_the_other_arm():
 
 
 def test_an_object_off_the_table_ends_the_episode_as_unrecoverable_at_once():
-    from agentchord.worlds.sim.disturbances import ScriptedDisturbance
+    from agentchord.sim.disturbances import ScriptedDisturbance
 
     pull = ScriptedDisturbance("move_to_obj", "pull", after=15, seed=1, spot=(0.0, 1.2), lying=False)
     result = run_episode(EpisodeSpec("single_arm_pour_water", seed=1, disturbance=pull))
@@ -166,7 +166,7 @@ def test_an_object_off_the_table_ends_the_episode_as_unrecoverable_at_once():
 
 
 def test_a_perturbed_grasp_re_approaches_the_object_where_it_is_now():
-    from agentchord.worlds.sim.disturbances import ScriptedDisturbance
+    from agentchord.sim.disturbances import ScriptedDisturbance
 
     push = ScriptedDisturbance("grasp", "perturb", after=40, seed=3)
     result = run_episode(EpisodeSpec("single_arm_pour_water", seed=2, disturbance=push))
@@ -179,7 +179,7 @@ def test_a_perturbed_grasp_re_approaches_the_object_where_it_is_now():
 
 def test_a_recovery_that_merges_with_a_constraint_violated_fires_the_failure_watching_it():
     from agentchord.graph.models import ActionCall
-    from agentchord.tasks import load_task_graph
+    from agentchord.library import load_task_graph
 
     graph = load_task_graph(TASK)
     # A recovery cut short (here: one that only opens the hand, unwatched) merges at v2 without the bottle.

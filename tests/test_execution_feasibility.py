@@ -8,9 +8,9 @@ from agentchord.actions.library import Grasp
 from agentchord.execution.edge_program import EdgeProgram
 from agentchord.execution.feasibility import FeasibilityChecker, first_grasps, off_table
 from agentchord.features.extractors import make_extractor
-from agentchord.tasks import load_task_graph
-from agentchord.worlds.sim.tasks import SIM_TASKS
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.library import load_task_graph
+from agentchord.sim.tasks import SIM_TASKS
+from agentchord.sim.world import SimWorld
 
 
 def _robot() -> RobotController:

@@ -6,7 +6,7 @@ from agentchord.agents.replies import branch_nominal_nodes, branch_owners, strea
 from agentchord.execution.planning import composer_call, pipelined_schedule, sequential_calls
 from agentchord.execution.reasoning import LatencyModel, TokenLatencyModel
 from agentchord.graph.progress import forward_filter, nominal_path
-from agentchord.tasks import load_task_graph
+from agentchord.library import load_task_graph
 
 TASKS = ["single_arm_pour_water", "dual_arm_pour_water", "rearrange_table", "handover_block", "fold_towel", "setup_coffee_tray"]
 

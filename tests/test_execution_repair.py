@@ -6,16 +6,16 @@ import pytest
 
 from agentchord.agents.reasoner import UnanticipatedFailure
 from agentchord.execution.edge_program import EdgeProgram
-from agentchord.execution.episode import EpisodeSpec, run_episode
+from agentchord.episode import EpisodeSpec, run_episode
 from agentchord.execution.executor import Executor, ExecutorConfig
 from agentchord.execution.repair import RepairRejectedError, ScriptedRepairer, validate_repair
 from agentchord.execution.strategies import make_strategy
 from agentchord.features.frame import FeatureFrame
 from agentchord.graph.models import FailureMode, TaskGraph
-from agentchord.tasks import load_task_graph
-from agentchord.worlds.sim.disturbances import ScriptedDrop
-from agentchord.worlds.sim.tasks import SIM_TASKS
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.library import load_task_graph
+from agentchord.sim.disturbances import ScriptedDrop
+from agentchord.sim.tasks import SIM_TASKS
+from agentchord.sim.world import SimWorld
 
 TASK = "single_arm_pour_water"
 FAILURE = UnanticipatedFailure(edge="e2", context="v1", observation="at v2: tilt(bottle) - 15 = 4.33")

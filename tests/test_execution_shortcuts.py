@@ -6,7 +6,7 @@ from agentchord.expr.compiler import compile_expr
 from agentchord.expr.vocabulary import Vocabulary
 from agentchord.features.frame import make_static_frame
 from agentchord.graph.progress import nominal_path
-from agentchord.tasks import load_task_graph
+from agentchord.library import load_task_graph
 
 GRAPH = load_task_graph("single_arm_pour_water")
 NOMINAL_NEXT = {GRAPH.edge(e).source: e for e in nominal_path(GRAPH)}

@@ -9,7 +9,7 @@ from agentchord.execution.strategies import make_strategy
 from agentchord.expr import Vocabulary
 from agentchord.features.frame import make_static_frame
 from agentchord.monitor import EdgeMonitors, RecoveryMap
-from agentchord.tasks import load_task_graph
+from agentchord.library import load_task_graph
 
 
 def _context(task: str, holding: set[tuple[str, str]] | None = None) -> SimpleNamespace:

@@ -5,8 +5,8 @@ import pytest
 
 from agentchord.features.extractors import make_extractor
 from agentchord.features.frame import level_tilt_deg, tilt_deg
-from agentchord.worlds.sim.tasks import SIM_TASKS
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.sim.tasks import SIM_TASKS
+from agentchord.sim.world import SimWorld
 
 
 def _frame(task: str):

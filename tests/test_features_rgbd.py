@@ -10,7 +10,7 @@ from agentchord.expr.templates import lost_view
 from agentchord.features.oracle import OracleExtractor
 from agentchord.features.rgbd import MIN_POINTS, RgbdExtractor, frame_points
 from agentchord.features.segmentation import LabelSegmenter, NoisySegmenter
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.sim.world import SimWorld
 
 SMALL = {"width": 160, "height": 120}
 

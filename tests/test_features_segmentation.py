@@ -14,7 +14,7 @@ from agentchord.features.segmentation import (
     Segmenter,
     erode,
 )
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.sim.world import SimWorld
 
 
 @pytest.fixture

@@ -119,7 +119,7 @@ def test_render_refuses_a_graph_too_large_to_lay_out(pour: TaskGraph, tmp_path: 
 
 def test_an_arm_switching_alternative_is_drawn_dotted_and_says_what_it_replaces():
     from agentchord.graph.render import to_dot
-    from agentchord.tasks import load_task_graph
+    from agentchord.library import load_task_graph
 
     dot = to_dot(load_task_graph("single_arm_pour_water"))
     line = next(line for line in dot.splitlines() if "e2_r_bottle_dropped_via_left\\n" in line)
@@ -158,7 +158,7 @@ def test_each_library_graph_renders_within_a_page_with_its_names(path: Path, tmp
 
 def test_readable_dot_names_each_branch_and_folds_the_other_arm() -> None:
     from agentchord.graph.figure import to_figure_dot
-    from agentchord.tasks import load_task_graph
+    from agentchord.library import load_task_graph
 
     dot = to_figure_dot(load_task_graph("handover_block"))
     assert "rankdir=TB" in dot

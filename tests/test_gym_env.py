@@ -10,7 +10,7 @@ from gymnasium.utils.env_checker import check_env
 import agentchord.gym
 from agentchord.gym.aloha import joint_action
 from agentchord.gym.env import AgentChordEnv, disturbance_setting
-from agentchord.worlds.sim.tasks import SIM_TASKS
+from agentchord.sim.tasks import SIM_TASKS
 
 
 def test_every_task_is_registered() -> None:
@@ -80,7 +80,7 @@ def test_disturbance_setting() -> None:
 
 def test_replaying_an_agentchord_episode_succeeds_in_the_env() -> None:
     """The env's scene and physics are the episode's: its commands, replayed, succeed there too."""
-    from agentchord.execution.episode import EpisodeSpec, run_episode
+    from agentchord.episode import EpisodeSpec, run_episode
 
     actions = []
     result = run_episode(EpisodeSpec(task="single_arm_pour_water", seed=0),

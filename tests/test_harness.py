@@ -5,7 +5,7 @@ import math
 import pytest
 
 from agentchord.harness import KINDS, PRESETS, UNDISTURBED, DisturbanceSetting, parse_kinds
-from agentchord.worlds.sim.disturbances import ProtocolDisturbances, RandomDisturbances, schedule
+from agentchord.sim.disturbances import ProtocolDisturbances, RandomDisturbances, schedule
 
 
 def test_options_become_one_setting_the_same_way():

@@ -19,7 +19,7 @@ import yaml
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
-from agentchord.execution.episode import EpisodeSpec, run_episode
+from agentchord.episode import EpisodeSpec, run_episode
 from agentchord.execution.executor import ExecutorConfig
 from agentchord.graph.exceptions import GraphFileError, GraphNotRunnableError
 from agentchord.graph.loader import dump_graph, load_graph

@@ -282,11 +282,11 @@ def test_graph_check_with_a_task_checks_the_scene(tmp_path):
 
 
 def test_run_refuses_a_towel_graph_on_the_blocks_scene():
-    from agentchord.tasks import load_task_graph
+    from agentchord.library import load_task_graph
 
     graph = load_task_graph("fold_towel")
     with pytest.raises(Exception) as caught:
-        from agentchord.execution.episode import EpisodeSpec, run_episode
+        from agentchord.episode import EpisodeSpec, run_episode
 
         run_episode(EpisodeSpec(task="blocks_and_cup", graph=graph))
     assert type(caught.value).__name__ == "GraphNotRunnableError"

@@ -158,7 +158,7 @@ def test_a_failed_trial_is_the_environment_s_own_failure() -> None:
 
 
 def test_a_trial_s_success_is_the_environment_s_own_is_success() -> None:
-    from agentchord.execution.episode import EpisodeSpec, run_episode
+    from agentchord.episode import EpisodeSpec, run_episode
     from agentchord.gym.aloha import joint_action
 
     actions = []

@@ -6,7 +6,7 @@ from agentchord.expr import Vocabulary
 from agentchord.features.frame import make_static_frame
 from agentchord.graph.models import Edge, FailureMode
 from agentchord.monitor import EdgeMonitors, RecoveryMap
-from agentchord.tasks import load_task_graph
+from agentchord.library import load_task_graph
 
 VOCAB = Vocabulary(frozenset({"bottle", "cup"}))
 

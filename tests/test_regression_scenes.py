@@ -17,10 +17,10 @@ from __future__ import annotations
 
 import pytest
 
-from agentchord.execution.episode import EpisodeSpec, run_episode
+from agentchord.episode import EpisodeSpec, run_episode
 from agentchord.execution.reasoning import ReasoningConfig
 from agentchord.harness import KINDS, DisturbanceSetting
-from agentchord.tasks import load_task_graph
+from agentchord.library import load_task_graph
 
 REAL = DisturbanceSetting.from_options(protocol="real")
 STRESS = DisturbanceSetting.from_options(protocol="stress")
@@ -121,7 +121,7 @@ SCENES = [
     # bottle is still handed over, then the cup taken.
     pytest.param("dual_arm_pour_water", STRESS, 38, {}, lambda r: _handed_over(r, "left", "bottle"), id="dual_arm_pour-stress-38"),
     # A person's straight carry of the pulled bottle knocked over the cup just set upright; the
-    # person lifts it over (worlds/sim/hand.set_down_path, disturbances._carry_height): the cup,
+    # person lifts it over (sim/hand.set_down_path, disturbances._carry_height): the cup,
     # knocked once, is not knocked again.
     pytest.param("single_arm_pour_water", EVERY_KIND_03, 4, {}, lambda r: _modes(r).count("cup_tipped") == 1,
                  id="single_arm_pour-p0.3_every_kind-4"),

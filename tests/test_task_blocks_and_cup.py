@@ -7,8 +7,8 @@ import pytest
 
 from agentchord.agents.rules.goals import Folded, GoalSpec, Inside, On, Poured
 from agentchord.features.oracle import OracleExtractor
-from agentchord.worlds.sim.tasks import SIM_TASKS
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.sim.tasks import SIM_TASKS
+from agentchord.sim.world import SimWorld
 
 TASK = SIM_TASKS["blocks_and_cup"]
 

@@ -8,16 +8,16 @@ from agentchord.harness import DisturbanceSetting
 from agentchord.actions.base import Status
 from agentchord.actions.controller import RobotController
 from agentchord.actions.library import make_action
-from agentchord.execution.episode import EpisodeSpec, run_episode
+from agentchord.episode import EpisodeSpec, run_episode
 from agentchord.features.frame import make_static_frame, tilt_deg
 from agentchord.features.oracle import OracleExtractor
 from agentchord.graph.progress import forward_filter, nominal_path
 from agentchord.graph.validation import check_graph
-from agentchord.tasks import load_task_graph
-from agentchord.worlds.sim.disturbances import ScriptedDrop
-from agentchord.worlds.sim.tasks import SIM_TASKS
-from agentchord.worlds.sim.tasks.dual_arm_pour_water import DualPourTracker
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.library import load_task_graph
+from agentchord.sim.disturbances import ScriptedDrop
+from agentchord.sim.tasks import SIM_TASKS
+from agentchord.sim.tasks.dual_arm_pour_water import DualPourTracker
+from agentchord.sim.world import SimWorld
 
 TASK = "dual_arm_pour_water"
 

@@ -3,15 +3,15 @@
 import numpy as np
 import pytest
 
-from agentchord.execution.episode import EpisodeSpec, run_episode
+from agentchord.episode import EpisodeSpec, run_episode
 from agentchord.features.oracle import OracleExtractor
 from agentchord.graph.progress import forward_filter
 from agentchord.graph.validation import check_graph
-from agentchord.tasks import load_task_graph
-from agentchord.worlds.sim.disturbances import ScriptedDisturbance, ScriptedDrop
-from agentchord.worlds.sim.scene import SceneSpec
-from agentchord.worlds.sim.tasks import SIM_TASKS
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.library import load_task_graph
+from agentchord.sim.disturbances import ScriptedDisturbance, ScriptedDrop
+from agentchord.sim.scene import SceneSpec
+from agentchord.sim.tasks import SIM_TASKS
+from agentchord.sim.world import SimWorld
 
 TASK = SIM_TASKS["fold_towel"]
 CORNERS = ("towel_bl", "towel_br", "towel_tl", "towel_tr")

@@ -8,12 +8,12 @@ import pytest
 from agentchord.agents.observe import observe, task_regions
 from agentchord.agents.rules.goals import GoalSpec, HandedOver, Placed, Poured
 from agentchord.agents.rules.instructions import ground_instruction
-from agentchord.execution.episode import EpisodeSpec, planned_goal_tracker, run_episode
+from agentchord.episode import EpisodeSpec, planned_goal_tracker, run_episode
 from agentchord.features.oracle import OracleExtractor
-from agentchord.tasks import load_task_graph
-from agentchord.worlds.sim.tasks import SIM_TASKS
-from agentchord.worlds.sim.tasks.goal_tracker import POINT_TOLERANCE, GoalTracker
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.library import load_task_graph
+from agentchord.sim.tasks import SIM_TASKS
+from agentchord.sim.tasks.goal_tracker import POINT_TOLERANCE, GoalTracker
+from agentchord.sim.world import SimWorld
 
 
 def _handover_world(seed: int = 0, block_xy: tuple[float, float] | None = None):

@@ -6,18 +6,18 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from agentchord.execution.episode import EpisodeSpec, run_episode
+from agentchord.episode import EpisodeSpec, run_episode
 from agentchord.execution.executor import Executor
 from agentchord.execution.strategies import make_strategy
 from agentchord.features.oracle import OracleExtractor
 from agentchord.graph.progress import forward_filter, nominal_path
 from agentchord.graph.validation import check_graph
-from agentchord.tasks import load_task_graph
+from agentchord.library import load_task_graph
 from agentchord.harness import DisturbanceEvent, DisturbanceSetting
-from agentchord.worlds.sim.disturbances import ScriptedDrop
-from agentchord.worlds.sim.tasks import SIM_TASKS
-from agentchord.worlds.sim.tasks.handover_block import TARGET_RADIUS, TARGET_XY, HandoverTracker
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.sim.disturbances import ScriptedDrop
+from agentchord.sim.tasks import SIM_TASKS
+from agentchord.sim.tasks.handover_block import TARGET_RADIUS, TARGET_XY, HandoverTracker
+from agentchord.sim.world import SimWorld
 
 TASK = "handover_block"
 
@@ -221,7 +221,7 @@ def test_a_block_set_down_near_the_right_shoulder_is_approached_on_a_branch_that
     # to the grasp point stalls at once (7.5 cm short). Checked at the pre-grasp, the arm goes round
     # through home onto the branch that reaches the grasp point.
     from agentchord.actions import grasp, motion
-    from agentchord.worlds.sim.disturbances import ScriptedDisturbance
+    from agentchord.sim.disturbances import ScriptedDisturbance
 
     if not checks_the_line_ahead:
         monkeypatch.setattr(grasp, "approach", lambda robot, arm, goal, then=None, clear=None: motion.approach(robot, arm, goal))

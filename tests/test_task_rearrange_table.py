@@ -5,16 +5,16 @@ from dataclasses import dataclass, field
 import numpy as np
 import pytest
 
-from agentchord.execution.episode import EpisodeSpec, run_episode
+from agentchord.episode import EpisodeSpec, run_episode
 from agentchord.features.oracle import OracleExtractor
 from agentchord.graph.progress import forward_filter, nominal_path
 from agentchord.graph.validation import check_graph
-from agentchord.tasks import load_task_graph
+from agentchord.library import load_task_graph
 from agentchord.harness import DisturbanceEvent, DisturbanceSetting
-from agentchord.worlds.sim.disturbances import ScriptedDrop
-from agentchord.worlds.sim.tasks import SIM_TASKS
-from agentchord.worlds.sim.tasks.rearrange_table import TARGET_OFFSET, long_axis_yaw_deg, yaw_error_deg
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.sim.disturbances import ScriptedDrop
+from agentchord.sim.tasks import SIM_TASKS
+from agentchord.sim.tasks.rearrange_table import TARGET_OFFSET, long_axis_yaw_deg, yaw_error_deg
+from agentchord.sim.world import SimWorld
 
 TASK = "rearrange_table"
 

@@ -3,16 +3,16 @@
 import numpy as np
 import pytest
 
-from agentchord.execution.episode import EpisodeSpec, run_episode
+from agentchord.episode import EpisodeSpec, run_episode
 from agentchord.expr import Vocabulary, compile_expr
 from agentchord.features.oracle import OracleExtractor
 from agentchord.graph.progress import forward_filter, nominal_path
 from agentchord.graph.validation import check_graph
-from agentchord.tasks import load_task_graph
-from agentchord.worlds.sim.disturbances import ScriptedDisturbance, ScriptedDrop
-from agentchord.worlds.sim.tasks import SIM_TASKS
-from agentchord.worlds.sim.tasks.setup_coffee_tray import TRAY_TARGET, CoffeeTrayTracker, capsule_in_tray
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.library import load_task_graph
+from agentchord.sim.disturbances import ScriptedDisturbance, ScriptedDrop
+from agentchord.sim.tasks import SIM_TASKS
+from agentchord.sim.tasks.setup_coffee_tray import TRAY_TARGET, CoffeeTrayTracker, capsule_in_tray
+from agentchord.sim.world import SimWorld
 
 TASK = "setup_coffee_tray"
 

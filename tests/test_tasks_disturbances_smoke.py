@@ -2,11 +2,11 @@
 
 import pytest
 
-from agentchord.execution.episode import EpisodeSpec, run_episode
-from agentchord.tasks import library_tasks
+from agentchord.episode import EpisodeSpec, run_episode
+from agentchord.library import library_tasks
 from agentchord.harness import KINDS, DisturbanceSetting
-from agentchord.worlds.sim.disturbances import ScriptedDisturbance
-from agentchord.worlds.sim.tasks import SIM_TASKS
+from agentchord.sim.disturbances import ScriptedDisturbance
+from agentchord.sim.tasks import SIM_TASKS
 
 TASKS = sorted(set(SIM_TASKS) & set(library_tasks()))
 

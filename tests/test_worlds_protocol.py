@@ -19,7 +19,7 @@ from agentchord.worlds.protocol import (
     World,
     require_ground_truth,
 )
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.sim.world import SimWorld
 
 
 class NoGroundTruth:

@@ -14,14 +14,14 @@ from click.testing import CliRunner
 
 from agentchord.harness import DisturbanceSetting
 from agentchord.cli import main
-from agentchord.execution.episode import EpisodeSpec, run_episode
+from agentchord.episode import EpisodeSpec, run_episode
 from agentchord.execution.executor import ExecutorConfig
 from agentchord.features.oracle import OracleExtractor
 from agentchord.worlds.protocol import ArmCommand, GroundTruthWorld, World
 from agentchord.worlds.remote import RemoteWorld, RemoteWorldError, check_address
-from agentchord.worlds.sim.disturbances import ScriptedDisturbance
-from agentchord.worlds.sim.serve import WorldServer, serve_in_thread
-from agentchord.worlds.sim.trial import open_world
+from agentchord.sim.disturbances import ScriptedDisturbance
+from agentchord.sim.serve import WorldServer, serve_in_thread
+from agentchord.sim.trial import open_world
 from agentchord.worlds.wire import WireError, pack, unpack
 
 TASK = "single_arm_pour_water"

@@ -1,7 +1,7 @@
 """What a trial hands the executor besides the world: a disturbance schedule and a success check.
 
 The one home of the trial's protocols and the values they pass. The simulator implements them
-(``worlds/sim``: seeded disturbances, each task's success check); the executor names only these.
+(``sim/``: seeded disturbances, each task's success check); the executor names only these.
 A real robot's trial may have neither: no injected disturbances, and success judged by the graph's
 goal constraints.
 
@@ -51,7 +51,7 @@ class DisturbanceSetting:
     probability ``p``, the paper's Table I with ``kinds=("drop",)``), or a protocol (1-2 disturbances
     of ``kinds`` at random moments of each trial within ``window``, whatever ``p``: ``real`` is the
     paper's Table II, ``stress`` every kind, ``custom`` the kinds given). The seed of an episode
-    draws the schedule (the simulator's ``worlds.sim.disturbances.schedule``).
+    draws the schedule (the simulator's ``sim.disturbances.schedule``).
 
     Attributes:
         p: Probability per atomic action, in [0, 1].

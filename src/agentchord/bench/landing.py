@@ -16,11 +16,11 @@ import numpy as np
 
 from agentchord.actions.catalog import GraspArgs
 from agentchord.actions.library import Grasp
-from agentchord.execution.episode import EpisodeSpec, run_episode
+from agentchord.episode import EpisodeSpec, run_episode
 from agentchord.execution.executor import Executor, ExecutorConfig
 from agentchord.execution.feasibility import off_table
 from agentchord.features.frame import ARMS, tilt_deg
-from agentchord.worlds.sim.disturbances import ScriptedDisturbance
+from agentchord.sim.disturbances import ScriptedDisturbance
 
 #: Ticks after the event at which an object that no recovery bound is measured.
 SETTLE_TICKS = 110

@@ -12,7 +12,7 @@ import time
 import traceback
 from dataclasses import dataclass, field
 
-from agentchord.execution.episode import EpisodeSpec, run_episode
+from agentchord.episode import EpisodeSpec, run_episode
 from agentchord.execution.reasoning import ReasoningConfig
 from agentchord.harness import DisturbanceSetting
 
@@ -119,7 +119,7 @@ def sweep_keys(tasks: list[str], methods: list[str], conditions: list[Condition]
 
 def episode_spec(key: EpisodeKey, config: SweepConfig) -> EpisodeSpec:
     """The episode a key names, under the sweep's config."""
-    from agentchord.tasks import load_task_graph
+    from agentchord.library import load_task_graph
 
     condition = key.condition
     # With an LLM the plan is made (and timed) in the episode, from the instruction of the graph

@@ -48,8 +48,8 @@ main.add_command(demo)
 @main.command()
 def tasks() -> None:
     """List the simulated tasks, with a one-line description each."""
-    from agentchord.tasks import library_tasks
-    from agentchord.worlds.sim.tasks import SIM_TASKS
+    from agentchord.library import library_tasks
+    from agentchord.sim.tasks import SIM_TASKS
 
     graphs = set(library_tasks())
     width = max(len(name) for name in SIM_TASKS)
@@ -80,7 +80,7 @@ def serve(task, port, host, seed, release_after) -> None:
     check_task_name(task, "--task")
     import zmq
 
-    from agentchord.worlds.sim.serve import WorldServer, bind_host
+    from agentchord.sim.serve import WorldServer, bind_host
 
     def ready(endpoint: str) -> None:
         click.echo(f"serving {task} on {endpoint} (Ctrl-C to stop; a trial idle for {release_after:g} s is released)")
@@ -117,8 +117,8 @@ def plan(instruction, task, seed, goal_path, reasoner, perception, output, rende
     from agentchord.agents.pipeline import make_reasoner, plan_task
     from agentchord.execution.trace import Trace
     from agentchord.graph.loader import dump_graph
-    from agentchord.worlds.sim.tasks import SIM_TASKS
-    from agentchord.worlds.sim.trial import open_world
+    from agentchord.sim.tasks import SIM_TASKS
+    from agentchord.sim.trial import open_world
 
     check_task_name(task, "--task")
     _check_plan_outputs(output, render_path, trace_path, goal_path)
@@ -168,9 +168,9 @@ def _with_success(graph, task: str, goal, scene):
     own outcome keeps the task's check; another one (the bottle handed over in the pour scene) is
     judged by its goal spec and the goal node's constraints.
     """
-    from agentchord.execution.episode import planned_goal_tracker
+    from agentchord.episode import planned_goal_tracker
     from agentchord.graph.models import Success
-    from agentchord.worlds.sim.tasks import GoalTracker
+    from agentchord.sim.tasks import GoalTracker
 
     own_goal = isinstance(planned_goal_tracker(task, goal, graph, scene), GoalTracker)
     spec = goal.model_dump(mode="json") if goal is not None and own_goal else None

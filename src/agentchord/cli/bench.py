@@ -96,7 +96,7 @@ def bench_command(tasks, methods, ps, protocol, trials, first_seed, out_dir, bac
     from agentchord.bench.sweep import Condition, SweepConfig, describe, is_error, sweep_keys
     from agentchord.execution.methods import METHODS
     from agentchord.execution.reasoning import ReasoningConfig
-    from agentchord.worlds.sim.tasks import SIM_TASKS
+    from agentchord.sim.tasks import SIM_TASKS
 
     from agentchord.bench.tables import TASK_TITLES
 

@@ -58,8 +58,8 @@ def record_command(task, episodes, out, p, disturb, protocol, only_recovered, ke
     import sys
 
     from agentchord.cli.support import disturbance_setting
-    from agentchord.tasks import library_tasks
-    from agentchord.worlds.sim.tasks import SIM_TASKS
+    from agentchord.library import library_tasks
+    from agentchord.sim.tasks import SIM_TASKS
 
     if task not in SIM_TASKS:
         raise click.BadParameter(f"unknown task {task!r} (tasks: {', '.join(SIM_TASKS)})", param_hint="TASK")
@@ -74,7 +74,7 @@ def record_command(task, episodes, out, p, disturb, protocol, only_recovered, ke
                                                     cameras, size, "agentchord"))
     except ResumeError as exc:
         raise BadInput(f"--out {out}: {exc}") from None
-    from agentchord.worlds.sim.trial import open_world
+    from agentchord.sim.trial import open_world
 
     known = open_world(task, seed).camera_names
     unknown = [c for c in cameras if c not in known]

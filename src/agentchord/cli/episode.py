@@ -87,7 +87,7 @@ def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, inst
 
     Exit status 0 when the task succeeded, 1 when it failed, 2 on bad input.
     """
-    from agentchord.execution.episode import EpisodeSpec
+    from agentchord.episode import EpisodeSpec
 
     check_task_name(task, "TASK")
     if world is not None and video_path is not None:
@@ -111,7 +111,7 @@ def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, inst
         if video_path is None:
             return
         if "video" not in recorder:
-            from agentchord.worlds.sim.render import VideoRecorder
+            from agentchord.sim.render import VideoRecorder
 
             recorder["video"] = VideoRecorder(executor.world, video_path, camera=camera)
             recorder["seen"] = 0
@@ -185,7 +185,7 @@ def _load_graph_option(graph_path: str | None):
 def _run_or_explain(spec, on_tick=None, trace_path=None, graph_path=None):
     """Run an episode; a reasoner that cannot plan, or a graph that cannot run here, is bad input (exit 2)."""
     from agentchord.agents.exceptions import ReasonerError
-    from agentchord.execution.episode import run_episode
+    from agentchord.episode import run_episode
     from agentchord.graph.exceptions import GraphNotRunnableError
     from agentchord.worlds.remote import RemoteWorldError
 
@@ -204,7 +204,7 @@ def _check_camera(task: str, camera: str, video_path) -> None:
     """Refuse an unknown --camera before the episode, not when its first frame is drawn."""
     if video_path is None:
         return
-    from agentchord.worlds.sim.trial import open_world
+    from agentchord.sim.trial import open_world
 
     cameras = open_world(task, 0).camera_names
     if camera not in cameras:
@@ -359,7 +359,7 @@ def demo(task, trials, first_seed, p, disturb, protocol, perception, strategies,
     """Seeded episodes of each strategy under random drops, then a table per strategy."""
     from agentchord.bench.report import aggregate, paired_steps, print_tables
     from agentchord.bench.runner import run_many
-    from agentchord.execution.episode import EpisodeSpec
+    from agentchord.episode import EpisodeSpec
     from agentchord.worlds.remote import RemoteWorldError
 
     names = [s.strip() for s in strategies.split(",") if s.strip()]
@@ -376,7 +376,7 @@ def demo(task, trials, first_seed, p, disturb, protocol, perception, strategies,
     console.print(f"[bold]{task}[/bold]: {trials} seeded episodes per strategy; disturbances {', '.join(setting.kinds)}, "
                   f"{schedule}; perception {perception}")
     if planned and instruction is None:
-        from agentchord.tasks import load_task_graph
+        from agentchord.library import load_task_graph
 
         instruction = load_task_graph(task).instruction
     if instruction:

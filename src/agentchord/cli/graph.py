@@ -81,8 +81,8 @@ def check_command(files: tuple[Path, ...], task: str | None) -> None:
 
 def _scene_objects(task: str) -> list[str]:
     """The names the feature frame of ``task``'s scene holds (objects, cloth points)."""
-    from agentchord.worlds.sim.tasks import SIM_TASKS
-    from agentchord.worlds.sim.trial import open_world
+    from agentchord.sim.tasks import SIM_TASKS
+    from agentchord.sim.trial import open_world
 
     if task not in SIM_TASKS:
         raise click.BadParameter(f"unknown task {task!r} (tasks: {', '.join(SIM_TASKS)})", param_hint="--task")
@@ -228,7 +228,7 @@ def _warn_sim_objects(graph: TaskGraph) -> None:
     """Say so when the graph names objects that its simulated task's scene lacks."""
     import numpy as np
 
-    from agentchord.worlds.sim.tasks import SIM_TASKS
+    from agentchord.sim.tasks import SIM_TASKS
 
     task = SIM_TASKS.get(graph.task)
     if task is None:

@@ -267,7 +267,7 @@ PERCEPTION_NAMES = ("oracle", "rgbd")
 
 def check_task_name(task: str, param_hint: str) -> None:
     """Refuse a task that is not simulated, naming the ones that are (a usage error on ``param_hint``)."""
-    from agentchord.worlds.sim.tasks import SIM_TASKS
+    from agentchord.sim.tasks import SIM_TASKS
 
     if task not in SIM_TASKS:
         raise click.BadParameter(f"unknown task {task!r} (tasks: {', '.join(SIM_TASKS)})", param_hint=param_hint)

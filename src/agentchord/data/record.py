@@ -24,11 +24,11 @@ from pathlib import Path
 import numpy as np
 
 from agentchord.data.lerobot import DatasetWriter
-from agentchord.execution.episode import EpisodeSpec, run_episode
+from agentchord.episode import EpisodeSpec, run_episode
 from agentchord.guard.outputs import atomic_write_text
 from agentchord.gym.aloha import JOINT_NAMES, environment_names, environment_state, joint_action, joint_state
 from agentchord.gym.cameras import RgbCameras
-from agentchord.tasks import load_task_graph
+from agentchord.library import load_task_graph
 from agentchord.harness import UNDISTURBED, DisturbanceSetting
 from agentchord.worlds.protocol import CONTROL_HZ
 
@@ -219,7 +219,7 @@ def record(task: str, episodes: int, out: str | Path, *, disturbances: Disturban
     nodes = [n.id for n in graph.nodes]
     edges = [e.id for e in graph.edges]
     instruction = graph.instruction or task.replace("_", " ")
-    from agentchord.worlds.sim.trial import open_world  # the scene's object names
+    from agentchord.sim.trial import open_world  # the scene's object names
 
     settings = record_settings(task, disturbances, only_recovered, keep_failed, seed, cameras, image_size, strategy)
     state = recorded_state(out, settings)

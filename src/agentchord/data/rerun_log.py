@@ -16,7 +16,7 @@ One timeline, ``tick`` (50 Hz; ``time`` alongside in seconds), with:
 - ``events``: disturbances, detected failures, recovery switches and merges, repairs (text log);
 - ``world/disturbance``: what a disturbance looks like while it acts (and a moment after): a
   person's hand on a pulled object with the trail of its carry, a finger pushing or knocking one,
-  an arrow along the push (:mod:`agentchord.worlds.sim.markers`), labelled with the disturbance's
+  an arrow along the push (:mod:`agentchord.sim.markers`), labelled with the disturbance's
   name; the camera images show them too; ``status/disturbance``: 1 while one shows, and
   ``disturbance``: its name in a text log when it starts and ends.
 """
@@ -30,7 +30,7 @@ import numpy as np
 from agentchord.gym.aloha import ARMS, gripper_open
 from agentchord.gym.cameras import RgbCameras
 from agentchord.worlds.protocol import CONTROL_HZ
-from agentchord.worlds.sim.markers import KIND, WHAT, DisturbanceMarkers, Shape
+from agentchord.sim.markers import KIND, WHAT, DisturbanceMarkers, Shape
 
 #: Trace events logged to ``events``, with their level.
 EVENT_LEVELS = {

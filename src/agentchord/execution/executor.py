@@ -69,7 +69,7 @@ class ExecutorConfig:
     bind_wait_ticks: int = 100
     #: ... and a rigid object: a person's pull takes up to 3.3 s to set it down (out of the
     #: fingers, held clear of a moving gripper for up to 1.5 s, carried, lowered, held still:
-    #: ``worlds/sim/hand.py``).
+    #: ``sim/hand.py``).
     bind_rigid_wait_ticks: int = 200
     #: Ticks a failing goal verdict waits, arms still, for a scene that still moves (a cloth's vertices
     #: jittering in contact, a tray rocking after release, a bottle knocked over as the arm got home)

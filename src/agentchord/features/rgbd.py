@@ -29,7 +29,7 @@ from agentchord.features.shape_fit import ShapeFit, fit_box, fit_cylinder
 from agentchord.features.segmentation import LabelSegmenter, Segmenter
 from agentchord.worlds.protocol import CONTROL_HZ, Camera, CameraFrame, World
 
-#: Cameras used for perception (the simulated scene's are defined in :mod:`agentchord.worlds.sim.scene`).
+#: Cameras used for perception (the simulated scene's are defined in :mod:`agentchord.sim.scene`).
 PERCEPTION_CAMERAS = ("front", "side")
 #: Camera frame rate (Hz) of the paper's RGB-D setting.
 CAMERA_RATE_HZ = 10

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import gymnasium
 
-from agentchord.worlds.sim.tasks import SIM_TASKS
+from agentchord.sim.tasks import SIM_TASKS
 
 #: Namespace of the environment ids.
 NAMESPACE = "agentchord"

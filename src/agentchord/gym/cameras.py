@@ -1,6 +1,6 @@
 """Colour images of the simulated scene's cameras, for observations and datasets.
 
-The simulator's own cameras (``worlds/sim/cameras``) render depth and labels for perception; a
+The simulator's own cameras (``sim/cameras``) render depth and labels for perception; a
 policy and a dataset want plain RGB frames: one ``mujoco.Renderer`` per camera here.
 """
 
@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from agentchord.worlds.sim.markers import Shape, add_to_scene
-from agentchord.worlds.sim.renderers import close_at_exit, closed, open_renderer
+from agentchord.sim.markers import Shape, add_to_scene
+from agentchord.sim.renderers import close_at_exit, closed, open_renderer
 
 
 class RgbCameras:
@@ -37,7 +37,7 @@ class RgbCameras:
     def render(self, shapes: list[Shape] | tuple[Shape, ...] = ()) -> dict[str, np.ndarray]:
         """One (H, W, 3) uint8 image per camera of the state now, ``shapes`` drawn in.
 
-        ``shapes``: disturbance markers (:meth:`agentchord.worlds.sim.markers.DisturbanceMarkers.shapes`,
+        ``shapes``: disturbance markers (:meth:`agentchord.sim.markers.DisturbanceMarkers.shapes`,
         a Rerun recording's images); observations and datasets pass none.
         """
         out = {}

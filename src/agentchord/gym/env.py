@@ -17,9 +17,9 @@ from agentchord.gym.cameras import RgbCameras
 from agentchord.robot.aloha import ARM_JOINTS, ARM_PREFIX
 from agentchord.worlds.protocol import CONTROL_HZ
 from agentchord.harness import PRESETS, PROTOCOL_WINDOW, Disturbance, DisturbanceSetting
-from agentchord.worlds.sim.disturbances import schedule
-from agentchord.worlds.sim.tasks import SIM_TASKS
-from agentchord.worlds.sim.trial import open_world
+from agentchord.sim.disturbances import schedule
+from agentchord.sim.tasks import SIM_TASKS
+from agentchord.sim.trial import open_world
 
 #: Observation types: ``state`` (joint state and the objects' poses) and ``pixels_state`` (and camera images).
 OBS_TYPES = ("state", "pixels_state")

@@ -2,7 +2,7 @@
 (:mod:`~agentchord.robot.aloha`, plain numbers), and its MuJoCo kinematic model for the IK
 (:mod:`~agentchord.robot.model`).
 
-Both the simulator (``worlds/sim``) and the controller side (``solvers``, ``actions``) read it;
+Both the simulator (``sim/``) and the controller side (``solvers``, ``actions``) read it;
 neither owns it. A real robot of the same class (an AgileX CobotMagic) would get a module of
 its own beside ``aloha``.
 """

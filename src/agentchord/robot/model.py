@@ -3,7 +3,7 @@ package (loaded by path: we neither import its environments nor copy its files),
 through ``mujoco.MjSpec`` -- a tool-centre site between the fingers, gravity compensation,
 lighter joint friction, our own position actuators.
 
-The simulator builds its scene on it (``worlds/sim/scene.py``); the IK works on the robot
+The simulator builds its scene on it (``sim/scene.py``); the IK works on the robot
 alone with capsule collision proxies (:func:`build_robot_model`).
 """
 

@@ -8,7 +8,7 @@ worlds also know the true state of the objects (a simulator does, a real robot d
 they implement :class:`GroundTruthWorld` too, and a feature extractor that needs it says so
 (:func:`require_ground_truth`).
 
-Implementations: :class:`agentchord.worlds.sim.world.SimWorld` (MuJoCo, in process) and
+Implementations: :class:`agentchord.sim.world.SimWorld` (MuJoCo, in process) and
 :class:`agentchord.worlds.remote.RemoteWorld` (any world served over the message protocol of
 ``docs/world_protocol.md``, e.g. ``agentchord serve``). Disturbances, success checks and the
 scene's ground truth stay on the simulator's side: nothing here names them.

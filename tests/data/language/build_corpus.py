@@ -30,8 +30,8 @@ import yaml
 
 from agentchord.agents.observe import observe, task_regions
 from agentchord.agents.rules import knowledge as kb
-from agentchord.worlds.sim.tasks import SIM_TASKS
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.sim.tasks import SIM_TASKS
+from agentchord.sim.world import SimWorld
 
 HERE = Path(__file__).parent
 SCENES = {

@@ -293,6 +293,6 @@ def nominal_part(graph: TaskGraph) -> TaskGraph:
 
 
 def _example_graph() -> TaskGraph:
-    from agentchord.tasks import load_task_graph  # the task library imports the graph loader only
+    from agentchord.library import load_task_graph  # the task library imports the graph loader only
 
     return load_task_graph(EXAMPLE_TASK)

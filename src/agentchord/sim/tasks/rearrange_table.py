@@ -12,10 +12,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from agentchord.features.frame import FeatureFrame, level_tilt_deg
-from agentchord.worlds.sim.scene import ObjectSpec, SceneSpec
+from agentchord.sim.scene import ObjectSpec, SceneSpec
 from agentchord.harness import Verdict
-from agentchord.worlds.sim.tasks.base import resting_on_table, uniform
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.sim.tasks.base import resting_on_table, uniform
+from agentchord.sim.world import SimWorld
 
 #: Target of each utensil's centre, relative to the plate's centre (m), and the arm that moves it.
 TARGET_OFFSET = {"fork": (-0.17, 0.0), "spoon": (0.17, 0.0)}

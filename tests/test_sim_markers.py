@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from agentchord.worlds.sim.hand import set_down_path
-from agentchord.worlds.sim.markers import LINGER_TICKS, DisturbanceMarkers, read_marker
-from agentchord.worlds.sim.tasks import SIM_TASKS
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.sim.hand import set_down_path
+from agentchord.sim.markers import LINGER_TICKS, DisturbanceMarkers, read_marker
+from agentchord.sim.tasks import SIM_TASKS
+from agentchord.sim.world import SimWorld
 
 
 def _world() -> SimWorld:
@@ -68,7 +68,7 @@ def test_a_push_lingers_a_moment_then_goes():
 
 
 def test_filming_the_markers_changes_nothing_in_the_simulation(tmp_path):
-    from agentchord.worlds.sim.render import VideoRecorder
+    from agentchord.sim.render import VideoRecorder
 
     plain, filmed = _world(), _world()
     recorder = VideoRecorder(filmed, tmp_path / "v.mp4", size=(160, 120))
@@ -93,7 +93,7 @@ def test_filming_the_markers_changes_nothing_in_the_simulation(tmp_path):
 
 
 def test_the_hand_is_drawn_into_the_frame(tmp_path):
-    from agentchord.worlds.sim.render import VideoRecorder
+    from agentchord.sim.render import VideoRecorder
 
     world = _world()
     recorder = VideoRecorder(world, tmp_path / "v.mp4", every=1, size=(320, 240))

@@ -15,7 +15,7 @@ def library_path(task: str) -> Path:
     Raises:
         KeyError: No graph for that task in the library.
     """
-    path = Path(str(resources.files("agentchord.tasks") / "library" / f"{task}.yaml"))
+    path = Path(str(resources.files("agentchord.library") / "graphs" / f"{task}.yaml"))
     if not path.is_file():
         raise KeyError(f"no library graph for task {task!r} (have: {', '.join(library_tasks())})")
     return path
@@ -23,7 +23,7 @@ def library_path(task: str) -> Path:
 
 def library_tasks() -> list[str]:
     """Names of the tasks with a library graph."""
-    folder = resources.files("agentchord.tasks") / "library"
+    folder = resources.files("agentchord.library") / "graphs"
     return sorted(p.name[: -len(".yaml")] for p in folder.iterdir() if p.name.endswith(".yaml"))
 
 

@@ -20,12 +20,12 @@ from agentchord.execution.repair import Repairer
 from agentchord.execution.result import EpisodeResult
 from agentchord.graph.grounding import require_runnable
 from agentchord.graph.models import TaskGraph
-from agentchord.tasks import load_task_graph
+from agentchord.library import load_task_graph
 from agentchord.worlds.protocol import World
 from agentchord.worlds.remote import RemoteWorld
-from agentchord.worlds.sim.disturbances import schedule
-from agentchord.worlds.sim.tasks import SIM_TASKS, judge_by_goal
-from agentchord.worlds.sim.trial import open_world
+from agentchord.sim.disturbances import schedule
+from agentchord.sim.tasks import SIM_TASKS, judge_by_goal
+from agentchord.sim.trial import open_world
 
 
 @dataclass

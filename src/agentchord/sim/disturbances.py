@@ -46,9 +46,9 @@ from agentchord.harness import (
     RunningAction,
     parse_kinds,
 )
-from agentchord.worlds.sim.hand import OUT_S, set_down_path
-from agentchord.worlds.sim.scene import TABLE_FRICTION
-from agentchord.worlds.sim.world import CONTROL_HZ, SimWorld
+from agentchord.sim.hand import OUT_S, set_down_path
+from agentchord.sim.scene import TABLE_FRICTION
+from agentchord.sim.world import CONTROL_HZ, SimWorld
 
 #: How long a gripper fault forces the fingers open (ticks at 50 Hz).
 FAULT_TICKS = 12

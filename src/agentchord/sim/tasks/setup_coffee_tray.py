@@ -16,10 +16,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from agentchord.features.frame import FeatureFrame
-from agentchord.worlds.sim.scene import ObjectSpec, SceneSpec
+from agentchord.sim.scene import ObjectSpec, SceneSpec
 from agentchord.harness import Verdict
-from agentchord.worlds.sim.tasks.base import tilt_deg, uniform
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.sim.tasks.base import tilt_deg, uniform
+from agentchord.sim.world import SimWorld
 
 #: Where the tray must end (x, y, m): the designated forward position, 10-16 cm ahead of its start.
 TRAY_TARGET = (0.0, 0.67)

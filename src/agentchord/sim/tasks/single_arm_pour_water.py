@@ -7,10 +7,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from agentchord.features.frame import FeatureFrame
-from agentchord.worlds.sim.scene import ObjectSpec, SceneSpec
+from agentchord.sim.scene import ObjectSpec, SceneSpec
 from agentchord.harness import Verdict
-from agentchord.worlds.sim.tasks.base import pouring, resting_on_table, tilt_deg, uniform
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.sim.tasks.base import pouring, resting_on_table, tilt_deg, uniform
+from agentchord.sim.world import SimWorld
 
 
 @dataclass

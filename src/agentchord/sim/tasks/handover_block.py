@@ -19,10 +19,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from agentchord.features.frame import FeatureFrame
-from agentchord.worlds.sim.scene import ObjectSpec, SceneSpec
+from agentchord.sim.scene import ObjectSpec, SceneSpec
 from agentchord.harness import Verdict
-from agentchord.worlds.sim.tasks.base import resting_on_table, tilt_deg, uniform
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.sim.tasks.base import resting_on_table, tilt_deg, uniform
+from agentchord.sim.world import SimWorld
 
 #: Centre (x, y) of the target region on the right half of the table (m); the library
 #: graph's place action and its sub-goal constraint use the same numbers.

@@ -3,7 +3,7 @@
 A task knows how to sample one trial's scene from a seeded generator (object
 instances within a category, table poses) and how to judge success from the
 feature frames of the episode. The task *graph* lives in the task library
-(:mod:`agentchord.tasks`); this package is the world side only.
+(:mod:`agentchord.library`); this package is the world side only.
 """
 
 from __future__ import annotations
@@ -14,8 +14,8 @@ import numpy as np
 
 from agentchord.features.frame import FeatureFrame, ObjectFeatures, tilt_deg  # re-exported for the task modules
 from agentchord.harness import SuccessTracker
-from agentchord.worlds.sim.scene import SceneSpec
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.sim.scene import SceneSpec
+from agentchord.sim.world import SimWorld
 
 
 class SimTask(Protocol):

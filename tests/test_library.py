@@ -5,7 +5,7 @@ import pytest
 from agentchord.agents.rules.in_hand import redone_slips
 from agentchord.graph.progress import forward_filter, nominal_path
 from agentchord.graph.validation import check_graph
-from agentchord.tasks import library_tasks, load_task_graph
+from agentchord.library import library_tasks, load_task_graph
 
 
 @pytest.mark.parametrize("task", library_tasks())

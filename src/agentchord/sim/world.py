@@ -10,10 +10,10 @@ import mujoco
 import numpy as np
 
 from agentchord.worlds.protocol import CONTROL_HZ, ArmCommand, CameraFrame  # noqa: F401  (re-exported)
-from agentchord.worlds.sim.cameras import DepthCamera
-from agentchord.worlds.sim.exceptions import UnknownObjectError
-from agentchord.worlds.sim.hand import PersonHand, Waypoint
-from agentchord.worlds.sim.scene import (
+from agentchord.sim.cameras import DepthCamera
+from agentchord.sim.exceptions import UnknownObjectError
+from agentchord.sim.hand import PersonHand, Waypoint
+from agentchord.sim.scene import (
     ARM_JOINTS,
     ARM_PREFIX,
     FINGER_GAP_OFFSET,

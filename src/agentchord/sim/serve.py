@@ -34,11 +34,11 @@ from scipy.spatial.transform import Rotation
 
 from agentchord.robot.aloha import ARMS
 from agentchord.worlds.protocol import CONTROL_HZ, ArmCommand
-from agentchord.worlds.sim.cameras import DepthCamera
-from agentchord.worlds.sim.hand import Waypoint
-from agentchord.worlds.sim.tasks import SIM_TASKS
-from agentchord.worlds.sim.trial import open_world
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.sim.cameras import DepthCamera
+from agentchord.sim.hand import Waypoint
+from agentchord.sim.tasks import SIM_TASKS
+from agentchord.sim.trial import open_world
+from agentchord.sim.world import SimWorld
 from agentchord.worlds.wire import PROTOCOL_VERSION, WireError, pack, unpack
 
 #: The simulator's own calls a client may make (``sim``), and whether each changes the world.

@@ -10,8 +10,8 @@ import importlib
 import pkgutil
 
 from agentchord.harness import SuccessTracker, Verdict
-from agentchord.worlds.sim.tasks.base import SimTask
-from agentchord.worlds.sim.tasks.goal_tracker import GoalTracker
+from agentchord.sim.tasks.base import SimTask
+from agentchord.sim.tasks.goal_tracker import GoalTracker
 
 
 def _discover() -> dict[str, SimTask]:

@@ -1,4 +1,4 @@
-"""The world server (``worlds/sim/serve.py``): one client's trial at a time, and what it is sent checked."""
+"""The world server (``sim/serve.py``): one client's trial at a time, and what it is sent checked."""
 
 from __future__ import annotations
 
@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 import zmq
 
-from agentchord.worlds.sim import serve as serve_module
-from agentchord.worlds.sim.serve import MAX_CAMERAS, MAX_MESSAGE_BYTES, WorldServer, serve_in_thread
+from agentchord.sim import serve as serve_module
+from agentchord.sim.serve import MAX_CAMERAS, MAX_MESSAGE_BYTES, WorldServer, serve_in_thread
 from agentchord.worlds.wire import pack, unpack
 
 TASK = "single_arm_pour_water"

@@ -26,7 +26,7 @@ from agentchord.robot.aloha import (  # noqa: F401  (the robot's numbers, re-exp
 from agentchord.robot.exceptions import RobotModelError
 from agentchord.robot.model import add_collision_proxies, edit_robot, robot_xml
 from agentchord.worlds.protocol import grip_width, upright_height
-from agentchord.worlds.sim.exceptions import SceneError
+from agentchord.sim.exceptions import SceneError
 
 #: Sliding friction of the table top (MuJoCo takes the larger of two touching geoms' coefficients).
 TABLE_FRICTION = 1.0

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 from agentchord.actions.library import make_action
-from agentchord.execution.episode import EpisodeSpec, run_episode
+from agentchord.episode import EpisodeSpec, run_episode
 from agentchord.harness import KINDS, DisturbanceSetting, parse_kinds
-from agentchord.worlds.sim.disturbances import ProtocolDisturbances, RandomDisturbances, ScriptedDisturbance
+from agentchord.sim.disturbances import ProtocolDisturbances, RandomDisturbances, ScriptedDisturbance
 
 TASK = "single_arm_pour_water"
 
@@ -99,8 +99,8 @@ def test_landings_stay_in_the_stated_ranges(kind, low, high, upright):
 
 def test_a_push_or_a_knock_never_takes_an_object_in_the_air(pour_scene):
     from agentchord.features.oracle import OracleExtractor
-    from agentchord.worlds.sim.disturbances import _free_objects
-    from agentchord.worlds.sim.world import SimWorld
+    from agentchord.sim.disturbances import _free_objects
+    from agentchord.sim.world import SimWorld
 
     world = SimWorld(pour_scene)
     extractor = OracleExtractor(world, grasp_signal=lambda arm: False)
@@ -121,7 +121,7 @@ def test_a_push_or_a_knock_never_takes_an_object_in_the_air(pour_scene):
 
 def test_a_long_object_pulled_out_of_a_top_grasp_leaves_the_fingers_and_lands_flat():
     from agentchord.features.frame import tilt_deg
-    from agentchord.worlds.sim.disturbances import ScriptedDisturbance
+    from agentchord.sim.disturbances import ScriptedDisturbance
 
     seen = {}
 
@@ -161,8 +161,8 @@ def test_a_perturb_pushes_an_object_at_rest_or_in_the_other_hand_never_one_in_th
     import numpy as np
 
     from agentchord.features.oracle import OracleExtractor
-    from agentchord.worlds.sim.disturbances import inject
-    from agentchord.worlds.sim.world import SimWorld
+    from agentchord.sim.disturbances import inject
+    from agentchord.sim.world import SimWorld
 
     world = SimWorld(pour_scene)
     extractor = OracleExtractor(world, grasp_signal=lambda arm: False)
@@ -206,8 +206,8 @@ def test_a_carry_lifts_over_what_stands_in_its_way_but_not_over_its_own_load():
     # (planned coffee tray, real protocol, seed 2): what rests in or on the carried object goes with it.
     from types import SimpleNamespace
 
-    from agentchord.worlds.sim.disturbances import _carry_height
-    from agentchord.worlds.sim.tasks import SIM_TASKS
+    from agentchord.sim.disturbances import _carry_height
+    from agentchord.sim.tasks import SIM_TASKS
 
     specs = {o.name: o for o in SIM_TASKS["setup_coffee_tray"].sample_scene(np.random.default_rng(0)).objects}
     on_table = 0.5 * specs["capsule"].height

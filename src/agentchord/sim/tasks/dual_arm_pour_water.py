@@ -6,7 +6,7 @@ steady in the air while the right arm pours into it.
 
 Scene (ranges are the class constants below): a bottle on the right half of the table and a
 cup on the left half, both cylinders; the cup is narrow enough for a side grasp (diameter
-<= 5.6 cm in a 6.9 cm finger gap). The library graph (``tasks/library/dual_arm_pour_water.yaml``)
+<= 5.6 cm in a 6.9 cm finger gap). The library graph (``library/graphs/dual_arm_pour_water.yaml``)
 holds the cup at a receiving pose (tool at x 0.0, y 0.62, z 0.15) and pours from 9 cm beside it,
 8 cm above its rim, rolling the bottle 95 degrees, as single-arm pour water does.
 """
@@ -18,10 +18,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from agentchord.features.frame import FeatureFrame
-from agentchord.worlds.sim.scene import ObjectSpec, SceneSpec
+from agentchord.sim.scene import ObjectSpec, SceneSpec
 from agentchord.harness import Verdict
-from agentchord.worlds.sim.tasks.base import pouring, resting_on_table, tilt_deg, uniform
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.sim.tasks.base import pouring, resting_on_table, tilt_deg, uniform
+from agentchord.sim.world import SimWorld
 
 
 @dataclass

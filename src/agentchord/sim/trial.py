@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from agentchord.worlds.sim.tasks import SIM_TASKS
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.sim.tasks import SIM_TASKS
+from agentchord.sim.world import SimWorld
 
 #: Mixed into the seed of a trial's scene draw (the disturbance schedule draws from the bare seed).
 SCENE_SALT = 0x5CE7E

@@ -19,9 +19,9 @@ import numpy as np
 
 from agentchord.features.frame import FeatureFrame
 from agentchord.harness import Verdict
-from agentchord.worlds.sim.tasks.base import pouring, resting_on_table
-from agentchord.worlds.sim.tasks.rearrange_table import yaw_error_deg
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.sim.tasks.base import pouring, resting_on_table
+from agentchord.sim.tasks.rearrange_table import yaw_error_deg
+from agentchord.sim.world import SimWorld
 
 #: Largest speed (m/s) of an object at rest.
 REST_SPEED = 0.02

@@ -14,7 +14,7 @@ import pytest
 RENDER_THEN_TRITON = """
 import agentchord  # sets MUJOCO_GL
 import mujoco
-from agentchord.worlds.sim.renderers import open_renderer
+from agentchord.sim.renderers import open_renderer
 model = mujoco.MjModel.from_xml_string("<mujoco><worldbody><geom size='0.1'/></worldbody></mujoco>")
 data = mujoco.MjData(model)
 renderer = open_renderer(model, 32, 32)
@@ -36,7 +36,7 @@ def test_rendering_then_importing_triton_does_not_crash():
 def test_open_renderer_renders_the_model():
     import mujoco
 
-    from agentchord.worlds.sim.renderers import open_renderer
+    from agentchord.sim.renderers import open_renderer
 
     model = mujoco.MjModel.from_xml_string("<mujoco><worldbody><geom size='0.1'/></worldbody></mujoco>")
     renderer = open_renderer(model, 24, 40)

@@ -4,7 +4,7 @@ Grasp towel bottom corners (LR) -> lift towel bottom (LR) -> move to towel top c
 place towel (LR). Success: the two bottom corners of the towel lie within a tolerance of the
 corresponding top corners (a half-folded towel), released by both grippers, the cloth at rest.
 
-The towel is a MuJoCo flex cloth (:class:`~agentchord.worlds.sim.scene.ClothSpec`), grasped only
+The towel is a MuJoCo flex cloth (:class:`~agentchord.sim.scene.ClothSpec`), grasped only
 by friction between the finger pads: a top grasp pinches the corner vertex against nothing but the
 other finger. Convention: in the towel's own frame, the *bottom* edge is the y-min edge (nearer the
 front camera, ``towel_bl`` / ``towel_br``) and the *top* edge the y-max one (``towel_tl`` /
@@ -19,10 +19,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from agentchord.features.frame import FeatureFrame
-from agentchord.worlds.sim.scene import ClothSpec, SceneSpec
+from agentchord.sim.scene import ClothSpec, SceneSpec
 from agentchord.harness import Verdict
-from agentchord.worlds.sim.tasks.base import uniform
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.sim.tasks.base import uniform
+from agentchord.sim.world import SimWorld
 
 #: Bottom corner -> the top corner it is folded onto, and the arm that folds it.
 FOLD_PAIRS = {"towel_bl": ("towel_tl", "left"), "towel_br": ("towel_tr", "right")}

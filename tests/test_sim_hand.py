@@ -3,9 +3,9 @@
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from agentchord.worlds.sim.hand import min_jerk, set_down_path
-from agentchord.worlds.sim.tasks import SIM_TASKS
-from agentchord.worlds.sim.world import SimWorld
+from agentchord.sim.hand import min_jerk, set_down_path
+from agentchord.sim.tasks import SIM_TASKS
+from agentchord.sim.world import SimWorld
 
 
 def _world() -> SimWorld:
@@ -53,7 +53,7 @@ def test_out_of_a_moving_gripper_the_object_is_held_clear_of_it_until_it_stops()
     # The arm carries on while a person pulls (a baseline that does not stop): the out-of-the-fingers
     # segment follows the gripper, and the carry waits while the gripper still moves, so the arm does
     # not run into the object again.
-    from agentchord.worlds.sim.hand import OUT_S, PersonHand
+    from agentchord.sim.hand import OUT_S, PersonHand
 
     world = _world()
     body = world.model.body("bottle").id
@@ -82,7 +82,7 @@ def test_out_of_a_moving_gripper_the_object_is_held_clear_of_it_until_it_stops()
 
 
 def test_a_gripper_that_never_stops_is_waited_for_at_most_the_stated_time():
-    from agentchord.worlds.sim.hand import MAX_CLEAR_HOLD_S, PersonHand
+    from agentchord.sim.hand import MAX_CLEAR_HOLD_S, PersonHand
 
     world = _world()
     pos, matrix = world.object_pose("bottle")
@@ -99,7 +99,7 @@ def test_a_gripper_that_never_stops_is_waited_for_at_most_the_stated_time():
 
 
 def test_a_carry_with_something_in_the_way_lifts_over_it_and_one_without_goes_straight():
-    from agentchord.worlds.sim.hand import RISE_S
+    from agentchord.sim.hand import RISE_S
 
     pos, start = np.array([0.1, 0.5, 0.1]), Rotation.identity()
     args = (pos, start, np.array([0.0, 1.0, 0.0]), np.array([-0.2, 0.7]), 0.05, Rotation.identity())

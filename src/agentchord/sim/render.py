@@ -1,6 +1,6 @@
 """Offscreen rendering of episodes to video, with the graph state and the disturbances shown on the frames.
 
-A disturbance is drawn where it acts (:mod:`agentchord.worlds.sim.markers`: a person's hand
+A disturbance is drawn where it acts (:mod:`agentchord.sim.markers`: a person's hand
 carrying a pulled object, a finger pushing or knocking one), into the renderer's scene only,
 and named in an orange banner while it acts.
 """
@@ -12,9 +12,9 @@ from pathlib import Path
 
 import numpy as np
 
-from agentchord.worlds.sim.markers import KIND, WHAT, DisturbanceMarkers, add_to_scene
-from agentchord.worlds.sim.renderers import open_renderer
-from agentchord.worlds.sim.world import CONTROL_HZ, SimWorld
+from agentchord.sim.markers import KIND, WHAT, DisturbanceMarkers, add_to_scene
+from agentchord.sim.renderers import open_renderer
+from agentchord.sim.world import CONTROL_HZ, SimWorld
 
 #: The disturbance announcements of ``agentchord run --video`` (``DISTURBANCE: kind obj``): they name the kind.
 _ANNOUNCED = re.compile(r"DISTURBANCE: (?P<kind>\S+) (?P<obj>\S+)")

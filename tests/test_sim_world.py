@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from agentchord.worlds.sim.world import ArmCommand, SimWorld
+from agentchord.sim.world import ArmCommand, SimWorld
 
 
 def test_objects_rest_on_the_table_after_reset(pour_scene):

@@ -3,16 +3,16 @@
 A red block, a blue block and a wide open cup (a compound body: a floor and four walls)
 on the table. No fixed instruction: "put the red block into the cup", "stack the red
 block on the blue block", ... are planned by the agents, and success is judged from the
-goal they planned for (:class:`~agentchord.worlds.sim.tasks.goal_tracker.GoalTracker`).
+goal they planned for (:class:`~agentchord.sim.tasks.goal_tracker.GoalTracker`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from agentchord.worlds.sim.scene import ObjectSpec, SceneSpec
-from agentchord.worlds.sim.tasks.base import uniform
-from agentchord.worlds.sim.tasks.goal_tracker import GoalTracker
+from agentchord.sim.scene import ObjectSpec, SceneSpec
+from agentchord.sim.tasks.base import uniform
+from agentchord.sim.tasks.goal_tracker import GoalTracker
 
 #: Floor and wall thickness of the cup (m).
 CUP_FLOOR = 0.006

@@ -11,7 +11,7 @@ import mujoco
 import numpy as np
 
 from agentchord.worlds.protocol import CameraFrame
-from agentchord.worlds.sim.renderers import close_at_exit, closed, open_renderer
+from agentchord.sim.renderers import close_at_exit, closed, open_renderer
 
 class DepthCamera:
     """A scene camera that renders depth and segmentation with its own ``mujoco.Renderer``
