@@ -7,7 +7,7 @@ from scipy.spatial.transform import Rotation
 from agentchord.harness import DisturbanceSetting
 from agentchord.actions.base import Status
 from agentchord.actions.controller import RobotController
-from agentchord.actions.finger_clearance import swept_hits
+from agentchord.actions.grasping.finger_clearance import swept_hits
 from agentchord.actions.grasp import GraspMissed
 from agentchord.actions.joint_path import joint_path
 from agentchord.actions.library import make_action
@@ -157,7 +157,7 @@ def test_a_fallen_grasp_slides_along_the_object_where_a_finger_would_come_down_o
     # three times, for the right arm; the left arm's alternative could not reach past it. Slid 2.5 cm
     # along the bottle, clear of the cup, the right arm takes it.
     from agentchord.actions import grasp as grasp_module
-    from agentchord.actions.finger_clearance import TopGraspChoice
+    from agentchord.actions.grasping.finger_clearance import TopGraspChoice
     from agentchord.episode import EpisodeSpec, run_episode
 
     if not slides:
@@ -343,7 +343,7 @@ def test_a_side_grasp_does_not_sweep_its_fingers_into_a_bottle_lying_beside_the_
     # cup was caught 3.9 cm off the grasp point, three times. The clearing grasp passes over it.
     import dataclasses
 
-    from agentchord.actions import side_plan
+    from agentchord.actions.grasping import side_plan
 
     if not clearing:
         monkeypatch.setattr(side_plan, "CLEAR_TURNS_DEG", ())
@@ -372,7 +372,7 @@ def test_a_side_grasp_is_not_raised_over_a_neighbour_standing_in_its_way(pour_sc
     # lying one (a pour follows, which needs the asked hold).
     import dataclasses
 
-    from agentchord.actions.side_plan import REACH_VARIANTS, SidePlanner
+    from agentchord.actions.grasping.side_plan import REACH_VARIANTS, SidePlanner
 
     sizes = {"bottle": (0.0295, 0.0945), "cup": (0.0245, 0.042)}
     scene = dataclasses.replace(pour_scene, objects=[dataclasses.replace(o, size=sizes[o.name]) for o in pour_scene.objects])
@@ -396,7 +396,7 @@ def test_a_bottle_held_off_centre_by_a_fallen_grasp_is_carried_to_where_a_centre
     # A fallen grasp sets the bottle upright in the hand ~2 cm out along the approach. Carried to the
     # usual tool pose beside the cup, its mouth came down that far from where the pour aims (p = 0.3,
     # single-arm seed 4 once missed the cup by 4.2 cm): move_to_obj carries the object there instead.
-    from agentchord.actions.in_hand import axis_offset_in_tool
+    from agentchord.actions.grasping.in_hand import axis_offset_in_tool
     from agentchord.actions.move import MoveToObj
 
     monkeypatch.setattr(MoveToObj, "CENTRED_WITHIN", centred_within)

@@ -88,16 +88,16 @@ SCENES = [
     # The capsule is still handed over.
     pytest.param("setup_coffee_tray", STRESS, 22, {}, lambda r: _handed_over(r, "right", "capsule"), id="coffee_tray-stress-22"),
     # A fork that fell on its edge was put down on its edge ("not lying flat"), and the tilted tool's
-    # turn top-down over it lost the IK's line; tipped flat by the open fingers (actions/tip_flat.py),
+    # turn top-down over it lost the IK's line; tipped flat by the open fingers (actions/grasping/tip_flat.py),
     # taken along its length (actions/top_grasp.long_axis), a lost line gone round through home
     # (actions/motion.approach).
     pytest.param("rearrange_table", STRESS, 35, {}, None, id="rearrange-stress-35"),
     # A fork pushed against the plate's rim put a finger on the rim and the tool stopped short; the
-    # top grasp slides along the fork (actions/finger_clearance.py).
+    # top grasp slides along the fork (actions/grasping/finger_clearance.py).
     pytest.param("rearrange_table", STRESS, 2, {}, None, id="rearrange-stress-2"),
     pytest.param("rearrange_table", STRESS, 15, {}, None, id="rearrange-stress-15"),
     # A fork pressed flush against the rim, which no slide or turn clears, is dragged clear by one
-    # finger's tip pressed near its edge (actions/drag_clear.py).
+    # finger's tip pressed near its edge (actions/grasping/drag_clear.py).
     pytest.param("rearrange_table", STRESS, 2, {"planned": True}, None, id="rearrange-stress-2-planned"),
     # The cup, pulled out of the left hand, came to rest beside the bottle lying on the table, and
     # every side grasp of the cup pushed the bottle and closed off centre; a side grasp takes the

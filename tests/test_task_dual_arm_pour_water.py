@@ -184,11 +184,11 @@ def test_skip_if_held_keeps_a_finished_grasp_and_skip_if_placed_only_retreats():
 def test_reseat_turns_a_fallen_bottle_left_askew_into_a_nominal_side_grasp(x, y, yaw, reseated, monkeypatch):
     import agentchord.actions.grasp as grasp_module
     from agentchord.actions.grasp import Grasp
-    from agentchord.actions.wrist_branch import is_wound
+    from agentchord.actions.grasping.wrist_branch import is_wound
     from agentchord.robot.aloha import HOME_Q
 
     # The straight turn upright (the unflipped branch's joint-space turn leaves a bottle within
-    # 3 deg: tests/test_actions_wrist_branch.py): this one leaves the first bottle askew.
+    # 3 deg: tests/test_actions_grasping_wrist_branch.py): this one leaves the first bottle askew.
     monkeypatch.setattr(grasp_module, "plan_unflipped_fallen_grasp", lambda *args, **kwargs: None)
     calls, wound, homed = [], [], []
     reseat, move_joints = Grasp._reseat, grasp_module.move_joints

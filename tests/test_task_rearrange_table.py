@@ -160,7 +160,7 @@ def test_a_fork_that_flipped_over_is_grasped_lying_flat(level, monkeypatch):
     # Stress protocol, seed 45: the fork, shifted against the plate's rim, is dropped by the right arm
     # taking it for the left and lands upside down. Read as lying on its side (tilt 180 deg), its top
     # grasp aimed 5 cm above it and the fingers closed on nothing three times.
-    from agentchord.actions import top_grasp
+    from agentchord.actions.grasping import top_grasp
     from agentchord.features.frame import tilt_deg
 
     if not level:

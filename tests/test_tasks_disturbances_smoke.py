@@ -109,7 +109,8 @@ def test_without_the_height_check_that_bottle_pours_beside_the_cup(monkeypatch):
 
 def _top_grasps_at_the_centre(monkeypatch, report_blocked: bool) -> None:
     """Make every top grasp the plain one (the behaviour before the fingers' clearance was checked)."""
-    from agentchord.actions import finger_clearance, grasp
+    from agentchord.actions import grasp
+    from agentchord.actions.grasping import finger_clearance
 
     def plain(frame, obj, point, long_dir):
         hits = finger_clearance.blocking(frame, obj, point, long_dir)
@@ -140,7 +141,7 @@ def test_fingers_that_come_down_on_a_neighbour_are_named_in_the_reason(monkeypat
 
 
 def test_a_fork_the_fingers_come_down_beside_is_dragged_off_the_plate_and_taken(monkeypatch):
-    # The same again with the drag (actions/drag_clear.py): the fork is dragged clear and taken.
+    # The same again with the drag (actions/grasping/drag_clear.py): the fork is dragged clear and taken.
     _top_grasps_at_the_centre(monkeypatch, report_blocked=True)
     result = run_episode(EpisodeSpec("rearrange_table", seed=86, disturbances=DisturbanceSetting(kinds=KINDS, protocol="custom")))
     assert result.success, result.reason

@@ -3,9 +3,9 @@
 The action perceives through the feature frame (``robot.frame``) and starts from the
 robot's current commanded state, so a recovery edge begins wherever the failure left the arm.
 Where each grasp goes is worked out beside it: the side grasp in
-:mod:`~agentchord.actions.side_plan`, the top grasp in :mod:`~agentchord.actions.top_grasp` and
-:mod:`~agentchord.actions.finger_clearance`, the fallen grasp and its turn upright in
-:mod:`~agentchord.actions.fallen_turn`; this module moves through those poses and judges the hold.
+:mod:`~agentchord.actions.grasping.side_plan`, the top grasp in :mod:`~agentchord.actions.grasping.top_grasp` and
+:mod:`~agentchord.actions.grasping.finger_clearance`, the fallen grasp and its turn upright in
+:mod:`~agentchord.actions.grasping.fallen_turn`; this module moves through those poses and judges the hold.
 """
 
 from __future__ import annotations
@@ -18,11 +18,11 @@ import numpy as np
 from agentchord.actions import catalog
 from agentchord.actions.base import ActionFailed, ArmAction
 from agentchord.actions.controller import RobotController
-from agentchord.actions.drag_clear import drag_clear, plan_drag
-from agentchord.actions.finger_clearance import TopGraspChoice, clear_top_grasp, crossing_over, swept_hits
-from agentchord.actions.geometry import _matrix, _wrist_margin
-from agentchord.actions.in_hand import grasp_height_share
-from agentchord.actions.make_way import make_way
+from agentchord.actions.grasping.drag_clear import drag_clear, plan_drag
+from agentchord.actions.grasping.finger_clearance import TopGraspChoice, clear_top_grasp, crossing_over, swept_hits
+from agentchord.actions.grasping.geometry import quat_matrix, wrist_margin
+from agentchord.actions.grasping.in_hand import grasp_height_share
+from agentchord.actions.grasping.make_way import make_way
 from agentchord.actions.motion import (
     ANGULAR_SPEED,
     EMPTY_HAND_JOINT_SPEED,
@@ -37,10 +37,10 @@ from agentchord.actions.motion import (
     settle,
     wait_for_rest,
 )
-from agentchord.actions.fallen_turn import fallen_grasp_frame, turn_pose, turned
-from agentchord.actions.side_plan import SidePlanner, side_point, strikes_top
-from agentchord.actions.top_grasp import plain_top_grasp
-from agentchord.actions.wrist_branch import is_wound, move_above, plan_unflipped_fallen_grasp, turn_unflipped
+from agentchord.actions.grasping.fallen_turn import fallen_grasp_frame, turn_pose, turned
+from agentchord.actions.grasping.side_plan import SidePlanner, side_point, strikes_top
+from agentchord.actions.grasping.top_grasp import plain_top_grasp
+from agentchord.actions.grasping.wrist_branch import is_wound, move_above, plan_unflipped_fallen_grasp, turn_unflipped
 from agentchord.features.frame import ObjectFeatures, tilt_deg
 from agentchord.solvers.ik import ARM_CLEARANCE, PoseTarget, solve_from_scratch
 from agentchord.solvers.poses import top_down_rotation
@@ -102,7 +102,7 @@ class Grasp(ArmAction):
     LEANING_AS_FALLEN_DEG = 40.0
     #: Tries before a grasp that closes on nothing fails.
     ATTEMPTS = 3
-    #: Drags of an object pressed against a neighbour (:mod:`~agentchord.actions.drag_clear`) before
+    #: Drags of an object pressed against a neighbour (:mod:`~agentchord.actions.grasping.drag_clear`) before
     #: a grasp whose fingers still come down on it fails: the first may leave it short (slipping).
     DRAGS = 2
     #: Objects shorter than this (m) are grasped from above in ``auto`` mode.
@@ -437,15 +437,15 @@ class Grasp(ArmAction):
                 return float((np.degrees(diff) + 180.0) % 360.0 - 180.0)
 
             near, far = sorted((long_dir, -long_dir), key=lambda d: abs(turn(d)))
-            keep = _wrist_margin(robot, self.arm, turn(near), feats.pos)
-            long_dir = far if keep < 0.0 and _wrist_margin(robot, self.arm, turn(far), feats.pos) > keep else near
+            keep = wrist_margin(robot, self.arm, turn(near), feats.pos)
+            long_dir = far if keep < 0.0 and wrist_margin(robot, self.arm, turn(far), feats.pos) > keep else near
         rotation = top_down_rotation(long_dir)
         return rotation, point + self._offset(feats)
 
     def _offset(self, feats) -> np.ndarray:
         """The grasp offset in the world frame."""
         offset = np.asarray(self.args.offset, dtype=float)
-        return _matrix(feats.quat) @ offset if self.args.offset_frame == "object" else offset
+        return quat_matrix(feats.quat) @ offset if self.args.offset_frame == "object" else offset
 
     def _top_grasp(self, robot: RobotController) -> Iterator[None]:
         arm = self.arm

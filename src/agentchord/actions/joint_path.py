@@ -4,7 +4,7 @@ A joint-space move interpolates the joints, not the tool: the tool's path betwee
 can dip, swing sideways and pass near the other arm. Sampling the move's forward kinematics
 on a scratch solver tells the lowest the tool (and anything it holds) goes, how close the two
 arms' collision proxies come, and where the tool passes, which the finger-sweep check
-(:func:`agentchord.actions.finger_clearance.swept_hits`) reads.
+(:func:`agentchord.actions.grasping.finger_clearance.swept_hits`) reads.
 """
 
 from __future__ import annotations

@@ -10,9 +10,9 @@ from scipy.spatial.transform import Rotation
 from agentchord.actions import catalog
 from agentchord.actions.base import ArmAction
 from agentchord.actions.controller import RobotController
-from agentchord.actions.geometry import _level, _matrix
-from agentchord.actions.in_hand import axis_offset_in_tool, side_held_object
-from agentchord.actions.finger_clearance import swept_hits
+from agentchord.actions.grasping.geometry import level_frame, quat_matrix
+from agentchord.actions.grasping.in_hand import axis_offset_in_tool, side_held_object
+from agentchord.actions.grasping.finger_clearance import swept_hits
 from agentchord.actions.joint_path import joint_path
 from agentchord.actions.motion import (
     EMPTY_HAND_JOINT_SPEED,
@@ -54,7 +54,7 @@ class MoveToObj(ArmAction):
         if self.args.keep_orientation:
             rotation = robot.rotation(arm)
         elif self.args.yaw is None:
-            rotation = _level(robot.rotation(arm))
+            rotation = level_frame(robot.rotation(arm))
         else:
             yaw = np.radians(self.args.yaw)
             rotation = grasp_frame(np.array([np.cos(yaw), np.sin(yaw), 0.0]))
@@ -81,7 +81,7 @@ class MoveToObj(ArmAction):
         misses the cup by as much) is carried so that its axis lands where a centred one's would.
         """
         frame = robot.frame
-        measured = _matrix(frame.arms[self.arm].ee_quat)
+        measured = quat_matrix(frame.arms[self.arm].ee_quat)
         held = side_held_object(frame, self.arm, measured)
         if held is None:
             return np.zeros(3)

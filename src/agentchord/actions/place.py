@@ -12,11 +12,11 @@ from scipy.spatial.transform import Rotation
 from agentchord.actions import catalog
 from agentchord.actions.base import ActionFailed, ArmAction, ObjectGone
 from agentchord.actions.controller import RobotController
-from agentchord.actions.geometry import _level, _yaw_turn
+from agentchord.actions.grasping.geometry import level_frame, yaw_turn
 from agentchord.actions.grasp import UPRIGHT_TOLERANCE_DEG, Grasp
 from agentchord.actions.motion import grip, move_to, pose_from_matrix, settle, wait_for_rest
-from agentchord.actions.tip_flat import PUSH_SPEED, push_length, standing_height, tip_push, tip_start
-from agentchord.actions.top_grasp import long_axis, on_its_edge, plain_top_grasp
+from agentchord.actions.grasping.tip_flat import PUSH_SPEED, push_length, standing_height, tip_push, tip_start
+from agentchord.actions.grasping.top_grasp import long_axis, on_its_edge, plain_top_grasp
 from agentchord.features.frame import FeatureFrame, ObjectFeatures, tilt_deg
 from agentchord.solvers.exceptions import NoHandoffSpotError
 from agentchord.solvers.handoff import TAKER_MARGIN, handoff_spot
@@ -99,7 +99,7 @@ class Place(ArmAction):
             yield from wait_for_rest(robot, self.args.relative_to)
         obj = robot.frame.objects[self.args.obj]
         tool = robot.commanded_pose(arm)
-        rotation = _level(robot.rotation(arm))
+        rotation = level_frame(robot.rotation(arm))
         above = tool.pos.copy()
         target = None if self.args.target is None else np.asarray(self.args.target, dtype=float)
         if target is not None and self.args.relative_to is not None:
@@ -110,7 +110,7 @@ class Place(ArmAction):
             # Turn the tool about the vertical so the object's long axis ends at the asked yaw
             # (either direction), keeping the object's centre where it goes.
             goal = target if target is not None else obj.pos[:2]
-            turn = _yaw_turn(robot, arm, long_axis(obj), self.args.yaw, goal)
+            turn = yaw_turn(robot, arm, long_axis(obj), self.args.yaw, goal)
             held = obj.pos[:2] - tool.pos[:2]
             rotation = turn @ rotation
             above[:2] = goal - turn[:2, :2] @ held
@@ -195,7 +195,7 @@ class Place(ArmAction):
 
     def _tip_over(self, robot: RobotController, push: np.ndarray, rotation: np.ndarray) -> Iterator[None]:
         """Push the top edge of the released object, standing on its edge, across with the open fingers,
-        so it falls on its face (:mod:`~agentchord.actions.tip_flat`). Returns where the tool ends."""
+        so it falls on its face (:mod:`~agentchord.actions.grasping.tip_flat`). Returns where the tool ends."""
         tool = robot.commanded_pose(self.arm).pos
         feats = robot.frame.objects[self.args.obj]
         if not on_its_edge(feats):
@@ -264,7 +264,7 @@ class Place(ArmAction):
         arm = self.arm
         if robot.targets[arm].grip > 0.0:
             yield from grip(robot, arm, 0.0, ticks=8)
-        rotation = _level(robot.rotation(arm))
+        rotation = level_frame(robot.rotation(arm))
         tool = robot.commanded_pose(arm).pos
         retreat = tool - 0.08 * rotation[:, 0] + np.array([0.0, 0.0, 0.04 if rotation[2, 0] > -0.7 else 0.0])
         yield from move_to(robot, arm, pose_from_matrix(retreat, rotation))

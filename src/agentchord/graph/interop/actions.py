@@ -17,19 +17,19 @@ from agentchord.graph.interop.conventions import (
     TABLE_XY,
     WORKSPACE,
 )
-from agentchord.graph.interop.frames import _round
+from agentchord.graph.interop.frames import round6
 from agentchord.graph.interop.release import (
-    _after,
-    _Ctx,
-    _fmt,
-    _fmt_vec,
-    _fn_of,
-    _kwargs_of,
-    _number,
-    _Raw,
-    _RawStep,
-    _roll_of,
-    _Track,
+    holds_after,
+    CallContext,
+    fmt,
+    fmt_vec,
+    fn_of,
+    kwargs_of,
+    is_number,
+    RawCall,
+    RawStep,
+    roll_of,
+    Track,
 )
 from agentchord.graph.loader import format_loc
 from agentchord.graph.models import ActionCall
@@ -38,18 +38,18 @@ from agentchord.graph.models import ActionCall
 class ActionTranslator:
     """Translates release calls (mixed into the importer: reports through ``error`` / ``note``)."""
 
-    def _scan_orient(self, order: list[str], steps: dict[str, list[_RawStep]]) -> None:
+    def _scan_orient(self, order: list[str], steps: dict[str, list[RawStep]]) -> None:
         """Grasp modes implied by ``orient_eef`` right after a grasp of the same arm."""
-        last: dict[str, _Raw] = {}
+        last: dict[str, RawCall] = {}
         for edge_id in order:
             for step in steps[edge_id]:
                 for arm, raw in step.items():
                     if raw is None or not isinstance(raw.call, dict):
                         continue
                     prev = last.get(arm)
-                    kwargs = _kwargs_of(raw)
+                    kwargs = kwargs_of(raw)
                     if raw.call.get("fn") == "orient_eef" and prev is not None and prev.call.get("fn") == "grasp":
-                        obj = _kwargs_of(prev).get("obj_name")
+                        obj = kwargs_of(prev).get("obj_name")
                         direction = kwargs.get("direction", "front")
                         mode = {"down": "top", "front": "side"}.get(direction) if isinstance(direction, str) else None
                         if isinstance(obj, str) and mode is not None:
@@ -57,8 +57,8 @@ class ActionTranslator:
                     last[arm] = raw
 
     def _translate(
-        self, steps: list[_RawStep], continuation: list[_RawStep], holds: dict[str, str],
-        track: _Track | None = None,
+        self, steps: list[RawStep], continuation: list[RawStep], holds: dict[str, str],
+        track: Track | None = None,
     ) -> list[dict[str, ActionCall | None]]:
         """Our steps for ``steps``; ``continuation`` is what runs after them.
 
@@ -66,7 +66,7 @@ class ActionTranslator:
         """
         out: list[dict[str, ActionCall | None]] = []
         holds = dict(holds)
-        track = track if track is not None else _Track()
+        track = track if track is not None else Track()
         for k, step in enumerate(steps):
             ours: dict[str, ActionCall | None] = {}
             for arm, raw in step.items():
@@ -74,7 +74,7 @@ class ActionTranslator:
                     continue
                 after = steps[k + 1:] + continuation
                 nxt = next((s[arm] for s in after if s.get(arm) is not None), None)
-                ctx = _Ctx(arm, nxt, track.before.get(arm), track.previous.get(arm), holds, arm in track.turned)
+                ctx = CallContext(arm, nxt, track.before.get(arm), track.previous.get(arm), holds, arm in track.turned)
                 call = self._call(raw, ctx)
                 track.before[arm] = raw
                 if call is not None:
@@ -82,10 +82,10 @@ class ActionTranslator:
                     track.update(arm, call)
             if ours:
                 out.append(ours)
-                holds = _after(holds, [ours])
+                holds = holds_after(holds, [ours])
         return out
 
-    def _call(self, raw: _Raw, ctx: _Ctx) -> ActionCall | None:
+    def _call(self, raw: RawCall, ctx: CallContext) -> ActionCall | None:
         arm = ctx.arm
         f, path = raw.file, raw.path
         call = raw.call
@@ -131,27 +131,27 @@ class ActionTranslator:
             return None
         return ActionCall(fn=ours_fn, args=args)
 
-    def _obj_kwarg(self, kwargs: dict, raw: _Raw, fn: str) -> str | None:
+    def _obj_kwarg(self, kwargs: dict, raw: RawCall, fn: str) -> str | None:
         obj = kwargs.pop("obj_name", None)
         if not isinstance(obj, str) or not obj:
             self.error(raw.file, f"{raw.path}.kwargs.obj_name", f"{fn} needs obj_name (a string), got {obj!r}")
             return None
         return self._object(obj, raw.file, f"{raw.path}.kwargs.obj_name")
 
-    def _numbers(self, kwargs: dict, raw: _Raw, names: Iterable[str], default: float | None = 0.0,
+    def _numbers(self, kwargs: dict, raw: RawCall, names: Iterable[str], default: float | None = 0.0,
                  ) -> dict[str, float | None] | None:
         """Pop numeric kwargs (``None`` where absent and no default); ``None`` if one is not a number."""
         out: dict[str, float | None] = {}
         ok = True
         for name in names:
             value = kwargs.pop(name, default)
-            if (value is not None or default is not None) and not _number(value):  # null only where it may be
+            if (value is not None or default is not None) and not is_number(value):  # null only where it may be
                 self.error(raw.file, f"{raw.path}.kwargs.{name}", f"expected a number, got {value!r}")
                 ok = False
             out[name] = None if value is None or not ok else float(value)
         return out if ok else None
 
-    def _fn_grasp(self, kwargs: dict, raw: _Raw, ctx: _Ctx) -> tuple[str, dict] | None:
+    def _fn_grasp(self, kwargs: dict, raw: RawCall, ctx: CallContext) -> tuple[str, dict] | None:
         obj = self._obj_kwarg(kwargs, raw, "grasp")
         pre = kwargs.pop("pre_grasp_dis", None)
         if raw.extra.get("pre_grasp_dis") is not None:  # a recovery step's own pre_grasp_dis wins
@@ -160,7 +160,7 @@ class ActionTranslator:
             return None
         args: dict[str, Any] = {"obj": obj}
         if pre is not None:
-            if not _number(pre):
+            if not is_number(pre):
                 self.error(raw.file, f"{raw.path}.kwargs.pre_grasp_dis", f"expected a number (m), got {pre!r}")
                 return None
             args["pre_grasp_dis"] = float(pre)
@@ -173,24 +173,24 @@ class ActionTranslator:
             args["skip_if_held"] = True
         return "grasp", args
 
-    def _fn_move_relative_to_object(self, kwargs: dict, raw: _Raw, ctx: _Ctx) -> tuple[str, dict] | None:
+    def _fn_move_relative_to_object(self, kwargs: dict, raw: RawCall, ctx: CallContext) -> tuple[str, dict] | None:
         obj = self._obj_kwarg(kwargs, raw, "move_relative_to_object")
         d = self._numbers(kwargs, raw, ("x_offset", "y_offset", "z_offset"))
         if obj is None or d is None:
             return None
         offset = self.frame.vector((d["x_offset"], d["y_offset"], d["z_offset"]))
         held = ctx.holds.get(ctx.arm)
-        if held is not None and _fn_of(ctx.nxt) == "open_gripper":
+        if held is not None and fn_of(ctx.nxt) == "open_gripper":
             # The release lowers what it holds to this offset and lets go there: a place. Ours
             # carries it above the spot; the open_gripper after it becomes our place.
             carry = [offset[0], offset[1], PRE_PLACE_DIS]
             self.note(raw.file, raw.path,
-                      f"offset {_fmt_vec(offset)} then open_gripper: the release sets {held} down there; our "
-                      f"move_to_obj carries it to {_fmt_vec(carry)} from {obj}'s top point (the release's "
+                      f"offset {fmt_vec(offset)} then open_gripper: the release sets {held} down there; our "
+                      f"move_to_obj carries it to {fmt_vec(carry)} from {obj}'s top point (the release's "
                       f"pre_place_dis stand-off) and the open_gripper becomes our place")
             return "move_to_obj", {"obj": obj, "offset": carry, "keep_orientation": True}
         args: dict[str, Any] = {"obj": obj, "offset": list(offset)}
-        roll = _roll_of(ctx.nxt)
+        roll = roll_of(ctx.nxt)
         horizontal = math.hypot(offset[0], offset[1])
         if roll and horizontal > 1e-6:
             ox, oy = offset[0] / horizontal, offset[1] / horizontal
@@ -199,14 +199,14 @@ class ActionTranslator:
             args["yaw"] = round(math.degrees(math.atan2(approach[1], approach[0])), 1)
             self.note(raw.file, raw.path,
                       f"yaw {args['yaw']:g}: approach perpendicular to the offset so that the next "
-                      f"rotate_eef ({_fmt(roll)} deg) tips the held object toward {obj}")
+                      f"rotate_eef ({fmt(roll)} deg) tips the held object toward {obj}")
         else:
             args["keep_orientation"] = True
-        self.note(raw.file, raw.path, f"offset {_fmt_vec(offset)} in our frame, measured from {obj}'s top point "
+        self.note(raw.file, raw.path, f"offset {fmt_vec(offset)} in our frame, measured from {obj}'s top point "
                                       "(the release's: from its base-pose origin)")
         return "move_to_obj", args
 
-    def _fn_move_to_absolute_position(self, kwargs: dict, raw: _Raw, ctx: _Ctx) -> tuple[str, dict] | None:
+    def _fn_move_to_absolute_position(self, kwargs: dict, raw: RawCall, ctx: CallContext) -> tuple[str, dict] | None:
         d = self._numbers(kwargs, raw, ("x", "y", "z"), default=None)
         if d is None:
             return None
@@ -221,14 +221,14 @@ class ActionTranslator:
             self.note(raw.file, f"{raw.path}.kwargs.z", f"null (keep the current height) -> z = {CARRY_Z} m, "
                                                         "our carrying height")
         pos = self.frame.point((d["x"], d["y"], d["z"]))
-        clipped = tuple(_round(min(max(v, lo), hi)) for v, lo, hi in zip(pos, *WORKSPACE))
+        clipped = tuple(round6(min(max(v, lo), hi)) for v, lo, hi in zip(pos, *WORKSPACE))
         if clipped != pos:
-            self.note(raw.file, raw.path, f"position {_fmt_vec(pos)} clipped to our workspace: {_fmt_vec(clipped)}")
-        self.note(raw.file, raw.path, f"({_fmt(d['x'])}, {_fmt(d['y'])}, {_fmt(d['z'])}) in the release's frame "
-                                      f"-> {_fmt_vec(clipped)} in ours")
+            self.note(raw.file, raw.path, f"position {fmt_vec(pos)} clipped to our workspace: {fmt_vec(clipped)}")
+        self.note(raw.file, raw.path, f"({fmt(d['x'])}, {fmt(d['y'])}, {fmt(d['z'])}) in the release's frame "
+                                      f"-> {fmt_vec(clipped)} in ours")
         return "move_to_target", {"pos": list(clipped)}
 
-    def _fn_move_by_relative_offset(self, kwargs: dict, raw: _Raw, ctx: _Ctx) -> tuple[str, dict] | None:
+    def _fn_move_by_relative_offset(self, kwargs: dict, raw: RawCall, ctx: CallContext) -> tuple[str, dict] | None:
         d = self._numbers(kwargs, raw, ("dx", "dy", "dz"))
         mode = kwargs.pop("mode", "extrinsic")
         if d is None:
@@ -246,13 +246,13 @@ class ActionTranslator:
         self.error(raw.file, f"{raw.path}.kwargs.mode", f"expected 'extrinsic' or 'intrinsic', got {mode!r}")
         return None
 
-    def _fn_rotate_eef(self, kwargs: dict, raw: _Raw, ctx: _Ctx) -> tuple[str, dict] | None:
+    def _fn_rotate_eef(self, kwargs: dict, raw: RawCall, ctx: CallContext) -> tuple[str, dict] | None:
         d = self._numbers(kwargs, raw, ("degree",))
         if d is None:
             return None
         return "rotate_eef", {"angle": d["degree"]}
 
-    def _fn_place_on_table(self, kwargs: dict, raw: _Raw, ctx: _Ctx) -> tuple[str, dict] | None:
+    def _fn_place_on_table(self, kwargs: dict, raw: RawCall, ctx: CallContext) -> tuple[str, dict] | None:
         obj = self._obj_kwarg(kwargs, raw, "place_on_table")
         d = self._numbers(kwargs, raw, ("x", "y"), default=None)
         if "pre_place_dis" in kwargs:
@@ -269,45 +269,45 @@ class ActionTranslator:
             return None
         x, y, _ = self.frame.point((d["x"], d["y"], 0.0))
         (x_lo, y_lo), (x_hi, y_hi) = TABLE_XY
-        target = (_round(min(max(x, x_lo), x_hi)), _round(min(max(y, y_lo), y_hi)))
+        target = (round6(min(max(x, x_lo), x_hi)), round6(min(max(y, y_lo), y_hi)))
         if target != (x, y):
-            self.note(raw.file, raw.path, f"place target ({_fmt(x)}, {_fmt(y)}) clipped to our table: "
-                                          f"({_fmt(target[0])}, {_fmt(target[1])})")
-        self.note(raw.file, raw.path, f"place ({_fmt(d['x'])}, {_fmt(d['y'])}) in the release's frame -> "
-                                      f"({_fmt(target[0])}, {_fmt(target[1])}) in ours (the object's centre)")
+            self.note(raw.file, raw.path, f"place target ({fmt(x)}, {fmt(y)}) clipped to our table: "
+                                          f"({fmt(target[0])}, {fmt(target[1])})")
+        self.note(raw.file, raw.path, f"place ({fmt(d['x'])}, {fmt(d['y'])}) in the release's frame -> "
+                                      f"({fmt(target[0])}, {fmt(target[1])}) in ours (the object's centre)")
         args["target"] = list(target)
         return "place", args
 
-    def _fn_back_to_initial_pose(self, kwargs: dict, raw: _Raw, ctx: _Ctx) -> tuple[str, dict] | None:
+    def _fn_back_to_initial_pose(self, kwargs: dict, raw: RawCall, ctx: CallContext) -> tuple[str, dict] | None:
         return "back", {}
 
-    def _fn_open_gripper(self, kwargs: dict, raw: _Raw, ctx: _Ctx) -> tuple[str, dict] | None:
+    def _fn_open_gripper(self, kwargs: dict, raw: RawCall, ctx: CallContext) -> tuple[str, dict] | None:
         held = ctx.holds.get(ctx.arm)
-        if held is None or _fn_of(ctx.before) != "move_relative_to_object":
+        if held is None or fn_of(ctx.before) != "move_relative_to_object":
             return "open_gripper", {}
         # The move before it took what the arm holds to its release point: place it there.
-        move = _kwargs_of(ctx.before)
+        move = kwargs_of(ctx.before)
         ref = move.get("obj_name")
         ref = self.renames.get(ref, ref) if isinstance(ref, str) else None  # a list or dict is not a name
         d = {k: move.get(k, 0.0) for k in ("x_offset", "y_offset", "z_offset")}
-        if not isinstance(ref, str) or not all(_number(v) for v in d.values()):
+        if not isinstance(ref, str) or not all(is_number(v) for v in d.values()):
             return "open_gripper", {}  # the move itself reports what is wrong with it
         dx, dy, _ = self.frame.vector((d["x_offset"], d["y_offset"], 0.0))
         args: dict[str, Any] = {"obj": held, "target": [dx, dy], "relative_to": ref}
-        z = _round(min(max(float(d["z_offset"]), PLACE_Z[0]), PLACE_Z[1]))
+        z = round6(min(max(float(d["z_offset"]), PLACE_Z[0]), PLACE_Z[1]))
         if z:
             args["z_offset"] = z
         args.update(self._place_yaw(raw, ctx, held))
         self.note(raw.file, raw.path,
                   f"open_gripper after move_relative_to_object({ref}) while holding {held}: the release's place by "
-                  f"release -> place({held}, target ({_fmt(dx)}, {_fmt(dy)}) from {ref}'s centre"
-                  f"{f', z_offset {_fmt(z)}' if z else ''}): ours lowers {held} onto the table, opens, backs off")
+                  f"release -> place({held}, target ({fmt(dx)}, {fmt(dy)}) from {ref}'s centre"
+                  f"{f', z_offset {fmt(z)}' if z else ''}): ours lowers {held} onto the table, opens, backs off")
         return "place", args
 
-    def _fn_close_gripper(self, kwargs: dict, raw: _Raw, ctx: _Ctx) -> tuple[str, dict] | None:
+    def _fn_close_gripper(self, kwargs: dict, raw: RawCall, ctx: CallContext) -> tuple[str, dict] | None:
         return "close_gripper", {}
 
-    def _fn_orient_eef(self, kwargs: dict, raw: _Raw, ctx: _Ctx) -> tuple[str, dict] | None:
+    def _fn_orient_eef(self, kwargs: dict, raw: RawCall, ctx: CallContext) -> tuple[str, dict] | None:
         direction = kwargs.pop("direction", "front")
         if direction not in ("down", "front"):
             self.error(raw.file, f"{raw.path}.kwargs.direction", f"expected 'down' or 'front', got {direction!r}")
@@ -318,11 +318,11 @@ class ActionTranslator:
                                           f"it takes {held} with mode {self.grasp_modes[(ctx.arm, held)]!r}")
             return "move_by_offset", {}
         pitch = 90.0 if direction == "down" else -90.0
-        self.note(raw.file, raw.path, f"orient_eef {direction!r} -> move_by_offset angles (0, {_fmt(pitch)}, 0) "
+        self.note(raw.file, raw.path, f"orient_eef {direction!r} -> move_by_offset angles (0, {fmt(pitch)}, 0) "
                                       f"intrinsic: assumes a {'level' if direction == 'down' else 'top-down'} tool")
         return "move_by_offset", {"angles": [0.0, pitch, 0.0], "frame": "intrinsic"}
 
-    def _place_yaw(self, raw: _Raw, ctx: _Ctx, obj: str) -> dict[str, float]:
+    def _place_yaw(self, raw: RawCall, ctx: CallContext, obj: str) -> dict[str, float]:
         """``{"yaw": ...}`` for a place of ``obj`` held as the release's ``orient_eef 'down'`` left it, else ``{}``.
 
         That orientation is absolute (tool x along the release's x, fingers closing along its y), so a
@@ -332,9 +332,9 @@ class ActionTranslator:
         if self.grasp_modes.get((ctx.arm, obj)) != "top" or ctx.turned:
             return {}
         ax, ay, _ = self.frame.vector((1.0, 0.0, 0.0))
-        yaw = _round((math.degrees(math.atan2(ay, ax)) + 90.0) % 180.0 - 90.0)  # a long axis: mod 180
+        yaw = round6((math.degrees(math.atan2(ay, ax)) + 90.0) % 180.0 - 90.0)  # a long axis: mod 180
         yaw = 90.0 if yaw == -90.0 else yaw
         self.note(raw.file, raw.path,
-                  f"place yaw {_fmt(yaw)}: the release's orient_eef 'down' is absolute (its tool x forward, fingers "
+                  f"place yaw {fmt(yaw)}: the release's orient_eef 'down' is absolute (its tool x forward, fingers "
                   f"closing along its y), so {obj}, grasped across its narrow side, lies along the release's x")
         return {"yaw": yaw}

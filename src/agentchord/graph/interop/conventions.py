@@ -35,4 +35,5 @@ RELEASE_TASKS = {
 }
 #: Actions that open or close a gripper on purpose: a hold monitor is gated on them.
 GRIPPING = frozenset({"grasp", "place", "open_gripper", "close_gripper"})
-_WINDOW = 3
+#: The persistence window (ticks) of the monitors of an imported graph.
+PERSISTENCE_WINDOW = 3

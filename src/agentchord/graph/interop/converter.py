@@ -12,22 +12,22 @@ from pydantic import ValidationError
 from agentchord.expr.names import name_problem
 from agentchord.graph.interop.actions import ActionTranslator
 from agentchord.graph.interop.conventions import (
-    _WINDOW,
+    PERSISTENCE_WINDOW,
     ARM_NAMES,
     GRIPPING,
     RELEASE_TASKS,
 )
 from agentchord.graph.interop.exceptions import ReleaseImportError
 from agentchord.graph.interop.frames import FrameMap
-from agentchord.graph.interop.reader import ReleaseReader, _read_json
+from agentchord.graph.interop.reader import ReleaseReader, read_json
 from agentchord.graph.interop.release import (
-    _after,
-    _Binding,
-    _fmt,
-    _norm,
-    _released,
-    _slug,
-    _Track,
+    holds_after,
+    Binding,
+    fmt,
+    norm,
+    released_by,
+    slug,
+    Track,
 )
 from agentchord.graph.loader import format_loc
 from agentchord.graph.models import ActionCall, Edge, FailureMode, Node, TaskGraph
@@ -72,8 +72,8 @@ def import_release(
     """
     task_graph, recovery_spec = Path(task_graph), Path(recovery_spec)
     problems: list[str] = []
-    graph_data = _read_json(task_graph, problems)
-    spec_data = _read_json(recovery_spec, problems)
+    graph_data = read_json(task_graph, problems)
+    spec_data = read_json(recovery_spec, problems)
     if problems:
         raise ReleaseImportError(problems)
     return import_release_data(
@@ -175,8 +175,8 @@ class _Importer(ReleaseReader, ActionTranslator):
         # Nominal edges, with what each arm holds before each edge.
         holds_before: dict[str, dict[str, str]] = {}
         holds: dict[str, str] = {}
-        track = _Track()
-        track_before: dict[str, _Track] = {}
+        track = Track()
+        track_before: dict[str, Track] = {}
         released_into: dict[str, list[tuple[str, str]]] = {}
         nominal: dict[str, list[dict[str, ActionCall | None]]] = {}
         for k, edge_id in enumerate(order):
@@ -184,8 +184,8 @@ class _Importer(ReleaseReader, ActionTranslator):
             track_before[edge_id] = track.copy()
             continuation = [s for later in order[k + 1:] for s in steps[later]]
             nominal[edge_id] = self._translate(steps[edge_id], continuation, holds, track)
-            released_into[edge_id] = _released(holds_before[edge_id], nominal[edge_id])
-            holds = _after(holds, nominal[edge_id])
+            released_into[edge_id] = released_by(holds_before[edge_id], nominal[edge_id])
+            holds = holds_after(holds, nominal[edge_id])
 
         graph_edges: dict[str, Edge] = {}
         for edge in edges_raw:
@@ -196,7 +196,7 @@ class _Importer(ReleaseReader, ActionTranslator):
         # Recovery entry edges, one per binding.
         recovery_edges: list[Edge] = []
         entry_of: dict[int, str] = {}
-        by_edge: dict[str, list[_Binding]] = {}
+        by_edge: dict[str, list[Binding]] = {}
         for binding in bindings:
             by_edge.setdefault(binding.edge_id, []).append(binding)
         existing = set(order)
@@ -207,7 +207,7 @@ class _Importer(ReleaseReader, ActionTranslator):
                 target, continuation = failed.source, [s for later in order[k:] for s in steps[later]]
             else:
                 target, continuation = failed.target, [s for later in order[k + 1:] for s in steps[later]]
-            rec_id = f"{binding.edge_id}_r_{_slug(binding.name)}"
+            rec_id = f"{binding.edge_id}_r_{slug(binding.name)}"
             if rec_id in existing:
                 self.error(self.sfile, f"recovery_bindings[{binding.index}].failure_name",
                            f"recovery edge id {rec_id!r} is already taken")
@@ -240,7 +240,7 @@ class _Importer(ReleaseReader, ActionTranslator):
             constraints: list[str] = []
             edge_id = into.get(node["id"])
             if edge_id is not None:
-                after = _after(holds_before[edge_id], nominal[edge_id])
+                after = holds_after(holds_before[edge_id], nominal[edge_id])
                 constraints += [f"0.5 - holding({arm}, {obj})" for arm, obj in sorted(after.items())]
                 constraints += [f"holding({arm}, {obj}) - 0.5" for arm, obj in released_into[edge_id]]
             nodes.append(Node(id=node["id"], semantic=node.get("semantic", ""), constraints=constraints))
@@ -261,7 +261,7 @@ class _Importer(ReleaseReader, ActionTranslator):
 
 
     # ------------------------------------------------------------ monitors
-    def _failure(self, binding: _Binding, edge: Edge, holds: dict[str, str], entry: str) -> FailureMode:
+    def _failure(self, binding: Binding, edge: Edge, holds: dict[str, str], entry: str) -> FailureMode:
         terms = []
         gripping = {arm for arm, call in edge.calls if call.fn in GRIPPING}
         grasped = {call.args.get("obj"): arm for arm, call in edge.calls if call.fn == "grasp"}
@@ -272,11 +272,11 @@ class _Importer(ReleaseReader, ActionTranslator):
                 terms.append(f"{m['arm']}.closed * ({term})" if m["arm"] in gripping else term)
             else:
                 for obj in m["objects"]:
-                    term = f"drift({obj}, {_fmt(m['threshold'])})"
+                    term = f"drift({obj}, {fmt(m['threshold'])})"
                     arm = grasped.get(obj) or holder.get(obj)
                     terms.append(f"(1 - {arm}.closed) * {term}" if arm else term)
         monitor = terms[0] if len(terms) == 1 else f"max({', '.join(terms)})"
-        return FailureMode(name=binding.name, monitor=monitor, window=_WINDOW, intent=binding.intent or "recover",
+        return FailureMode(name=binding.name, monitor=monitor, window=PERSISTENCE_WINDOW, intent=binding.intent or "recover",
                            recovery=entry)
 
 
@@ -307,10 +307,10 @@ class _Importer(ReleaseReader, ActionTranslator):
         if task:
             return task
         for key in (release_task, folder):
-            name = RELEASE_TASKS.get(_norm(key))
+            name = RELEASE_TASKS.get(norm(key))
             if name is not None:
                 return name
-        name = _slug(release_task)
+        name = slug(release_task)
         self.note(self.gfile, "task", f"no simulated task matches {release_task!r}: task name {name!r} (use --task)")
         return name
 

@@ -7,7 +7,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 
-def _round(x: float) -> float:
+def round6(x: float) -> float:
     value = round(x, 6)
     return 0.0 if value == 0 else value
 
@@ -30,12 +30,12 @@ class FrameMap:
         """A displacement in our frame (turned, not shifted)."""
         c, s = math.cos(math.radians(self.yaw_deg)), math.sin(math.radians(self.yaw_deg))
         x, y, z = (float(a) for a in v)
-        return (_round(c * x - s * y), _round(s * x + c * y), _round(z))
+        return (round6(c * x - s * y), round6(s * x + c * y), round6(z))
 
     def point(self, p: Sequence[float]) -> tuple[float, float, float]:
         """A position in our frame."""
         x, y, z = self.vector(p)
-        return (_round(x + self.shift[0]), _round(y + self.shift[1]), _round(z + self.shift[2]))
+        return (round6(x + self.shift[0]), round6(y + self.shift[1]), round6(z + self.shift[2]))
 
     @classmethod
     def parse(cls, text: str) -> FrameMap:

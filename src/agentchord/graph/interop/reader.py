@@ -8,13 +8,13 @@ from pathlib import Path
 from typing import Any
 
 from agentchord.graph.interop.conventions import DROPPED_KWARGS, SLOTS
-from agentchord.graph.interop.release import _Binding, _number, _Raw, _RawStep
+from agentchord.graph.interop.release import Binding, is_number, RawCall, RawStep
 from agentchord.guard.documents import check_shape, read_text
 from agentchord.guard.exceptions import DocumentError
 from agentchord.guard.numbers import describe, non_finite
 
 
-def _read_json(path: Path, problems: list[str]) -> Any:
+def read_json(path: Path, problems: list[str]) -> Any:
     # Bounded like every input (agentchord.guard): regular files, size, depth, finite numbers.
     try:
         text = read_text(path)
@@ -123,15 +123,15 @@ class ReleaseReader:
             return None
         return nodes, order, data["start"], data["goal"], data["task"]
 
-    def _edge_steps(self, edge: dict, index: int) -> list[_RawStep]:
+    def _edge_steps(self, edge: dict, index: int) -> list[RawStep]:
         step = self._slots(self.gfile, f"edges[{index}]", edge)
         if all(v is None for v in step.values()):
             self.error(self.gfile, f"edges[{index}]", "both left_arm_action and right_arm_action are null")
             return []
         return [step]
 
-    def _slots(self, file: str, path: str, holder: dict) -> _RawStep:
-        step: _RawStep = {}
+    def _slots(self, file: str, path: str, holder: dict) -> RawStep:
+        step: RawStep = {}
         for slot, arm in SLOTS.items():
             call = holder.get(slot)
             if call is None:
@@ -139,12 +139,12 @@ class ReleaseReader:
             if not isinstance(call, dict):
                 self.error(file, f"{path}.{slot}", f"expected {{fn, kwargs}} or null, found {type(call).__name__}")
                 continue
-            step[arm] = _Raw(call, file, f"{path}.{slot}")
+            step[arm] = RawCall(call, file, f"{path}.{slot}")
         return step
 
 
     # --------------------------------------------------------- recovery spec
-    def _bindings(self, data: Any, steps: dict[str, list[_RawStep]], release_task: str) -> list[_Binding]:
+    def _bindings(self, data: Any, steps: dict[str, list[RawStep]], release_task: str) -> list[Binding]:
         f = self.sfile
         if not isinstance(data, dict):
             self.error(f, "(top level)", f"expected a recovery spec object, found {type(data).__name__}")
@@ -187,7 +187,7 @@ class ReleaseReader:
                           "(3 fires per edge and mode), not unbounded repetition")
             monitors = self._monitors(b.get("monitors"), f"{path}.monitors")
             rec_steps, intent = self._recovery_steps(b.get("recovery"), f"{path}.recovery", edge_id, steps)
-            bindings.append(_Binding(i, edge_id, name, monitors, rec_steps, merge, repeat is True, intent))
+            bindings.append(Binding(i, edge_id, name, monitors, rec_steps, merge, repeat is True, intent))
         return bindings
 
     def _monitors(self, raw: Any, path: str) -> list[tuple[str, dict[str, Any]]]:
@@ -212,7 +212,7 @@ class ReleaseReader:
                 if threshold is None:
                     threshold = 0.02
                     self.note(f, where, "no threshold: drift tolerance 0.02 m (the library graphs')")
-                elif not _number(threshold) or threshold <= 0:
+                elif not is_number(threshold) or threshold <= 0:
                     self.error(f, f"{where}.threshold", f"expected a positive number (m), got {threshold!r}")
                     continue
                 names = [self._object(o, f, f"{where}.objects[{k}]") for k, o in enumerate(objs)]
@@ -234,13 +234,13 @@ class ReleaseReader:
         return out
 
     def _recovery_steps(
-        self, raw: Any, path: str, failed: str, steps: dict[str, list[_RawStep]]
-    ) -> tuple[list[_RawStep], str]:
+        self, raw: Any, path: str, failed: str, steps: dict[str, list[RawStep]]
+    ) -> tuple[list[RawStep], str]:
         f = self.sfile
         if not isinstance(raw, list) or not raw:
             self.error(f, path, "missing or not a non-empty list of recovery steps")
             return [], ""
-        out: list[_RawStep] = []
+        out: list[RawStep] = []
         intents = []
         for j, s in enumerate(raw):
             where = f"{path}[{j}]"
@@ -251,7 +251,7 @@ class ReleaseReader:
             if s.get("force_valid") is not None:
                 self.note(f, f"{where}.force_valid", f"dropped: {DROPPED_KWARGS['force_valid']}")
             pre = s.get("pre_grasp_dis")
-            if pre is not None and not _number(pre):
+            if pre is not None and not is_number(pre):
                 self.error(f, f"{where}.pre_grasp_dis", f"expected a number (m), got {pre!r}")
                 continue
             extra = {"pre_grasp_dis": pre} if pre is not None else {}
@@ -264,7 +264,7 @@ class ReleaseReader:
                     continue
                 if arm is not None:
                     call = {"fn": "grasp", "kwargs": {"obj_name": s["obj_name"], **extra}}
-                    out.append({arm: _Raw(call, f, where)})
+                    out.append({arm: RawCall(call, f, where)})
                     intents.append("regrasp")
             elif kind == "regrasp_both":
                 self._unknown_keys(f, where, s, (*common, "arms"))
@@ -272,14 +272,14 @@ class ReleaseReader:
                 if not isinstance(arms, dict) or not arms:
                     self.error(f, f"{where}.arms", f"expected {{left_arm: obj, right_arm: obj}}, got {arms!r}")
                     continue
-                step: _RawStep = {}
+                step: RawStep = {}
                 for release_arm, obj in arms.items():
                     arm = self._arm(release_arm, f, f"{where}.arms.{release_arm}")
                     if not isinstance(obj, str):
                         self.error(f, f"{where}.arms.{release_arm}", f"expected an object name, got {obj!r}")
                     elif arm is not None:
                         call = {"fn": "grasp", "kwargs": {"obj_name": obj, **extra}}
-                        step[arm] = _Raw(call, f, f"{where}.arms.{release_arm}", {"skip_if_held": True})
+                        step[arm] = RawCall(call, f, f"{where}.arms.{release_arm}", {"skip_if_held": True})
                 if step:
                     out.append(step)
                     intents.append("regrasp both")
@@ -293,7 +293,7 @@ class ReleaseReader:
                     self.error(f, f"{where}.edge_id", f"unknown edge {edge_id!r}; the task graph has {known}")
                     continue
                 for replayed in steps[edge_id]:
-                    out.append({arm: None if raw_call is None else _Raw(raw_call.call, raw_call.file, raw_call.path,
+                    out.append({arm: None if raw_call is None else RawCall(raw_call.call, raw_call.file, raw_call.path,
                                                                           dict(extra))
                                 for arm, raw_call in replayed.items()})
                 intents.append("retry" if kind == "retry_failed_edge" else f"replay {edge_id}")

@@ -12,24 +12,24 @@ from typing import Any
 from agentchord.graph.models import ActionCall
 
 
-def _fmt(x: float) -> str:
+def fmt(x: float) -> str:
     return f"{x:g}"
 
 
 
 
-def _slug(text: str) -> str:
+def slug(text: str) -> str:
     return re.sub(r"[^a-z0-9]+", "_", text.lower()).strip("_") or "imported_task"
 
 
-def _norm(text: str) -> str:
+def norm(text: str) -> str:
     return re.sub(r"[^a-z0-9]", "", text.lower())
 
 
 
 
 @dataclass
-class _Raw:
+class RawCall:
     """A release arm call (``{fn, kwargs}``), where it is, and recovery-step extras."""
 
     call: dict[str, Any]
@@ -39,11 +39,11 @@ class _Raw:
 
 
 #: One step: our arm -> release call (None: idle).
-_RawStep = dict[str, "_Raw | None"]
+RawStep = dict[str, "RawCall | None"]
 
 
 @dataclass
-class _Track:
+class Track:
     """Each arm's history along a translation.
 
     Attributes:
@@ -52,7 +52,7 @@ class _Track:
         turned: Arms whose tool turned (a roll, a pitch) since they last grasped.
     """
 
-    before: dict[str, _Raw] = field(default_factory=dict)
+    before: dict[str, RawCall] = field(default_factory=dict)
     previous: dict[str, str] = field(default_factory=dict)
     turned: set[str] = field(default_factory=set)
 
@@ -63,12 +63,12 @@ class _Track:
         elif call.fn == "rotate_eef" or any(call.args.get("angles", ())):
             self.turned.add(arm)
 
-    def copy(self) -> _Track:
-        return _Track(dict(self.before), dict(self.previous), set(self.turned))
+    def copy(self) -> Track:
+        return Track(dict(self.before), dict(self.previous), set(self.turned))
 
 
 @dataclass
-class _Ctx:
+class CallContext:
     """What one release call is translated in view of.
 
     Attributes:
@@ -81,20 +81,20 @@ class _Ctx:
     """
 
     arm: str
-    nxt: _Raw | None
-    before: _Raw | None
+    nxt: RawCall | None
+    before: RawCall | None
     previous: str | None
     holds: dict[str, str]
     turned: bool
 
 
 @dataclass
-class _Binding:
+class Binding:
     index: int
     edge_id: str
     name: str
     monitors: list[tuple[str, dict[str, Any]]]
-    steps: list[_RawStep]
+    steps: list[RawStep]
     merge: str
     repeat: bool
     intent: str
@@ -102,15 +102,15 @@ class _Binding:
 
 
 
-def _number(value: Any) -> bool:
+def is_number(value: Any) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
 
 
-def _fmt_vec(v: Sequence[float]) -> str:
-    return "(" + ", ".join(_fmt(x) for x in v) + ")"
+def fmt_vec(v: Sequence[float]) -> str:
+    return "(" + ", ".join(fmt(x) for x in v) + ")"
 
 
-def _kwargs_of(raw: _Raw | None) -> dict:
+def kwargs_of(raw: RawCall | None) -> dict:
     """A release call's kwargs; empty where the call or its kwargs is not an object (the call's own
     translation reports that)."""
     if raw is None or not isinstance(raw.call, dict):
@@ -119,20 +119,20 @@ def _kwargs_of(raw: _Raw | None) -> dict:
     return kwargs if isinstance(kwargs, dict) else {}
 
 
-def _roll_of(raw: _Raw | None) -> float:
+def roll_of(raw: RawCall | None) -> float:
     """The roll (deg) of a release ``rotate_eef`` call, 0 for anything else."""
     if raw is None or not isinstance(raw.call, dict) or raw.call.get("fn") != "rotate_eef":
         return 0.0
-    degree = _kwargs_of(raw).get("degree", 0)
-    return float(degree) if _number(degree) else 0.0
+    degree = kwargs_of(raw).get("degree", 0)
+    return float(degree) if is_number(degree) else 0.0
 
 
-def _fn_of(raw: _Raw | None) -> str | None:
+def fn_of(raw: RawCall | None) -> str | None:
     """The release action name of a call, None for none."""
     return raw.call.get("fn") if raw is not None and isinstance(raw.call, dict) else None
 
 
-def _after(holds: dict[str, str], steps: list[dict[str, ActionCall | None]]) -> dict[str, str]:
+def holds_after(holds: dict[str, str], steps: list[dict[str, ActionCall | None]]) -> dict[str, str]:
     """What each arm holds after ``steps``: a grasp takes its object, a place or opening lets go."""
     holds = dict(holds)
     for step in steps:
@@ -146,7 +146,7 @@ def _after(holds: dict[str, str], steps: list[dict[str, ActionCall | None]]) -> 
     return holds
 
 
-def _released(before: dict[str, str], steps: list[dict[str, ActionCall | None]]) -> list[tuple[str, str]]:
+def released_by(before: dict[str, str], steps: list[dict[str, ActionCall | None]]) -> list[tuple[str, str]]:
     """``(arm, obj)`` pairs that ``steps`` let go of on purpose."""
     holds, out = dict(before), []
     for step in steps:

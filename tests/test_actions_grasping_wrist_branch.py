@@ -8,7 +8,7 @@ import agentchord.actions.grasp as grasp_module
 from agentchord.actions.base import Status
 from agentchord.actions.library import make_action
 from agentchord.actions.motion import pose_from_matrix
-from agentchord.actions.wrist_branch import (
+from agentchord.actions.grasping.wrist_branch import (
     is_flipped,
     is_wound,
     other_branch,

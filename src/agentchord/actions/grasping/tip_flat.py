@@ -15,8 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from agentchord.actions.finger_clearance import FINGER_ACROSS, swept_hits
-from agentchord.actions.top_grasp import FINGERTIP_REACH, on_its_edge
+from agentchord.actions.grasping.finger_clearance import FINGER_ACROSS, swept_hits
+from agentchord.actions.grasping.top_grasp import FINGERTIP_REACH, on_its_edge
 from agentchord.features.frame import FeatureFrame, ObjectFeatures
 
 #: The finger tips push this far (m) under the object's top edge: high, so it tips before it slides.
@@ -78,7 +78,7 @@ def tip_push(
     Across the fingers, one way or the other, set down short by :func:`fall_shift` (so it falls onto
     its spot), by half that, or on its spot (where a neighbour is too near: rearrange, a fork beside
     the plate): the first whose fingers, pushing from there, sweep through no neighbour. None when
-    the object is not flat and on its edge (:func:`~agentchord.actions.top_grasp.on_its_edge`), the
+    the object is not flat and on its edge (:func:`~agentchord.actions.grasping.top_grasp.on_its_edge`), the
     tool is not top-down, or every push is blocked: the object is then put down as it is held.
 
     Args:

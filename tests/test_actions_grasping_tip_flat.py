@@ -8,8 +8,8 @@ from agentchord.actions import place as place_module
 from agentchord.actions.base import Status
 from agentchord.actions.controller import RobotController
 from agentchord.actions.library import make_action
-from agentchord.actions.tip_flat import fall_shift, standing_height, tip_push
-from agentchord.actions.top_grasp import on_its_edge
+from agentchord.actions.grasping.tip_flat import fall_shift, standing_height, tip_push
+from agentchord.actions.grasping.top_grasp import on_its_edge
 from agentchord.features.frame import level_tilt_deg, make_static_frame
 from agentchord.features.oracle import OracleExtractor
 from agentchord.solvers.poses import top_down_rotation

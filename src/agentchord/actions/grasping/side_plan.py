@@ -22,9 +22,9 @@ from scipy.spatial.transform import Rotation
 
 from agentchord.actions.catalog import GraspArgs
 from agentchord.actions.controller import RobotController
-from agentchord.actions.finger_clearance import side_approach_blocking
+from agentchord.actions.grasping.finger_clearance import side_approach_blocking
 from agentchord.actions.motion import grasp_frame, pose_from_matrix
-from agentchord.actions.top_grasp import FINGERTIP_REACH
+from agentchord.actions.grasping.top_grasp import FINGERTIP_REACH
 from agentchord.features.frame import ObjectFeatures, tilt_deg
 from agentchord.solvers.ik import solve_from_scratch
 

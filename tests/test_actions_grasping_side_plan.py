@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from agentchord.actions.side_plan import strikes_top
+from agentchord.actions.grasping.side_plan import strikes_top
 from agentchord.features.frame import make_static_frame
 
 # A bottle 20 cm tall, 6 cm across, standing at (0, 0.5); its top at 20 cm.

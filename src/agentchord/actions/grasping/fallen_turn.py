@@ -13,7 +13,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from agentchord.actions.motion import grasp_frame
-from agentchord.actions.top_grasp import FINGERTIP_REACH
+from agentchord.actions.grasping.top_grasp import FINGERTIP_REACH
 from agentchord.features.frame import ObjectFeatures
 from agentchord.solvers.poses import top_down_rotation
 

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from agentchord.actions.top_grasp import FINGERTIP_REACH, lies_on_side, long_axis, on_its_edge, plain_top_grasp
+from agentchord.actions.grasping.top_grasp import FINGERTIP_REACH, lies_on_side, long_axis, on_its_edge, plain_top_grasp
 from agentchord.features.frame import make_static_frame, tilt_deg
 
 

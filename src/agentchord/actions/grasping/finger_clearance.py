@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from agentchord.actions.geometry import _matrix
+from agentchord.actions.grasping.geometry import quat_matrix
 from agentchord.actions.motion import line_poses
 from agentchord.features.frame import UP, FeatureFrame, ObjectFeatures
 from agentchord.solvers.ik import PoseTarget
@@ -113,7 +113,7 @@ def is_round(feats: ObjectFeatures) -> bool:
 
 def _inside(feats: ObjectFeatures, points: np.ndarray, clearance: float = CLEARANCE) -> np.ndarray:
     """Which points lie within ``clearance`` of an object: its oriented box, or its cylinder when round."""
-    local = (points - feats.pos) @ _matrix(feats.quat)
+    local = (points - feats.pos) @ quat_matrix(feats.quat)
     half = 0.5 * np.asarray(feats.extent, dtype=float) + clearance
     if is_round(feats):
         radius = 0.5 * float(max(feats.extent[0], feats.extent[1])) + clearance
@@ -220,7 +220,7 @@ def neighbours_hit(frame: FeatureFrame, obj: str | None, points: np.ndarray, cle
 def horizontal_sizes(feats: ObjectFeatures, long_dir: np.ndarray) -> tuple[float, float]:
     """An object's size (m) along ``long_dir`` and across it on the table: its box seen from above,
     whether it stands (a fork's length) or lies (a bottle's, along its axis)."""
-    rotation = _matrix(feats.quat)
+    rotation = quat_matrix(feats.quat)
     extent = np.asarray(feats.extent, dtype=float)
     across_dir = np.cross(UP, long_dir)
     return float(np.abs(long_dir @ rotation) @ extent), float(np.abs(across_dir @ rotation) @ extent)

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from agentchord.actions.fallen_turn import TURN_FROM_BASE, fallen_grasp_frame, turn_pose, turned
-from agentchord.actions.top_grasp import FINGERTIP_REACH
+from agentchord.actions.grasping.fallen_turn import TURN_FROM_BASE, fallen_grasp_frame, turn_pose, turned
+from agentchord.actions.grasping.top_grasp import FINGERTIP_REACH
 from agentchord.features.frame import make_static_frame
 
 

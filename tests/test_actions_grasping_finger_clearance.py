@@ -6,7 +6,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from agentchord.actions.finger_clearance import (
+from agentchord.actions.grasping.finger_clearance import (
     END_MARGIN,
     FINGER_ACROSS,
     TopGraspChoice,
@@ -223,7 +223,7 @@ def _top_down(at, long_dir=(-0.4, 0.92, 0.0)):
 
 
 def _leg_hits(frame, obj, start, end):
-    from agentchord.actions.finger_clearance import _sweeps
+    from agentchord.actions.grasping.finger_clearance import _sweeps
 
     return _sweeps(frame, obj, start, end)
 

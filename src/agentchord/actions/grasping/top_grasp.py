@@ -2,7 +2,7 @@
 
 A top grasp (a short or flat object: a block, a capsule, cutlery) comes straight down with the
 fingers closing across the object's narrow horizontal side. This is the plain grasp, before any
-clearance of a neighbour (:mod:`~agentchord.actions.finger_clearance`) or offset the graph asks
+clearance of a neighbour (:mod:`~agentchord.actions.grasping.finger_clearance`) or offset the graph asks
 for; the place action uses it too, to put an object down where a top grasp can take it again.
 """
 
@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from agentchord.actions.geometry import _matrix
+from agentchord.actions.grasping.geometry import quat_matrix
 from agentchord.features.frame import ObjectFeatures, level_tilt_deg
 
 #: Tilt (deg) beyond which an object is treated as lying on its side.
@@ -49,7 +49,7 @@ def long_axis(feats: ObjectFeatures) -> np.ndarray:
     fork on its edge against the plate was taken along its thickness, with the fingers across its
     14 cm length).
     """
-    rot = _matrix(feats.quat)
+    rot = quat_matrix(feats.quat)
     if on_its_edge(feats):
         level = [feats.extent[i] * float(np.linalg.norm(rot[:2, i])) for i in (0, 1)]
         return rot[:, 0] if level[0] >= level[1] else rot[:, 1]
@@ -76,7 +76,7 @@ def plain_top_grasp(feats: ObjectFeatures) -> tuple[np.ndarray, np.ndarray]:
     # high as its sides stand.
     across = float(feats.extent[0])
     if on_its_edge(feats):
-        across = float(np.abs(_matrix(feats.quat)[2]) @ np.asarray(feats.extent, dtype=float))
+        across = float(np.abs(quat_matrix(feats.quat)[2]) @ np.asarray(feats.extent, dtype=float))
     top_z = feats.pos[2] + 0.5 * across if lying else max(feats.top[2], feats.bottom[2])
     height = top_z - min(feats.bottom[2], feats.top[2]) if not lying else across
     tips_z = max(top_z - min(0.7 * height, 0.03), 0.004)

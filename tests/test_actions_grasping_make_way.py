@@ -5,7 +5,7 @@ import pytest
 
 from agentchord.harness import DisturbanceSetting
 from agentchord.actions.controller import RobotController
-from agentchord.actions.make_way import NEAREST_TO_SHOULDER, STEP_BACK, make_way, step_back_pose
+from agentchord.actions.grasping.make_way import NEAREST_TO_SHOULDER, STEP_BACK, make_way, step_back_pose
 from agentchord.features.oracle import OracleExtractor
 from agentchord.solvers.ik import PoseTarget
 from agentchord.sim.world import SimWorld

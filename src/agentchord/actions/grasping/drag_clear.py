@@ -2,7 +2,7 @@
 
 An object pushed flush against another leaves no room on that side for an open finger: a fork
 against the plate's rim. Where no slide or turn of the grasp clears the neighbour
-(:mod:`~agentchord.actions.finger_clearance`), the finger comes down on it and the tool stops
+(:mod:`~agentchord.actions.grasping.finger_clearance`), the finger comes down on it and the tool stops
 short. Then the tip of one open finger is pressed lightly on the object's top, near its edge on
 the neighbour's side, and the hand slides away: the finger's friction (1.5) beats
 the table's (at most 1.2 for the objects here), and the object comes along. The grasp then looks
@@ -21,7 +21,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from agentchord.actions.controller import RobotController
-from agentchord.actions.finger_clearance import (
+from agentchord.actions.grasping.finger_clearance import (
     FINGER_ACROSS,
     FINGER_SPAN_DOWN,
     SHORT_RATIO,
@@ -32,9 +32,9 @@ from agentchord.actions.finger_clearance import (
     open_finger_points,
     swept_hits,
 )
-from agentchord.actions.geometry import _matrix
+from agentchord.actions.grasping.geometry import quat_matrix
 from agentchord.actions.motion import approach, move_to, pose_from_matrix, settle, wait_for_rest
-from agentchord.actions.top_grasp import plain_top_grasp
+from agentchord.actions.grasping.top_grasp import plain_top_grasp
 from agentchord.features.frame import UP, FeatureFrame, ObjectFeatures
 from agentchord.solvers.poses import top_down_rotation
 
@@ -86,14 +86,14 @@ class DragPlan:
 
 def _away_from(feats: ObjectFeatures, neighbour: ObjectFeatures) -> np.ndarray | None:
     """The horizontal direction (unit) from a neighbour's nearest point to the object's centre."""
-    local = (feats.pos - neighbour.pos) @ _matrix(neighbour.quat)
+    local = (feats.pos - neighbour.pos) @ quat_matrix(neighbour.quat)
     half = 0.5 * np.asarray(neighbour.extent, dtype=float)
     nearest = np.clip(local, -half, half)
     if is_round(neighbour):  # the nearest point of its circle
         radial = np.hypot(local[0], local[1])
         if radial > 1e-9:
             nearest[:2] = local[:2] * min(1.0, 0.5 * float(max(neighbour.extent[:2])) / radial)
-    direction = (_matrix(neighbour.quat) @ (local - nearest))[:2]
+    direction = (quat_matrix(neighbour.quat) @ (local - nearest))[:2]
     norm = float(np.linalg.norm(direction))
     return None if norm < 1e-6 else np.r_[direction / norm, 0.0]
 
@@ -101,7 +101,7 @@ def _away_from(feats: ObjectFeatures, neighbour: ObjectFeatures) -> np.ndarray |
 def _chord(feats: ObjectFeatures, direction: np.ndarray) -> float:
     """The length (m) of the line through an object's centre along a horizontal ``direction`` to its
     sides (its oriented box, or its circle when round, seen from above)."""
-    local = np.abs(direction @ _matrix(feats.quat))[:2]
+    local = np.abs(direction @ quat_matrix(feats.quat))[:2]
     extent = np.asarray(feats.extent, dtype=float)[:2]
     if is_round(feats):
         return float(max(extent))
@@ -120,7 +120,7 @@ def _tip_points(tip: np.ndarray, rotation: np.ndarray) -> np.ndarray:
 
 def _top(feats: ObjectFeatures) -> float:
     """The height (m) of an object's highest point (its oriented box)."""
-    return float(feats.pos[2] + 0.5 * np.abs(_matrix(feats.quat)[2]) @ np.asarray(feats.extent, dtype=float))
+    return float(feats.pos[2] + 0.5 * np.abs(quat_matrix(feats.quat)[2]) @ np.asarray(feats.extent, dtype=float))
 
 
 def _moved(frame: FeatureFrame, obj: str, shift: np.ndarray) -> FeatureFrame:

@@ -8,11 +8,11 @@ import pytest
 
 from agentchord.actions.base import Status
 from agentchord.actions.controller import RobotController
-from agentchord.actions.drag_clear import EDGE_MARGIN, FINGER_ACROSS, TIP_THICKNESS, DragPlan, plan_drag
-from agentchord.actions.finger_clearance import clear_top_grasp
+from agentchord.actions.grasping.drag_clear import EDGE_MARGIN, FINGER_ACROSS, TIP_THICKNESS, DragPlan, plan_drag
+from agentchord.actions.grasping.finger_clearance import clear_top_grasp
 from agentchord.actions.grasp import Grasp
 from agentchord.actions.library import make_action
-from agentchord.actions.top_grasp import plain_top_grasp
+from agentchord.actions.grasping.top_grasp import plain_top_grasp
 from agentchord.features.frame import make_static_frame
 from agentchord.features.oracle import OracleExtractor
 from agentchord.sim.tasks import SIM_TASKS

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from agentchord.actions.controller import RobotController
-from agentchord.actions.finger_clearance import swept_hits
+from agentchord.actions.grasping.finger_clearance import swept_hits
 from agentchord.actions.joint_path import joint_path
 from agentchord.actions.motion import ANGULAR_SPEED, EMPTY_HAND_JOINT_SPEED, line_poses, move_joints, pose_from_matrix
 from agentchord.robot.aloha import ARM_JOINTS, ARM_PREFIX

@@ -1,9 +1,9 @@
-"""Where a held object sits in the hand (actions/in_hand.py)."""
+"""Where a held object sits in the hand (actions/grasping/in_hand.py)."""
 
 import numpy as np
 import pytest
 
-from agentchord.actions.in_hand import axis_offset_in_tool, grasp_height_share, side_held_object
+from agentchord.actions.grasping.in_hand import axis_offset_in_tool, grasp_height_share, side_held_object
 from agentchord.features.frame import make_static_frame
 from agentchord.solvers.poses import grasp_frame
 

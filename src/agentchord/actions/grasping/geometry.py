@@ -11,19 +11,19 @@ from agentchord.actions.motion import grasp_frame
 from agentchord.robot.aloha import ARM_JOINTS, ARM_PREFIX
 
 
-def _level(rotation: np.ndarray) -> np.ndarray:
+def level_frame(rotation: np.ndarray) -> np.ndarray:
     """The tool's level side-grasp frame for its current approach; a top-down tool is kept."""
     if abs(rotation[2, 0]) > 0.7:
         return rotation
     return grasp_frame(rotation[:, 0])
 
 
-def _matrix(quat: np.ndarray) -> np.ndarray:
+def quat_matrix(quat: np.ndarray) -> np.ndarray:
     w, x, y, z = quat
     return Rotation.from_quat([x, y, z, w]).as_matrix()
 
 
-def _yaw_turn(robot: RobotController, arm: str, direction: np.ndarray, yaw_deg: float, goal: np.ndarray) -> np.ndarray:
+def yaw_turn(robot: RobotController, arm: str, direction: np.ndarray, yaw_deg: float, goal: np.ndarray) -> np.ndarray:
     """Rotation about world z that brings ``direction``'s yaw to ``yaw_deg``, either way round (mod 180).
 
     Of the two turns, the smaller one unless it would drive the wrist-rotate joint (whose axis
@@ -34,12 +34,12 @@ def _yaw_turn(robot: RobotController, arm: str, direction: np.ndarray, yaw_deg: 
     delta = (yaw_deg - current + 90.0) % 180.0 - 90.0
     candidates = [delta] if abs(delta) < 1e-6 else [delta, delta - np.copysign(180.0, delta)]
     best = candidates[0]
-    if _wrist_margin(robot, arm, best, goal) < 0.0:
-        best = max(candidates, key=lambda turn: _wrist_margin(robot, arm, turn, goal))
+    if wrist_margin(robot, arm, best, goal) < 0.0:
+        best = max(candidates, key=lambda turn: wrist_margin(robot, arm, turn, goal))
     return Rotation.from_euler("z", best, degrees=True).as_matrix()
 
 
-def _wrist_margin(robot: RobotController, arm: str, turn_deg: float, goal: np.ndarray) -> float:
+def wrist_margin(robot: RobotController, arm: str, turn_deg: float, goal: np.ndarray) -> float:
     """Predicted distance (rad) of the wrist-rotate joint to its range after turning the tool
     ``turn_deg`` about world z while moving to ``goal`` (x, y); the waist's own turn is accounted for."""
     lo, hi = robot.ik.model.joint(f"{ARM_PREFIX[arm]}/wrist_rotate").range
