@@ -7,6 +7,7 @@ from pathlib import Path
 
 import pytest
 
+from agentchord.library import library_path, library_tasks
 from agentchord.graph import RenderError, TaskGraph, load_graph, render, to_dot, to_mermaid
 
 POUR = Path(__file__).parent / "data" / "graphs" / "pour_water.yaml"
@@ -127,7 +128,7 @@ def test_an_arm_switching_alternative_is_drawn_dotted_and_says_what_it_replaces(
 
 
 # ------------------------------------------------------------------ the readable figure (issue 49)
-LIBRARY = sorted((Path(__file__).parent.parent / "src" / "agentchord" / "tasks" / "library").glob("*.yaml"))
+LIBRARY = [library_path(task) for task in library_tasks()]
 needs_dot = pytest.mark.skipif(shutil.which("dot") is None, reason="Graphviz `dot` not installed (apt-get install graphviz)")
 
 
