@@ -89,7 +89,7 @@ SCENES = [
     pytest.param("setup_coffee_tray", STRESS, 22, {}, lambda r: _handed_over(r, "right", "capsule"), id="coffee_tray-stress-22"),
     # A fork that fell on its edge was put down on its edge ("not lying flat"), and the tilted tool's
     # turn top-down over it lost the IK's line; tipped flat by the open fingers (actions/grasping/tip_flat.py),
-    # taken along its length (actions/top_grasp.long_axis), a lost line gone round through home
+    # taken along its length (actions/grasping/top_grasp.long_axis), a lost line gone round through home
     # (actions/motion.approach).
     pytest.param("rearrange_table", STRESS, 35, {}, None, id="rearrange-stress-35"),
     # A fork pushed against the plate's rim put a finger on the rim and the tool stopped short; the
@@ -101,12 +101,16 @@ SCENES = [
     pytest.param("rearrange_table", STRESS, 2, {"planned": True}, None, id="rearrange-stress-2-planned"),
     # The cup, pulled out of the left hand, came to rest beside the bottle lying on the table, and
     # every side grasp of the cup pushed the bottle and closed off centre; a side grasp takes the
-    # nearest clear way in (actions/side_plan.SidePlanner.clear). Both still fall here.
+    # nearest clear way in (actions/grasping/side_plan.SidePlanner.clear). Both still fall here.
     pytest.param("dual_arm_pour_water", STRESS, 8, {}, lambda r: {"bottle_dropped", "cup_dropped"} <= set(_modes(r)),
                  id="dual_arm_pour-stress-8"),
     # A side grasp passing 3 mm beside the standing cup holds as planned: no clearance is kept
-    # (actions/finger_clearance.side_approach_blocking).
+    # (actions/grasping/finger_clearance.side_approach_blocking).
     pytest.param("single_arm_pour_water", STRESS, 9, {}, None, id="single_arm_pour-stress-9"),
+    # A bottle lying on nothing but the robot's open fingers (a pull set it down there) was pushed
+    # and went off the table: a push is applied only to what rests on the table or is held
+    # (sim/disturbances.inject).
+    pytest.param("single_arm_pour_water", REAL, 32, {}, None, id="single_arm_pour-real-32"),
     # A regrasp starting with the hand over the dropped bottle drove the gripper down into its top
     # and knocked it over; the approach goes round the top (actions/grasp.Grasp._pass_over). Table
     # II's episode: the sweep's reasoning.
@@ -114,7 +118,7 @@ SCENES = [
                  id="dual_arm_pour-real-1-table2"),
     # A capsule lying on its side beside the tray's handle was read as standing on an edge and taken
     # across its flat ends, a finger on the handle; only a flat object stands on an edge
-    # (actions/top_grasp.on_its_edge).
+    # (actions/grasping/top_grasp.on_its_edge).
     pytest.param("setup_coffee_tray", REAL, 84, {}, None, id="coffee_tray-real-84"),
     # The bottle, set down for the right arm, was struck by the left hand going to take the cup; a
     # hand-off spot keeps out of the corridor of the next grasp (solvers/handoff.handoff_spot). The
