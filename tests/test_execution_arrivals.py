@@ -114,3 +114,19 @@ def test_a_failure_before_its_branch_hurries_it(monkeypatch):
     assert hurried.early_failures[0]["tick"] == waited.early_failures[0]["tick"]
     assert hurried.early_failures[0]["waited_ticks"] < waited.early_failures[0]["waited_ticks"] - 25
     assert hurried.plan_wait_s < waited.plan_wait_s
+
+
+def test_an_edge_that_ends_violated_before_its_modes_arrived_waits_for_them_and_recovers(monkeypatch):
+    # The cup knocked over while the bottle tilts over it (e3): e3's own modes (cup_tipped) have not
+    # arrived and no monitor derived from e3's constraints reads the cup. The edge ends at v3 with the
+    # bottle no longer over the cup; the robot waits there for e3's modes, which read the cup tipped.
+    knock = ScriptedDisturbance("rotate_eef", "knock", after=30)
+    pipelined, sequential = _run(disturbance=knock), _run("agentchord-sequential", disturbance=knock)
+    assert sequential.success and pipelined.success, pipelined.reason
+    (early,) = pipelined.early_failures
+    assert early["edge"] == "e3" and early["failure"].startswith("reached v3: ")
+    assert early["then"].startswith("recovery for cup_") and early["waited_ticks"] > 0
+    # Before: the robot went on from v3 as if it held, and poured beside the cup.
+    monkeypatch.setattr("agentchord.execution.arrivals.PlanArrivals._early_arrival", lambda self, program, arrive: False)
+    unwatched = _run(disturbance=knock)
+    assert not unwatched.success and unwatched.early_failures == []

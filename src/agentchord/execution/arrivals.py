@@ -16,7 +16,9 @@ fired, had it been there) and waits for that mode's branch; if no mode watches i
 all the edge's branches and asks their monitors what the scene is: one that reads it violated
 recovers, else the edge goes on. A skill that reports failure waits for the list, then goes to
 the strategy as usual. A nominal edge whose grounding has not arrived when the robot reaches its
-source waits the same way. Each case is in the trace (``failure_before_branch``,
+source waits the same way. A nominal edge that ends at a node whose constraints do not hold before
+its modes have all arrived (their monitors never watched it) waits for them at the node, then asks
+them what the scene is, as a derived monitor's failure does. Each case is in the trace (``failure_before_branch``,
 ``modes_listed``, ``branch_arrived`` with what came of it) and in the episode's result
 (:attr:`EpisodeResult.early_failures`).
 
@@ -115,6 +117,7 @@ class PlanArrivals:
     still_since: int | None
     plan_wait_ticks: int
     _derived: dict[str, EdgeMonitors]
+    constraints: dict[str, Any]
     frame: Any
     background: ThreadedPlan | ScriptedPlan | None
     _incoming: tuple[int, TaskGraph] | None
@@ -246,7 +249,8 @@ class PlanArrivals:
         if failure is not None:
             self.trace.add(self.world.tick, "failure_before_branch", edge=edge_id, failure=failure, arrives_tick=until)
 
-    def _early_failure(self, detection: Detection, suspended: EdgeProgram | None = None, since: int | None = None) -> bool:
+    def _early_failure(self, detection: Detection, suspended: EdgeProgram | None = None, since: int | None = None,
+                       resume: Callable[[], tuple[bool, str] | None] | None = None) -> bool:
         """Wait for the branch of a failure that fired before it arrived (True when it waits).
 
         A mode that fires before its branch (a strategy's detection) waits for its own branch. A derived
@@ -254,7 +258,8 @@ class PlanArrivals:
         come; then it is the mode that watches the same constraint, if there is one: it waits for that
         mode's branch and switches to its recovery then, as if the mode had fired (it would have, had it
         been there). Otherwise it waits for every mode of the edge and asks them what the scene is: one
-        that reads it violated switches to its recovery, else the edge goes on.
+        that reads it violated switches to its recovery, else the edge goes on (``resume``, when given:
+        what going on is for an edge that has ended).
         """
         derived = detection.failure.intent == DERIVED_INTENT
         listed = self._listed_tick(detection.edge_id) if derived else None
@@ -264,7 +269,7 @@ class PlanArrivals:
         elif derived:
             watching = self.as_arranged(detection)
             if watching is not detection:
-                return self._early_failure(watching, suspended, since)
+                return self._early_failure(watching, suspended, since, resume)
             if self._pending_modes(detection.edge_id):
                 self._hurry(detection.edge_id, None)
             pending = self._pending_modes(detection.edge_id)
@@ -283,7 +288,7 @@ class PlanArrivals:
                 watching = self.as_arranged(detection)
                 self.trace.add(self.world.tick, "modes_listed", edge=detection.edge_id, failure=detection.failure.name,
                                taken_as=watching.failure.name if watching is not detection else None)
-                if self._early_failure(detection, suspended, since):
+                if self._early_failure(detection, suspended, since, resume):
                     return None
                 self._arrived(f"recovery for {watching.failure.name}", since)
                 return self._recover_after_wait(detection, since)
@@ -298,7 +303,7 @@ class PlanArrivals:
             self._arrived("no failure mode of the edge is violated: the edge goes on", since)
             if suspended is not None:
                 self._arm_monitors(suspended)
-            return None
+            return resume() if resume is not None else None
 
         if since == self.world.tick:
             self.trace.add(self.world.tick, "failure_before_branch", edge=detection.edge_id, failure=detection.failure.name,
@@ -320,6 +325,30 @@ class PlanArrivals:
         before = {(c.call.part, c.start_s) for c in schedule.calls}
         moved = [c.call.part for c in self.schedule.calls if (c.call.part, c.start_s) not in before]
         self.trace.add(self.world.tick, "plan_hurried", edge=edge_id, failure=failure, moved=moved)
+
+    def _early_arrival(self, program: EdgeProgram, arrive: Callable[[], tuple[bool, str] | None]) -> tuple[bool, str] | None | bool:
+        """A nominal edge that ended at a node whose constraints do not hold, before its failure modes had
+        all arrived: their monitors never watched the edge (a cup knocked over while the bottle was
+        carried to it), so the robot waits for them as for a failure before its branch, then asks them
+        what the scene is; one that reads it violated recovers, else the robot arrives (``arrive``).
+
+        Returns:
+            False when the edge's modes were all here (arrive as usual); otherwise what came of it now
+            (None: it waits, or recovers).
+        """
+        if program.kind != "nominal" or self.schedule is None or not self._pending_modes(program.edge_id):
+            return False
+        values = [(c.source, c.scalar(self.frame)) for c in self.constraints[program.target]]
+        violated = [(source, value) for source, value in values if value > 0.0]
+        if not violated:
+            return False
+        source, value = violated[0]
+        failure = FailureMode(name=f"reached {program.target}: {source}", monitor=source, intent=DERIVED_INTENT,
+                              recovery=program.edge_id)
+        detection = Detection(program.edge_id, failure, self.world.tick, self.world.tick, float(value))
+        if self._early_failure(detection, resume=arrive):
+            return None
+        return self._on_failure(self.as_arranged(detection))  # the mode watching it is here already
 
     def _recover_after_wait(self, detection: Detection, since: int) -> tuple[bool, str] | None:
         """Recover from a failure that waited for its branch since tick ``since``.

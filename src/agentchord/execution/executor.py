@@ -495,6 +495,9 @@ class Executor(RecoverySwitching, PlanArrivals):
         detection = self._repair(program)
         if detection is not None:
             return self._on_failure(detection)
+        early = self._early_arrival(program, lambda: self._arrive(program.target))
+        if early is not False:
+            return early
         target = self.graph.node(program.target) if program.kind != "backtrack" else None
         if target is not None and target.kind == "recovery":
             self.path.append(target.id)
