@@ -130,3 +130,19 @@ def test_an_edge_that_ends_violated_before_its_modes_arrived_waits_for_them_and_
     monkeypatch.setattr("agentchord.execution.arrivals.PlanArrivals._early_arrival", lambda self, program, arrive: False)
     unwatched = _run(disturbance=knock)
     assert not unwatched.success and unwatched.early_failures == []
+
+
+@pytest.mark.slow
+def test_a_skill_that_fails_before_its_modes_arrive_asks_them_first():
+    # Fold towel, stress protocol: the left corner drops as it is carried to its place (e4), before
+    # e4's modes have arrived; the place finds nothing to place. Once the list is here its monitors
+    # read the corner slipped, and that recovery runs (the episode had ended on the skill's failure).
+    from agentchord.harness import DisturbanceSetting
+
+    spec = EpisodeSpec("fold_towel", seed=11, disturbances=DisturbanceSetting.from_options(protocol="stress"),
+                       reasoning=ReasoningConfig(latency=TokenLatencyModel()))
+    result = run_episode(spec)
+    assert result.success, result.reason
+    first = result.early_failures[0]
+    assert first["failure"].startswith("skill failed: left.place(obj=towel_bl")
+    assert first["then"].startswith("recovery for bl_slipped")

@@ -375,7 +375,13 @@ class PlanArrivals:
         return detection
 
     def _early_program_failure(self) -> bool:
-        """Wait for the list of modes of an edge whose skill failed before it arrived (True when it waits)."""
+        """Wait for the list of modes of an edge whose skill failed before it arrived (True when it waits).
+
+        Once the list is here, its monitors are asked what the scene is first, as they would have been
+        asked every tick had they been armed (a corner dropped as it was carried to its place: the
+        sequential plan's monitor fires before the place finds nothing to place). One that reads it
+        violated recovers; otherwise the skill's failure goes to the strategy as usual.
+        """
         program = self.program
         listed = self._listed_tick(program.edge_id) if program is not None and program.kind == "nominal" else None
         if listed is None:
@@ -384,6 +390,11 @@ class PlanArrivals:
 
         def arrived() -> tuple[bool, str] | None:
             self.program = program
+            monitors = self.monitors.get(program.edge_id)
+            now = monitors.violated_now(self.frame) if monitors is not None else None
+            if now is not None:
+                self._arrived(f"recovery for {now.failure.name} (the skill failed: {program.failure_reason})", since)
+                return self._recover_after_wait(Detection(now.edge_id, now.failure, self.world.tick, self.world.tick, now.value), since)
             self._arrived(f"the skill's failure taken as the strategy takes it ({program.failure_reason})", since)
             return self._on_program_failed()
 
