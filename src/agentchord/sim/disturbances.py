@@ -184,7 +184,7 @@ def _take_and_set_down(world: SimWorld, frame: FeatureFrame, obj: str, arm: str,
     else:
         rest, height = yaw, 0.5 * spec.height
     # Out of the fingers entirely: a fork taken out of a top grasp slides along its length.
-    distance = max(PULL_OUT_DISTANCE, _half_extent_along(spec, matrix, out) + PULL_OUT_MARGIN)
+    distance = max(PULL_OUT_DISTANCE, spec.half_extent_along(matrix, out) + PULL_OUT_MARGIN)
     over = _carry_height(world, frame, obj, pos[:2] + distance * out[:2], spot)
     path = set_down_path(pos, Rotation.from_matrix(matrix), out, spot, height, rest, distance, over=over)
     world.hand_carry(obj, path, out_of=arm)
@@ -202,7 +202,7 @@ def _carry_height(world: SimWorld, frame: FeatureFrame, obj: str, start: np.ndar
     reach = float(np.linalg.norm(spec.size[:2] if spec.shape == "cylinder" else spec.size[:3]))
     up = np.array([0.0, 0.0, 1.0])
     here, matrix = world.object_pose(obj)
-    bottom = here[2] - _half_extent_along(spec, matrix, up)
+    bottom = here[2] - spec.half_extent_along(matrix, up)
     held = {name for _, name in frame.holding}
     tops = []
     for name in world.object_names:
@@ -210,13 +210,13 @@ def _carry_height(world: SimWorld, frame: FeatureFrame, obj: str, start: np.ndar
             continue
         other = world.object_spec(name)
         other_pos, other_matrix = world.object_pose(name)
-        resting_on = other_pos[2] - _half_extent_along(other, other_matrix, up) > bottom + LOAD_ABOVE
+        resting_on = other_pos[2] - other.half_extent_along(other_matrix, up) > bottom + LOAD_ABOVE
         if resting_on and np.linalg.norm(other_pos[:2] - here[:2]) < _footprint(spec):
             # Lifted over its own load: a tray pulled with a capsule in it would throw the capsule
             # off the table.
             continue
         if _distance_to_segment(other_pos[:2], start, spot) < _footprint(other) + reach + CARRY_PASS_CLEARANCE:
-            tops.append(other_pos[2] + _half_extent_along(other, other_matrix, up))
+            tops.append(other_pos[2] + other.half_extent_along(other_matrix, up))
     return max(tops) + reach + CARRY_PASS_CLEARANCE if tops else None
 
 
@@ -225,15 +225,6 @@ def _distance_to_segment(point: np.ndarray, a: np.ndarray, b: np.ndarray) -> flo
     ab = b - a
     t = float(np.clip((point - a) @ ab / max(float(ab @ ab), 1e-12), 0.0, 1.0))
     return float(np.linalg.norm(point - (a + t * ab)))
-
-
-def _half_extent_along(spec, matrix: np.ndarray, direction: np.ndarray) -> float:
-    """Half the object's extent (m) along a world direction, in its pose ``matrix``."""
-    local = np.abs(matrix.T @ direction)
-    if spec.shape == "cylinder":
-        radius, half_height = spec.size[0], spec.size[1]
-        return float(local[2] * half_height + np.sqrt(max(1.0 - local[2] ** 2, 0.0)) * radius)
-    return float(local @ np.asarray(spec.size[:3], dtype=float))
 
 
 def _horizontal(rng: np.random.Generator) -> np.ndarray:

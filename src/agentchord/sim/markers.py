@@ -153,15 +153,6 @@ def _push_shapes(contact: np.ndarray, direction: np.ndarray, above: np.ndarray) 
     ]
 
 
-def _half_extent(spec, matrix: np.ndarray, direction: np.ndarray) -> float:
-    """Half the object's extent (m) along a world direction, in its pose ``matrix``."""
-    local = np.abs(matrix.T @ direction)
-    if spec.shape == "cylinder":
-        radius, half_height = spec.size[0], spec.size[1]
-        return float(local[2] * half_height + np.sqrt(max(1.0 - local[2] ** 2, 0.0)) * radius)
-    return float(local @ np.asarray(spec.size[:3], dtype=float))
-
-
 def read_marker(world, obj: str) -> DisturbanceMarker | None:
     """The disturbance acting on ``obj`` now, read from the wrench on its body (None: none acts).
 
@@ -176,7 +167,7 @@ def read_marker(world, obj: str) -> DisturbanceMarker | None:
     pos, matrix = world.object_pose(obj)
     spec = world.object_spec(obj)
     up = np.array([0.0, 0.0, 1.0])
-    half_up = _half_extent(spec, matrix, up)
+    half_up = spec.half_extent_along(matrix, up)
     above = pos + (half_up + 0.04) * up
     if abs(float(force[2])) > _EPS:  # it carries the weight: a person's hand
         return DisturbanceMarker("hand", obj, pos + half_up * up, up, above)
@@ -185,7 +176,7 @@ def read_marker(world, obj: str) -> DisturbanceMarker | None:
     direction = np.array([force[0], force[1], 0.0]) / max(float(np.hypot(force[0], force[1])), _EPS)
     # Drawn on the object's side, between a finger's width over its foot and its top.
     height = float(np.clip(h, -half_up + 0.012, half_up - 0.005))
-    contact = pos + height * up - _half_extent(spec, matrix, direction) * direction
+    contact = pos + height * up - spec.half_extent_along(matrix, direction) * direction
     return DisturbanceMarker("knock" if h > 0.0 else "push", obj, contact, direction, above)
 
 

@@ -73,6 +73,14 @@ class ObjectSpec:
         """Smallest horizontal width (what a gripper closes on)."""
         return grip_width(self.shape, self.size)
 
+    def half_extent_along(self, matrix: np.ndarray, direction: np.ndarray) -> float:
+        """Half the object's extent (m) along a world direction, in its pose ``matrix`` (3 x 3)."""
+        local = np.abs(matrix.T @ direction)
+        if self.shape == "cylinder":
+            radius, half_height = self.size[0], self.size[1]
+            return float(local[2] * half_height + np.sqrt(max(1.0 - local[2] ** 2, 0.0)) * radius)
+        return float(local @ np.asarray(self.size[:3], dtype=float))
+
 
 @dataclass
 class ClothSpec:
