@@ -142,7 +142,7 @@ def _run_in(world: World, spec: EpisodeSpec, on_tick: Callable[[Executor], None]
         strategy=strategy,
         tracker=tracker,
         disturbance=spec.make_disturbance(),
-        disturbances=spec.disturbances if spec.disturbance is None else None,
+        disturbance_setting=spec.disturbances if spec.disturbance is None else None,
         seed=spec.seed,
         config=spec.config,
         on_tick=on_tick,

@@ -94,7 +94,7 @@ class Executor(RecoverySwitching, PlanArrivals):
             repair; the episode goes on from the unmet sub-goal as before).
         background: The rest of a pipelined plan asked while the robot moves (an LLM's arranger and
             conductor); ``graph`` is then the composed graph it starts on.
-        disturbances: The setting ``disturbance`` was drawn from (None: a scripted schedule, or none).
+        disturbance_setting: The setting ``disturbance`` was drawn from (None: a scripted schedule, or none).
         seed: The trial's seed (its scene and its schedule). Both go into the trace's ``episode_start``.
     """
 
@@ -110,7 +110,7 @@ class Executor(RecoverySwitching, PlanArrivals):
         perception: str = "oracle",
         repairer: Repairer | None = None,
         background: ThreadedPlan | ScriptedPlan | None = None,
-        disturbances: DisturbanceSetting | None = None,
+        disturbance_setting: DisturbanceSetting | None = None,
         seed: int | None = None,
     ) -> None:
         filtered = forward_filter(graph)
@@ -118,7 +118,7 @@ class Executor(RecoverySwitching, PlanArrivals):
         self.strategy = strategy
         self.tracker = tracker
         self.disturbance = disturbance
-        self.disturbance_setting = disturbances
+        self.disturbance_setting = disturbance_setting
         self.seed = seed
         self.config = config or ExecutorConfig()
         self.on_tick = on_tick
