@@ -4,6 +4,10 @@ import json
 
 from agentchord.agents.replies import (
     STREAM_HEADER,
+    alternatives_reply,
+    branch_alternatives,
+    branch_edges,
+    branch_entry,
     branch_owners,
     branch_reply,
     count_tokens,
@@ -52,6 +56,27 @@ def test_every_recovery_edge_comes_with_the_first_failure_mode_that_leads_to_it(
     assert reply["recovery"] == "e2_r_bottle_dropped"
     assert "r_bottle_regrasped_again" in [e["id"] for e in reply["edges"]]
     assert [f["name"] for f in modes_reply(graph.edge("e2"))] == ["bottle_dropped", "cup_tipped", "cup_shifted", "bottle_slipped"]
+
+
+def test_a_branch_is_written_without_the_other_arms_way_which_comes_in_a_reply_of_its_own():
+    graph = _graph()
+    owners = branch_owners(graph)
+    # The entry the robot needs when the mode fires: the regrasp alone, not the left arm's way to it.
+    assert branch_entry(graph, "e2", "bottle_dropped", owners) == ["e2_r_bottle_dropped", "r_bottle_regrasped"]
+    reply = branch_reply(graph, "e2", "bottle_dropped", owners)
+    written = [item["id"] for part in ("entry", "nodes", "edges") for item in reply[part]]
+    assert "e2_r_bottle_dropped_via_left" not in written
+    assert all(e.alternative_to is None for e in branch_edges(graph, "e2", "bottle_dropped", owners))
+    # The branch's alternatives: the entry's, and that of the regrasp again on a second drop.
+    alternatives = branch_alternatives(graph, "e2", "bottle_dropped", owners)
+    assert {(e.id, e.alternative_to) for e in alternatives} == {
+        ("e2_r_bottle_dropped_via_left", "e2_r_bottle_dropped"), ("r_bottle_regrasped_again_via_left", "r_bottle_regrasped_again")}
+    assert [a["id"] for a in alternatives_reply(graph, "e2", "bottle_dropped", owners)["alternatives"]] == [e.id for e in alternatives]
+    # Every recovery edge is written exactly once, in a branch or in an alternatives reply.
+    once = []
+    for edge_id, failure in [(e.id, f.name) for e in graph.nominal_edges() for f in e.failures]:
+        once += [e.id for e in branch_edges(graph, edge_id, failure, owners) + branch_alternatives(graph, edge_id, failure, owners)]
+    assert sorted(once) == sorted(e.id for e in graph.recovery_edges())
 
 
 def test_the_conductor_writes_the_values_it_grounds_not_the_structure():

@@ -121,3 +121,51 @@ def test_a_schedule_without_its_inputs_is_not_hurried():
     schedule = pipelined_schedule(_graph(), TokenLatencyModel())
     bare = type(schedule)(schedule.calls, schedule.first_motion_s, schedule.edge_ready_s, schedule.mode_ready_s)
     assert bare.hurried(5.0, "e3", "bottle_dropped") is bare
+
+
+@pytest.mark.parametrize("task", ["single_arm_pour_water", "dual_arm_pour_water", "handover_block"])
+def test_the_other_arms_way_is_asked_after_its_branch_and_no_mode_waits_for_it(task):
+    graph = _graph(task)
+    schedule = pipelined_schedule(graph, TokenLatencyModel())
+    calls = {c.call.part: c for c in schedule.calls}
+    alternatives = [part for part in calls if part.endswith(" alternatives")]
+    assert alternatives
+    for part in alternatives:  # in a call of its own, once the branch (the entry it goes round) has been written
+        mode = part.removesuffix(" alternatives")
+        assert calls[part].start_s >= calls[f"{mode} branch"].end_s - 1e-9
+        assert calls[f"{mode} alternatives grounded"].start_s >= calls[part].end_s - 1e-9
+    for edge, failure in graph.failures():
+        if edge.is_recovery:
+            continue
+        # A mode is recoverable once its own entry is grounded, whenever its entry's alternative comes.
+        mode = f"{edge.id}/{failure.name}"
+        assert schedule.mode_ready_s[(edge.id, failure.name)] == max(
+            calls[f"{mode} entry grounded"].end_s if f"{mode} entry grounded" in calls else 0.0,
+            schedule.edge_ready_s[failure.recovery],
+        )
+    for edge in graph.recovery_edges():
+        if edge.alternative_to is not None:
+            assert schedule.edge_ready_s[edge.id] > schedule.edge_ready_s[edge.alternative_to]
+
+
+def test_with_one_call_at_a_time_every_branch_is_written_before_any_alternative():
+    # Nothing else to wait for: the composer's whole graph has streamed before the second call starts.
+    schedule = pipelined_schedule(_graph("dual_arm_pour_water"), TokenLatencyModel(concurrency=1))
+    parts = [c.call.part for c in sorted(schedule.calls, key=lambda c: c.start_s)]
+    last_branch = max(k for k, part in enumerate(parts) if part.endswith(" branch"))
+    first_alternatives = min(k for k, part in enumerate(parts) if part.endswith(" alternatives"))
+    assert last_branch < first_alternatives
+
+
+def test_a_recovery_that_binds_the_other_arms_way_before_it_arrived_hurries_it():
+    graph = _graph()
+    schedule = pipelined_schedule(graph, TokenLatencyModel())
+    at = schedule.mode_ready_s[("e2", "bottle_dropped")]
+    hurried = schedule.hurried(at, "e2", None, recovery_edge="e2_r_bottle_dropped_via_left")
+    assert hurried.edge_ready_s["e2_r_bottle_dropped_via_left"] < schedule.edge_ready_s["e2_r_bottle_dropped_via_left"] - 2.0
+    starts = {c.call.part: c.start_s for c in hurried.calls}
+    unhurried = {c.call.part: c.start_s for c in schedule.calls}
+    assert starts["e2/bottle_dropped alternatives"] < unhurried["e2/bottle_dropped alternatives"]
+    # Nothing else of the branch is asked again, and no mode arrives later for it than the model allows.
+    assert hurried.mode_ready_s[("e2", "bottle_dropped")] == schedule.mode_ready_s[("e2", "bottle_dropped")]
+    assert all(_overlap(hurried.calls, c.start_s) <= 4 for c in hurried.calls)

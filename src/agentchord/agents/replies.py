@@ -9,8 +9,9 @@ replies' real tokens on the mean, 0.57 of the conductor's numbers (``benchmarks/
 The pipelined plan splits the agents' work (:mod:`agentchord.execution.planning`): the composer's
 nominal graph is written in execution order -- the start node, then each edge followed by the node it
 reaches (:func:`stream_order`) -- so that an edge and both its nodes can be read from the stream
-long before the reply ends; the arranger writes each edge's failure modes, then each mode's branch;
-the conductor grounds each edge and each branch (:func:`branch_owners` says which mode's branch
+long before the reply ends; the arranger writes each edge's failure modes, then each mode's branch,
+and last, in calls of their own, the branches' other-arm alternatives; the conductor grounds each
+edge, each branch and each alternative (:func:`branch_owners` says which mode's branch
 brings which recovery edge).
 """
 
@@ -160,12 +161,24 @@ def modes_reply(edge: Edge) -> list[dict[str, Any]]:
     return [_dump(f.model_copy(update={"recovery": ""})) for f in edge.failures]
 
 
+def branch_alternatives(graph: TaskGraph, edge_id: str, failure: str, owners: dict[str, tuple[str, str]]) -> list[Edge]:
+    """The other arm's ways (``alternative_to`` edges) one failure mode's branch brings: the arranger
+    writes them in a call of their own, after every edge's branches (:func:`alternatives_reply`)."""
+    return [e for e in graph.recovery_edges() if e.alternative_to is not None and owners.get(e.id) == (edge_id, failure)]
+
+
+def alternatives_reply(graph: TaskGraph, edge_id: str, failure: str, owners: dict[str, tuple[str, str]]) -> dict[str, Any]:
+    """What the arranger writes for one failure mode's other-arm alternatives (none: an empty list)."""
+    return {"failure": failure, "alternatives": [_dump(e) for e in branch_alternatives(graph, edge_id, failure, owners)]}
+
+
 def branch_entry(graph: TaskGraph, edge_id: str, failure: str, owners: dict[str, tuple[str, str]]) -> list[str]:
     """The part of one failure mode's branch the robot needs the moment the mode fires: its recovery
-    entry and the entry's alternatives (the other arm's way), with the recovery nodes they reach."""
+    entry, with the recovery node it reaches. The entry's alternatives (the other arm's way) come
+    later (:func:`alternatives_reply`): a recovery needs one only when its own arm cannot reach."""
     key = (edge_id, failure)
     entry = next(f.recovery for f in graph.edge(edge_id).failures if f.name == failure)
-    edges = [e for e in with_alternatives(graph, [entry]) if owners.get(e) == key]
+    edges = [entry] if owners.get(entry) == key else []
     nodes = [graph.edge(e).target for e in edges]
     return edges + [n for n in dict.fromkeys(nodes) if owners.get(n) == key]
 
@@ -173,13 +186,14 @@ def branch_entry(graph: TaskGraph, edge_id: str, failure: str, owners: dict[str,
 def branch_reply(graph: TaskGraph, edge_id: str, failure: str, owners: dict[str, tuple[str, str]]) -> dict[str, Any]:
     """What the arranger writes for one failure mode's branch: its entry, the recovery nodes and edges it brings.
 
-    Written entry first (:func:`branch_entry`: the entry edges, then the nodes they reach), then the
-    rest, so that the conductor can ground the entry while the rest streams.
+    Written entry first (:func:`branch_entry`: the entry edge, then the node it reaches), then the
+    rest, so that the conductor can ground the entry while the rest streams. The other arm's
+    alternatives are not in it (:func:`alternatives_reply`).
     """
     key = (edge_id, failure)
     first = branch_entry(graph, edge_id, failure, owners)
     rank = {item: k for k, item in enumerate(first)}
-    edges = sorted((e for e in graph.recovery_edges() if owners.get(e.id) == key), key=lambda e: rank.get(e.id, len(rank)))
+    edges = sorted((e for e in branch_edges(graph, edge_id, failure, owners)), key=lambda e: rank.get(e.id, len(rank)))
     nodes = sorted((n for n in graph.recovery_nodes() if owners.get(n.id) == key), key=lambda n: rank.get(n.id, len(rank)))
     entry_edges = [e for e in edges if e.id in rank]
     entry_nodes = [n for n in nodes if n.id in rank]
@@ -200,14 +214,14 @@ def branch_entry_tokens(graph: TaskGraph, edge_id: str, failure: str, owners: di
 
 
 def branch_edges(graph: TaskGraph, edge_id: str, failure: str, owners: dict[str, tuple[str, str]]) -> list[Edge]:
-    """The recovery edges one failure mode's branch brings (the conductor grounds them)."""
-    return [e for e in graph.recovery_edges() if owners.get(e.id) == (edge_id, failure)]
+    """The recovery edges one failure mode's branch brings, its other-arm alternatives aside (the conductor grounds them)."""
+    return [e for e in graph.recovery_edges() if e.alternative_to is None and owners.get(e.id) == (edge_id, failure)]
 
 
 def branch_nominal_nodes(graph: TaskGraph, edge_id: str, failure: str, owners: dict[str, tuple[str, str]]) -> set[str]:
     """The nominal nodes one failure mode's branch names (where it leaves and merges): the arranger reads them first."""
     nominal = {n.id for n in graph.nodes if not n.is_recovery}
-    edges = branch_edges(graph, edge_id, failure, owners)
+    edges = [*branch_edges(graph, edge_id, failure, owners), *branch_alternatives(graph, edge_id, failure, owners)]
     return {end for e in edges for end in (e.source, e.target) if end in nominal}
 
 

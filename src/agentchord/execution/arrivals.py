@@ -312,19 +312,20 @@ class PlanArrivals:
         self.waiting = Waiting(until, since, detection.edge_id, detection.failure.name, arrived, self.world.tick)
         return True
 
-    def _hurry(self, edge_id: str, failure: str | None) -> None:
+    def _hurry(self, edge_id: str, failure: str | None, recovery_edge: str | None = None) -> None:
         """Tell the planner what the robot now waits for: the branch of ``failure`` on ``edge_id`` (None: every
-        mode of the edge) goes first from this tick (:meth:`PlanSchedule.hurried`; a modelled schedule only)."""
+        mode of the edge), or the grounding of ``recovery_edge``, goes first from this tick
+        (:meth:`PlanSchedule.hurried`; a modelled schedule only)."""
         schedule = self.schedule
         if schedule is None or schedule.inputs is None:
             return
-        self.schedule = schedule.hurried(schedule.first_motion_s + self.world.tick / CONTROL_HZ, edge_id, failure)
+        self.schedule = schedule.hurried(schedule.first_motion_s + self.world.tick / CONTROL_HZ, edge_id, failure, recovery_edge)
         if self._early_armed is not None:  # the running edge's modes may come at another tick now
             listed = self._listed_tick(self._early_armed)
             self._rearm_tick = self.world.tick if listed is None else listed
         before = {(c.call.part, c.start_s) for c in schedule.calls}
         moved = [c.call.part for c in self.schedule.calls if (c.call.part, c.start_s) not in before]
-        self.trace.add(self.world.tick, "plan_hurried", edge=edge_id, failure=failure, moved=moved)
+        self.trace.add(self.world.tick, "plan_hurried", edge=recovery_edge or edge_id, failure=failure, moved=moved)
 
     def _early_arrival(self, program: EdgeProgram, arrive: Callable[[], tuple[bool, str] | None]) -> tuple[bool, str] | None | bool:
         """A nominal edge that ended at a node whose constraints do not hold, before its failure modes had
@@ -403,10 +404,16 @@ class PlanArrivals:
         return True
 
     def _wait_for_grounding(self, program: EdgeProgram) -> bool:
-        """Wait for an edge's grounding (nominal, or further on in a branch) if the robot reached its source first (True when it waits)."""
+        """Wait for an edge's grounding (nominal, further on in a branch, or an alternative a recovery bound)
+        if the robot needs it first (True when it waits). A recovery edge's is hurried."""
         until = self._tick_at(self.schedule.edge_ready_s.get(program.edge_id)) if self.schedule is not None else None
         if until is None:
             return False
+        if program.kind == "recovery":
+            self._hurry(program.edge_id, None, recovery_edge=program.edge_id)
+            until = self._tick_at(self.schedule.edge_ready_s.get(program.edge_id))
+            if until is None:
+                return False
         since = self.world.tick
 
         def arrived() -> tuple[bool, str] | None:

@@ -9,18 +9,20 @@ its first. The composer's reply streams in execution order (:func:`~agentchord.a
 as soon as an edge has streamed, the conductor grounds it, and once the node it reaches has too, the
 arranger is asked for its failure modes; per mode the arranger then writes its recovery branch, once
 the nominal nodes the branch leaves from and merges at have streamed too. The branch streams entry
-first: the conductor grounds the entry (and the other arm's way) as soon as it has streamed, the
-rest of the branch when the reply ends. The calls are served as the model allows (``concurrency`` at
-once), in the order the robot needs them: the edges' groundings, then edge k's modes and their
-branches before edge k+1's. The robot moves once the first edge is grounded; every other part
-arrives while it moves, as an event on the episode's clock (:class:`PlanSchedule`). An edge's
-monitors are armed once the arranger's list of its modes has arrived; a mode can be recovered from
-once its recovery entry has arrived grounded; an edge further on in a branch, like a nominal one, is
-waited for if the robot reaches it first.
+first: the conductor grounds the entry as soon as it has streamed, the rest of the branch when the
+reply ends. The other arm's way into a recovery (an arm-switching alternative, needed only when the
+entry's arm cannot reach what fell) is written last, in a call of its own per mode, and grounded
+after it. The calls are served as the model allows (``concurrency`` at once), in the order the robot
+needs them: the edges' groundings, then edge k's modes and their branches before edge k+1's, then
+the alternatives. The robot moves once the first edge is grounded; every other part arrives while
+it moves, as an event on the episode's clock (:class:`PlanSchedule`). An edge's monitors are armed
+once the arranger's list of its modes has arrived; a mode can be recovered from once its recovery
+entry has arrived grounded; an edge further on in a branch, like a nominal one, and an alternative
+the recovery binds are waited for if the robot needs them first.
 
 A failure that fires before its branch has arrived **hurries** it: from that moment the calls its
-branch still needs (the edge's list of modes, the branch, the grounding of its entry and of the
-entry's alternatives) go first whenever a slot frees, as a planner told what the robot waits for
+branch still needs (the edge's list of modes, the branch, the grounding of its entry) go first
+whenever a slot frees, as a planner told what the robot waits for
 would send them (:meth:`PlanSchedule.hurried`). Calls that started before stay as they were.
 
 Pure functions of a graph, a latency model and the hurries: the same inputs give the same schedule.
@@ -32,7 +34,9 @@ import math
 from dataclasses import dataclass, field
 
 from agentchord.agents.replies import (
+    alternatives_reply,
     augmentation_reply,
+    branch_alternatives,
     branch_edges,
     branch_entry,
     branch_entry_tokens,
@@ -48,7 +52,7 @@ from agentchord.agents.replies import (
 )
 from agentchord.execution.reasoning import AnyLatencyModel, ModelledCall
 from agentchord.graph.models import TaskGraph
-from agentchord.graph.progress import nominal_path, with_alternatives
+from agentchord.graph.progress import nominal_path
 from agentchord.worlds.protocol import CONTROL_HZ
 
 
@@ -108,16 +112,18 @@ class PlanSchedule:
         """The control tick (counted from the first motion) at which a part arriving at ``seconds`` is armed."""
         return max(0, math.ceil(round((seconds - self.first_motion_s) * CONTROL_HZ, 6)))
 
-    def hurried(self, at_s: float, edge_id: str, failure: str | None) -> PlanSchedule:
+    def hurried(self, at_s: float, edge_id: str, failure: str | None, recovery_edge: str | None = None) -> PlanSchedule:
         """The schedule once a failure of ``edge_id`` (``failure``, or None: which mode is not known yet)
         fired at ``at_s`` before its branch arrived: what that branch still needs goes first from then on.
+        With ``recovery_edge``: the robot waits for that recovery edge's grounding (an alternative it
+        bound, an edge further on in a branch), and what it still needs goes first.
 
         What started before ``at_s`` keeps its times; a schedule without inputs stays as it is.
         """
         if self.inputs is None:
             return self
         graph, latency = self.inputs
-        return pipelined_schedule(graph, latency, (*self.hurries, Hurry(at_s, edge_id, failure)))
+        return pipelined_schedule(graph, latency, (*self.hurries, Hurry(at_s, edge_id, failure, recovery_edge)))
 
     def branches_ready_s(self, edge_id: str) -> float:
         """When every failure mode of ``edge_id`` has arrived (its list, if it has none)."""
@@ -134,11 +140,14 @@ class Hurry:
         edge_id: The nominal edge it fired on.
         failure: Its failure mode; None for a monitor derived from the edge's constraints before the
             arranger listed the edge's modes (every mode of the edge is hurried then).
+        recovery_edge: A recovery edge the robot waits for instead (its grounding and what that reads are
+            hurried, not the modes' branches).
     """
 
     at_s: float
     edge_id: str
     failure: str | None = None
+    recovery_edge: str | None = None
 
 
 @dataclass
@@ -166,7 +175,8 @@ def pipelined_schedule(graph: TaskGraph, latency: AnyLatencyModel, hurries: tupl
 
     Calls, in the order the robot needs them: the nominal edges' groundings first (without them the
     robot cannot go on; without a branch it can), then edge by edge the list of its failure modes,
-    per mode its branch and the branch's grounding. A call starts when what it reads has arrived
+    per mode its branch and the branch's grounding; last, per mode, the other arm's alternatives and
+    their grounding. A call starts when what it reads has arrived
     (an edge's grounding the edge from the composer's stream; its modes the edge and its nodes; a
     branch also the nominal nodes it leaves from and merges at) and the model has a free slot (``latency.concurrency`` at once; the composer
     holds one while it streams); among the calls ready, the first in need goes first. A flat latency
@@ -221,6 +231,15 @@ def pipelined_schedule(graph: TaskGraph, latency: AnyLatencyModel, hurries: tupl
                 ground_key.update({e.id: f"rest:{mode}" for e in rest})
             ground_key.update({e.id: f"entry:{mode}" for e in first})
             ground_key[f"{edge_id}/{failure.name}"] = f"entry:{mode}"
+            # The other arm's way is needed only when the entry's arm cannot reach: written after every
+            # edge's own branches, in a call of its own that reads the entry.
+            alternatives = branch_alternatives(graph, edge_id, failure.name, owners)
+            if alternatives:
+                jobs.append(_Job(ModelledCall("arranger", "plan", count_tokens(alternatives_reply(graph, edge_id, failure.name, owners)),
+                                              part=f"{mode} alternatives"), (2, k, j, 0), f"alternatives:{mode}", after=f"branch:{mode}"))
+                jobs.append(_Job(ModelledCall("conductor", "plan", count_tokens(grounding_patch(alternatives)), part=f"{mode} alternatives grounded"),
+                                 (2, k, j, 1), f"alternatives grounded:{mode}", after=f"alternatives:{mode}"))
+                ground_key.update({e.id: f"alternatives grounded:{mode}" for e in alternatives})
     _hurry(jobs, hurries, graph, ground_key)
     done = _serve(jobs, latency, busy_until=[composer_end])
     ends = {job.key: job.end_s for job in done}
@@ -229,11 +248,11 @@ def pipelined_schedule(graph: TaskGraph, latency: AnyLatencyModel, hurries: tupl
         recovery_ready.setdefault(recovery.id, max(ends.values(), default=composer_end))
     modes: dict[tuple[str, str], float] = {}
     for edge, failure in graph.failures():
-        # A mode can be recovered from once its trigger and its recovery entry (with the entry's alternatives)
-        # have arrived grounded; an edge further on in the branch is waited for when the robot reaches it.
+        # A mode can be recovered from once its trigger and its recovery entry have arrived grounded; an edge
+        # further on in the branch, or the entry's alternative, is waited for when the robot is to start it.
         key = ground_key.get(f"{edge.id}/{failure.name}")
         own = ends[key] if key is not None else recovery_ready.get(edge.id, composer_end)
-        entries = [recovery_ready[e] for e in with_alternatives(graph, [failure.recovery]) if e in recovery_ready]
+        entries = [recovery_ready[failure.recovery]] if failure.recovery in recovery_ready else []
         modes[(edge.id, failure.name)] = max([own, *entries])
     calls = [ScheduledCall(composer, 0.0, composer_end)]
     calls += [ScheduledCall(job.call, job.start_s, job.end_s) for job in sorted(done, key=lambda j: (j.start_s, j.priority))]
@@ -246,16 +265,21 @@ def pipelined_schedule(graph: TaskGraph, latency: AnyLatencyModel, hurries: tupl
 
 def _hurry(jobs: list[_Job], hurries: tuple[Hurry, ...], graph: TaskGraph, ground_key: dict[str, str]) -> None:
     """Mark the calls each hurried branch still needs: the edge's list of modes, the branch, the grounding of
-    its entry and of the entry's alternatives (another mode's branch may bring one), and the calls they read."""
+    its entry (another mode's branch may bring it), and the calls they read. Not the entry's alternatives:
+    the robot needs one only if its arm cannot reach, which is known when the recovery binds."""
     by_key = {job.key: job for job in jobs}
     for hurry in hurries:
-        modes = [hurry.failure] if hurry.failure is not None else [f.name for f in graph.edge(hurry.edge_id).failures]
-        keys = [f"modes:{hurry.edge_id}"]
+        if hurry.recovery_edge is not None:
+            keys = [ground_key[hurry.recovery_edge]] if hurry.recovery_edge in ground_key else []
+            modes = []
+        else:
+            modes = [hurry.failure] if hurry.failure is not None else [f.name for f in graph.edge(hurry.edge_id).failures]
+            keys = [f"modes:{hurry.edge_id}"]
         for name in modes:
             keys.append(f"entry:{hurry.edge_id}/{name}")
             failure = next((f for f in graph.edge(hurry.edge_id).failures if f.name == name), None)
             if failure is not None:
-                keys += [ground_key[e] for e in with_alternatives(graph, [failure.recovery]) if e in ground_key]
+                keys += [ground_key[failure.recovery]] if failure.recovery in ground_key else []
         while keys:
             job = by_key.get(keys.pop())
             if job is None or (job.hurried_s is not None and job.hurried_s <= hurry.at_s):

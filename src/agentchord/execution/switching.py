@@ -76,6 +76,7 @@ class RecoverySwitching:
     as_arranged: Callable[[Detection], Detection]
     _early_program_failure: Callable[[], bool]
     modes_unknown: Callable[[str], bool]
+    _wait_for_grounding: Callable[[EdgeProgram], bool]
 
     def _beyond_every_arm(self, obj: str, confirm_ik: bool) -> tuple[bool, str] | None:
         """The unrecoverable outcome when no arm can take ``obj`` where it is (else None)."""
@@ -138,8 +139,10 @@ class RecoverySwitching:
             if not problems:
                 self.trace.add(self.world.tick, "recovery_bound", edge=candidate.edge_id, waited_ticks=waited,
                                refused=refused, arms=sorted({a.arm for step in candidate.steps for a in step}))
-                self._start(candidate)
-                self._fallbacks = binding.candidates[k + 1:]  # not started yet: still fresh programs
+                # A pipelined plan's alternative (the other arm's way) may not have arrived: the arms hold still for it.
+                if not self._wait_for_grounding(candidate):
+                    self._start(candidate)
+                    self._fallbacks = binding.candidates[k + 1:]  # not started yet: still fresh programs
                 return None
             refused.append({"edge": candidate.edge_id, "reason": "; ".join(p.reason for p in problems)})
         summary = "; ".join(f"{r['edge']}: {r['reason']}" for r in refused)
@@ -258,11 +261,21 @@ class RecoverySwitching:
         """
         if self.modes_unknown(edge_id):
             return None  # its failure modes have not arrived
-        violated = {" ".join(c.source.split()): c.scalar(self.frame) for c in self.constraints[node_id]
-                     if c.scalar(self.frame) > 0.0}
+        broken = [c for c in self.constraints[node_id] if c.scalar(self.frame) > 0.0]
+        violated = {" ".join(c.source.split()): c.scalar(self.frame) for c in broken}
+        read = frozenset().union(*(c.objects for c in broken))
+        compiled = {m.failure.name: m for m in self.monitors[edge_id].monitors} if edge_id in self.monitors else {}
+        # In the arranger's order, the first mode that watches what broke: its monitor names a violated
+        # constraint, or reads the scene alone (no hand), reads an object a violated constraint reads and
+        # is violated now. The second takes a mode listed first for a worse state (both towel corners
+        # off, before either one) whose monitor spells the constraints differently.
         for failure in self.graph.edge(edge_id).failures:
             monitor = " ".join(failure.monitor.split())
             watched = [value for source, value in violated.items() if source in monitor]
+            scene = compiled.get(failure.name)
+            if not watched and scene is not None and not scene.expr.arms and scene.expr.objects & read:
+                value = scene.expr.scalar(self.frame)
+                watched = [value] if value > failure.margin else []
             if watched:
                 self.trace.add(self.world.tick, "violation_at_merge", node=node_id, edge=edge_id, failure=failure.name)
                 return Detection(edge_id, failure, self.world.tick, self.world.tick, float(watched[0]))
