@@ -193,7 +193,7 @@ def branch_reply(graph: TaskGraph, edge_id: str, failure: str, owners: dict[str,
     key = (edge_id, failure)
     first = branch_entry(graph, edge_id, failure, owners)
     rank = {item: k for k, item in enumerate(first)}
-    edges = sorted((e for e in branch_edges(graph, edge_id, failure, owners)), key=lambda e: rank.get(e.id, len(rank)))
+    edges = sorted(branch_edges(graph, edge_id, failure, owners), key=lambda e: rank.get(e.id, len(rank)))
     nodes = sorted((n for n in graph.recovery_nodes() if owners.get(n.id) == key), key=lambda n: rank.get(n.id, len(rank)))
     entry_edges = [e for e in edges if e.id in rank]
     entry_nodes = [n for n in nodes if n.id in rank]

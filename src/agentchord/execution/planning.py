@@ -269,9 +269,8 @@ def _hurry(jobs: list[_Job], hurries: tuple[Hurry, ...], graph: TaskGraph, groun
     the robot needs one only if its arm cannot reach, which is known when the recovery binds."""
     by_key = {job.key: job for job in jobs}
     for hurry in hurries:
-        if hurry.recovery_edge is not None:
-            keys = [ground_key[hurry.recovery_edge]] if hurry.recovery_edge in ground_key else []
-            modes = []
+        if hurry.recovery_edge is not None:  # a recovery edge's grounding, not a mode's branch
+            modes, keys = [], [ground_key[hurry.recovery_edge]] if hurry.recovery_edge in ground_key else []
         else:
             modes = [hurry.failure] if hurry.failure is not None else [f.name for f in graph.edge(hurry.edge_id).failures]
             keys = [f"modes:{hurry.edge_id}"]

@@ -261,9 +261,10 @@ class RecoverySwitching:
         """
         if self.modes_unknown(edge_id):
             return None  # its failure modes have not arrived
-        broken = [c for c in self.constraints[node_id] if c.scalar(self.frame) > 0.0]
-        violated = {" ".join(c.source.split()): c.scalar(self.frame) for c in broken}
-        read = frozenset().union(*(c.objects for c in broken))
+        values = [(c, c.scalar(self.frame)) for c in self.constraints[node_id]]
+        broken = [(c, value) for c, value in values if value > 0.0]
+        violated = {" ".join(c.source.split()): value for c, value in broken}
+        read = frozenset().union(*(c.objects for c, _ in broken))
         compiled = {m.failure.name: m for m in self.monitors[edge_id].monitors} if edge_id in self.monitors else {}
         # In the arranger's order, the first mode that watches what broke: its monitor names a violated
         # constraint, or reads the scene alone (no hand), reads an object a violated constraint reads and
