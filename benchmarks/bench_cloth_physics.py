@@ -17,6 +17,16 @@ Variants (``--variants`` takes a comma-separated subset):
 - ``dt-4ms`` / ``dt-5ms``: a longer physics step (5 or 4 substeps a tick).
 - ``dt-4ms-noslip-touch``: both.
 - ``grid-5``: a 5 x 5 grid (75 degrees of freedom).
+- ``pyramidal``: pyramidal friction cones instead of elliptic ones (the noslip pass stays).
+- ``cg``: the conjugate-gradient solver instead of Newton (the same problem, solved to the same
+  tolerance, within the same 100 iterations).
+- ``pyramidal-cg``, ``pyramidal-dt-4ms``, ``pyramidal-cg-dt-4ms``: combinations.
+
+Two cheaper pinches MuJoCo 3.8 does not offer a flex, so they are not variants: an ``adhesion``
+actuator on the finger bodies pulls on geom contacts only (on the cloth's it applies no force),
+and sleeping islands (``mjENBL_SLEEP``) stop with "flex equality does not yet support sleeping".
+``--probes`` checks both on the installed MuJoCo (a pad pressed on a box, then on a cloth, and
+lifted with its adhesion on; a resting cloth stepped with sleeping on) and prints what it found.
 """
 
 from __future__ import annotations
@@ -30,6 +40,7 @@ from dataclasses import dataclass
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
+import mujoco
 from rich.console import Console
 from rich.table import Table
 
@@ -49,6 +60,8 @@ class Variant:
     noslip: int | None = None
     noslip_on_touch: bool = False
     grid: tuple[int, int] | None = None
+    cone: str | None = None
+    solver: str | None = None
 
 
 VARIANTS = {
@@ -59,6 +72,11 @@ VARIANTS = {
     "dt-5ms": Variant(timestep=0.005),
     "dt-4ms-noslip-touch": Variant(timestep=0.004, noslip_on_touch=True),
     "grid-5": Variant(grid=(5, 5)),
+    "pyramidal": Variant(cone="pyramidal"),
+    "cg": Variant(solver="cg"),
+    "pyramidal-cg": Variant(cone="pyramidal", solver="cg"),
+    "pyramidal-dt-4ms": Variant(cone="pyramidal", timestep=0.004),
+    "pyramidal-cg-dt-4ms": Variant(cone="pyramidal", solver="cg", timestep=0.004),
 }
 
 
@@ -73,6 +91,10 @@ def towel_physics(variant: Variant) -> Iterator[None]:
         init(world, scene, *args, **kwargs)
         if scene.cloth is not None and variant.noslip is not None:
             world.model.opt.noslip_iterations = variant.noslip
+        if scene.cloth is not None and variant.cone is not None:
+            world.model.opt.cone = getattr(mujoco.mjtCone, f"mjCONE_{variant.cone.upper()}")
+        if scene.cloth is not None and variant.solver is not None:
+            world.model.opt.solver = getattr(mujoco.mjtSolver, f"mjSOL_{variant.solver.upper()}")
 
     def touch_step(world):
         if world.scene.cloth is not None:
@@ -103,13 +125,70 @@ def run_variant(variant: Variant, seeds: list[int], protocol: str | None) -> dic
                 failed.append(f"{seed}: {result.reason[:70]}")
     return {"success": len(seeds) - len(failed), "speed": statistics.median(speeds), "failed": failed}
 
+#: A pad on a vertical slide, pressed down and lifted, with an adhesion actuator on its body; under
+#: it either a thin box or a small flex cloth (the towel's contact settings).
+_PROBE_XML = """<mujoco><option timestep="0.002" cone="elliptic"/>
+<worldbody><geom type="plane" size="1 1 .1"/>
+<body name="pad" pos="0 0 0.03"><joint name="z" type="slide" axis="0 0 1"/>
+<geom type="box" size=".02 .02 .005" mass=".1"/></body>{under}</worldbody>
+<actuator><position joint="z" kp="400" kv="40"/><adhesion body="pad" ctrlrange="0 1" gain="5"/></actuator></mujoco>"""
+_PROBE_BOX = '<body name="box" pos="0 0 0.006"><freejoint/><geom type="box" size=".03 .03 .005" mass=".02"/></body>'
+_PROBE_CLOTH = """<flexcomp name="cloth" type="grid" count="5 5 1" spacing=".03 .03 .03" pos="0 0 0.005" radius="0.004"
+dim="2" mass="0.02"><contact condim="3" friction="1.5 0.005 0.0001" selfcollide="none"/>
+<edge equality="true" damping="0.01"/></flexcomp>"""
+
+
+def probe_adhesion(under: str, adhesion: float = 1.0) -> float:
+    """How high (m) the pad lifts what lies under it (``box`` or ``cloth``): its centre's height after the lift."""
+    model = mujoco.MjModel.from_xml_string(_PROBE_XML.format(under=_PROBE_BOX if under == "box" else _PROBE_CLOTH))
+    data = mujoco.MjData(model)
+    data.ctrl[:] = (-0.02, adhesion)  # pressed on it
+    for _ in range(400):
+        mujoco.mj_step(model, data)
+    data.ctrl[0] = 0.06  # lifted 8 cm
+    for _ in range(400):
+        mujoco.mj_step(model, data)
+    if under == "box":
+        return float(data.xpos[model.body("box").id][2])
+    return float(data.flexvert_xpos[12][2])  # the cloth's centre vertex
+
+
+def probe_sleep() -> str:
+    """What stepping a resting flex cloth with sleeping enabled does: ``sleeps`` or MuJoCo's error."""
+    model = mujoco.MjModel.from_xml_string(_PROBE_XML.format(under=_PROBE_CLOTH))
+    model.opt.enableflags |= mujoco.mjtEnableBit.mjENBL_SLEEP
+    data = mujoco.MjData(model)
+    try:
+        for _ in range(200):
+            mujoco.mj_step(model, data)
+    except mujoco.FatalError as error:
+        return str(error)
+    return "sleeps"
+
+
+def print_probes() -> None:
+    """Whether the installed MuJoCo offers a pinch that holds a cloth without the noslip pass."""
+    table = Table(title=f"MuJoCo {mujoco.__version__}: a cloth pinch without the noslip pass")
+    for column in ("probe", "found"):
+        table.add_column(column)
+    for under in ("box", "cloth"):
+        for adhesion in (0.0, 1.0):
+            found = f"{100 * probe_adhesion(under, adhesion):.1f} cm"
+            table.add_row(f"pad lifted 8 cm, adhesion {'on' if adhesion else 'off'}: height of the {under}", found)
+    table.add_row("a resting flex with sleeping on", probe_sleep())
+    Console().print(table)
+
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--seeds", default="0,1,2", help="comma-separated seeds")
     parser.add_argument("--protocols", default="none,real", help="comma-separated: none, real, stress")
     parser.add_argument("--variants", default="all", help=f"comma-separated: {', '.join(VARIANTS)}")
+    parser.add_argument("--probes", action="store_true", help="only check MuJoCo's adhesion and sleeping on a flex")
     args = parser.parse_args()
+    if args.probes:
+        print_probes()
+        return
     seeds = [int(s) for s in args.seeds.split(",")]
     names = list(VARIANTS) if args.variants == "all" else args.variants.split(",")
     unknown = [n for n in names if n not in VARIANTS]
