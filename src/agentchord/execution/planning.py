@@ -137,7 +137,7 @@ class Hurry:
 
     Attributes:
         at_s: When it fired (seconds from the start of planning).
-        edge_id: The nominal edge it fired on.
+        edge_id: The nominal edge it fired on; with ``recovery_edge``, that recovery edge itself.
         failure: Its failure mode; None for a monitor derived from the edge's constraints before the
             arranger listed the edge's modes (every mode of the edge is hurried then).
         recovery_edge: A recovery edge the robot waits for instead (its grounding and what that reads are
