@@ -125,8 +125,9 @@ def run_variant(variant: Variant, seeds: list[int], protocol: str | None) -> dic
                 failed.append(f"{seed}: {result.reason[:70]}")
     return {"success": len(seeds) - len(failed), "speed": statistics.median(speeds), "failed": failed}
 
+
 #: A pad on a vertical slide, pressed down and lifted, with an adhesion actuator on its body; under
-#: it either a thin box or a small flex cloth (the towel's contact settings).
+#: it either a thin box or a small flex cloth (with the towel's contact dimension and friction).
 _PROBE_XML = """<mujoco><option timestep="0.002" cone="elliptic"/>
 <worldbody><geom type="plane" size="1 1 .1"/>
 <body name="pad" pos="0 0 0.03"><joint name="z" type="slide" axis="0 0 1"/>
