@@ -24,6 +24,7 @@ from agentchord.agents.llm.sizes import prompt_size
 from agentchord.agents.observe import observe, task_regions
 from agentchord.agents.pipeline import plan_task
 from agentchord.agents.reasoner import ArrangeRequest, ComposeRequest, ConductRequest
+from agentchord.episode import planned_success
 from agentchord.graph.loader import dump_graph, load_graph
 from agentchord.graph.models import Success, TaskGraph
 from agentchord.sim.tasks import SIM_TASKS
@@ -53,7 +54,8 @@ def plan_case(name: str, record: bool = False) -> tuple[TaskGraph, list]:
     config = LlmConfig(base_url="http://fixture.invalid/v1", model="fixture", api_key="none", max_repairs=3)
     reasoner = LlmReasoner(config, client=FixtureClient(book))
     result = plan_task(case.instruction, scene, reasoner, task=case.task)
-    graph = result.graph
+    # Judged as `plan` judges it: by the goal the composer stated, unless the instruction is the task's own.
+    graph = planned_success(result.graph, case.task, reasoner.last_goal, scene)
     if case.goal is not None:
         graph = graph.model_copy(update={"success": Success(judge="goal", goal_spec=case.goal)})
     return graph, result.calls

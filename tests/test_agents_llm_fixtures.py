@@ -12,7 +12,7 @@ import yaml
 from click.testing import CliRunner
 from replay_server import Completion, HttpError, ReplayServer
 
-from agentchord.agents import ComposeRequest, Scene, SceneObject
+from agentchord.agents import ArrangeRequest, ComposeRequest, ConductRequest, Scene, SceneObject
 from agentchord.agents.llm import request_message, scene_json, system_prompt
 from agentchord.agents.llm.fixtures import (
     FixtureBook,
@@ -23,10 +23,11 @@ from agentchord.agents.llm.fixtures import (
     request_digest,
 )
 from agentchord.agents.llm.sizes import estimate_tokens, prompt_size
-from agentchord.agents.llm.skills import SkillNotesError, parse_skill_notes, select_notes, skill_notes
+from agentchord.agents.llm.skills import SkillNotesError, graph_features, parse_skill_notes, select_notes, skill_notes
 from agentchord.agents.scene import ArmState, Region
 from agentchord.cli import main
 from agentchord.graph.loader import load_graph
+from agentchord.graph.models import TaskGraph
 
 CASES_DIR = Path(__file__).parent / "data" / "llm"
 CASES = sorted(p.name for p in CASES_DIR.iterdir() if (p / "case.yaml").is_file())
@@ -91,9 +92,43 @@ def test_skill_notes_follow_the_request():
     assert "# Skill notes" not in system_prompt("composer")
 
 
+def _handover_graph(giver: str, receiver: str) -> TaskGraph:
+    """A nominal hand-over of the block from ``giver`` to ``receiver``, then a place."""
+    def step(arm: str, fn: str, **args) -> dict:
+        return {arm: {"fn": fn, "args": args}}
+    edges = [
+        step(giver, "grasp", obj="block", mode="side", height=0.85),
+        step(giver, "move_to_target", pos=[0.0, 0.5, 0.25]),
+        step(receiver, "grasp", obj="block", mode="side", height=0.2, lift=0.0),
+        step(giver, "open_gripper"),
+        step(receiver, "place", obj="block", target=[0.0, 0.45]),
+    ]
+    return TaskGraph.model_validate({
+        "task": "t", "start": "v0", "goal": f"v{len(edges)}", "objects": ["block"],
+        "nodes": [{"id": f"v{i}", "semantic": f"s{i}"} for i in range(len(edges) + 1)],
+        "edges": [{"id": f"e{i + 1}", "source": f"v{i}", "target": f"v{i + 1}", "actions": a} for i, a in enumerate(edges)],
+    })
+
+
+def test_arranger_and_conductor_notes_follow_what_the_graph_does():
+    scene = Scene(objects=[SceneObject(name="block", pos=(0.1, 0.5, 0.1), extent=(0.04, 0.04, 0.2))])
+    for giver, receiver in (("left", "right"), ("right", "left")):
+        graph = _handover_graph(giver, receiver)
+        assert graph_features(graph, scene) == {"handover"}
+        assert {n.name for n in select_notes(ArrangeRequest(graph=graph, scene=scene))} == {"handover"}
+    # The words of the instruction do not choose the arranger's notes: the graph does.
+    graph = _handover_graph("right", "left").model_copy(update={"instruction": "Pour the block beside the tray."})
+    assert {n.name for n in select_notes(ConductRequest(graph=graph, scene=scene))} == {"handover"}
+    # The note is written for either giver.
+    text = next(n for n in skill_notes() if n.name == "handover").text("arranger")
+    assert "holding(left" not in text and "right.closed" not in text
+
+
 def test_every_note_is_selectable_and_malformed_notes_are_named():
-    assert {note.name for note in skill_notes()} >= {"handover", "two_arm_carry", "cloth", "beside", "inside", "pouring", "regions"}
-    assert all(note.when for note in skill_notes())
+    assert {note.name for note in skill_notes()} >= {"handover", "two_arm_carry", "cloth", "placement", "thin_flat", "inside", "pouring", "regions"}
+    assert all(note.when and note.does for note in skill_notes())
+    with pytest.raises(SkillNotesError, match="unknown Does: juggling"):
+        parse_skill_notes("## x\nWhen: y\nDoes: juggling\nTitle: X\n\ntext\n")
     with pytest.raises(SkillNotesError, match="section 'x': expected a When: line"):
         parse_skill_notes("## x\nTitle: X\n\ntext\n")
     with pytest.raises(SkillNotesError, match=r"unknown agent tag \[planner\]"):

@@ -19,12 +19,12 @@ from agentchord.execution.reasoning import ReasoningConfig
 from agentchord.execution.repair import Repairer
 from agentchord.execution.result import EpisodeResult
 from agentchord.graph.grounding import require_runnable
-from agentchord.graph.models import TaskGraph
+from agentchord.graph.models import Success, TaskGraph
 from agentchord.library import load_task_graph
 from agentchord.worlds.protocol import World
 from agentchord.worlds.remote import RemoteWorld
 from agentchord.sim.disturbances import schedule
-from agentchord.sim.tasks import SIM_TASKS, judge_by_goal
+from agentchord.sim.tasks import SIM_TASKS, GoalTracker, judge_by_goal
 from agentchord.sim.trial import open_world
 
 
@@ -183,7 +183,8 @@ def planned_goal_tracker(task_name: str, goal: GoalSpec | None, graph: TaskGraph
 
     A task with no fixed goal (``blocks_and_cup``) judges the goal it was planned for. A paper
     task keeps its own check (the pour event, the handover to its target region) when the
-    planned goal has the same outcome as the task's own instruction, read in the same scene;
+    plan's instruction is the task's own, or the planned goal has the same outcome as the
+    task's own instruction read in the same scene;
     a new combination in its scene (the bottle handed over, the block set on a side of the
     table) is judged by its planned goal instead, not reported as a failure of the paper's task.
     """
@@ -194,9 +195,31 @@ def planned_goal_tracker(task_name: str, goal: GoalSpec | None, graph: TaskGraph
     if hasattr(tracker, "expect"):
         tracker.expect(goal, constraints, regions)
         return tracker
-    if goal is None or goal.outcome() == _own_goal_outcome(task_name, scene):
+    if goal is None or _is_own_instruction(task_name, graph.instruction) or goal.outcome() == _own_goal_outcome(task_name, scene):
         return tracker
     return judge_by_goal(goal, constraints, regions)
+
+
+def planned_success(graph: TaskGraph, task: str, goal: GoalSpec | None, scene: Scene) -> TaskGraph:
+    """``graph`` saying what success means for it (its ``success``), as the run of a planned graph judges it.
+
+    The same choice as ``run --instruction`` makes (:func:`planned_goal_tracker`): the task's own
+    instruction, or a goal with its outcome, keeps the task's check; any other goal (the bottle
+    handed over in the pour scene, a hand-over the other way) is judged by its goal spec and the
+    goal node's constraints.
+    """
+    own_goal = isinstance(planned_goal_tracker(task, goal, graph, scene), GoalTracker)
+    spec = goal.model_dump(mode="json") if goal is not None and own_goal else None
+    return graph.model_copy(update={"success": Success(judge="goal" if own_goal else "task", goal_spec=spec)})
+
+
+def _is_own_instruction(task_name: str, instruction: str) -> bool:
+    """Whether ``instruction`` is the task library's own for ``task_name`` (case and spacing aside)."""
+    try:
+        own = load_task_graph(task_name).instruction
+    except KeyError:
+        return False
+    return " ".join(own.lower().split()) == " ".join(instruction.lower().split()) != ""
 
 
 def _own_goal_outcome(task_name: str, scene: Scene) -> frozenset | None:

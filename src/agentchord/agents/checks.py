@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
+from agentchord.agents.reach_check import reach_problems
 from agentchord.agents.reasoner import AgentRequest, ArrangeRequest, ComposeRequest, ConductRequest
 from agentchord.agents.scene import Scene
 from agentchord.graph.models import TaskGraph
@@ -16,13 +17,17 @@ def check_reply(request: AgentRequest, graph: TaskGraph) -> list[Problem]:
     The checks of ``graph check`` (:func:`check_graph`), then the agent's own:
 
     - composer: a nominal graph only (no failure modes, no recovery nodes or
-      edges); every graph object is a scene object.
-    - arranger: start, goal and every nominal node and edge of the input kept
-      (edge endpoints and actions unchanged); everything added is ``kind:
+      edges); every graph object is a scene object; every grasp and place within
+      its arm's reach (:mod:`agentchord.agents.reach_check`). The goal it states
+      in ``success.goal_spec`` is checked by the reasoner that reads it (an LLM's:
+      :func:`agentchord.agents.rules.feasibility.stated_goal_problems`).
+    - arranger: start, goal, success and every nominal node and edge of the input
+      kept (edge endpoints and actions unchanged); everything added is ``kind:
       recovery``; every graph object is a scene object.
     - conductor: the input's structure kept: the same node ids and kinds, the
       same edges with the same endpoints and kinds, the same failure modes per
-      edge with the same recovery entry edges.
+      edge with the same recovery entry edges, the same success; every nominal
+      grasp and place, as grounded, within its arm's reach.
 
     Args:
         request: What the agent was asked.
@@ -32,14 +37,24 @@ def check_reply(request: AgentRequest, graph: TaskGraph) -> list[Problem]:
     if isinstance(request, ComposeRequest):
         problems += _check_nominal_only(graph)
         problems += _check_scene_objects(graph, request.scene)
+        problems += reach_problems(graph, request.scene)
     elif isinstance(request, ArrangeRequest):
         problems += _check_keeps_nominal(request.graph, graph)
+        problems += _check_keeps_success(request.graph, graph)
         problems += _check_scene_objects(graph, request.scene)
     elif isinstance(request, ConductRequest):
         problems += _check_keeps_structure(request.graph, graph)
+        problems += _check_keeps_success(request.graph, graph)
+        problems += reach_problems(graph, request.scene)
     else:  # pragma: no cover - guarded by the type
         raise TypeError(f"expected a ComposeRequest, ArrangeRequest or ConductRequest, got {type(request).__name__}")
     return problems
+
+
+def _check_keeps_success(before: TaskGraph, after: TaskGraph) -> list[Problem]:
+    if after.success == before.success:
+        return []
+    return [Problem("success", "must stay as the input states it (the composer's goal); copy it unchanged")]
 
 
 def _check_nominal_only(graph: TaskGraph) -> list[Problem]:

@@ -8,6 +8,7 @@ from typing import Any
 from pydantic import BaseModel, ConfigDict, Field
 
 from agentchord.features.frame import UP, FeatureFrame
+from agentchord.solvers.reach import BASE, SIDE_REACH, TOP_REACH, table_distance
 
 Vec3 = tuple[float, float, float]
 Vec4 = tuple[float, float, float, float]
@@ -27,6 +28,8 @@ class SceneObject(_Model):
         quat: Orientation (w, x, y, z).
         axis: Unit principal axis (bottom to top for an upright object).
         extent: Full size along the object's principal axes.
+        reachable_by: The arms that can grasp it where it lies (:func:`arms_reaching`); ``None``
+            when not computed.
     """
 
     name: str
@@ -35,6 +38,7 @@ class SceneObject(_Model):
     quat: Vec4 = (1.0, 0.0, 0.0, 0.0)
     axis: Vec3 = (0.0, 0.0, 1.0)
     extent: Vec3
+    reachable_by: list[str] | None = None
 
 
 class ArmState(_Model):
@@ -48,6 +52,10 @@ class ArmState(_Model):
         holding: Name of the object in the gripper, if any.
         home: Whether the arm is at its home pose (false in an observation taken mid-task
             with the arm elsewhere: a plan that ends at home sends it back).
+        base: Where the arm's base stands on the table plane (x, y).
+        reach_top: How far (m, horizontally from ``base``) the arm reaches a point on the table
+            from above: a top grasp, or setting an object down.
+        reach_side: How far it reaches with a side grasp of a tall object (tool level).
     """
 
     name: str
@@ -56,6 +64,9 @@ class ArmState(_Model):
     closed: bool = False
     holding: str | None = None
     home: bool = True
+    base: tuple[float, float] | None = None
+    reach_top: float | None = None
+    reach_side: float | None = None
 
 
 class Region(_Model):
@@ -125,12 +136,14 @@ class Scene(_Model):
                 quat=r(feats.quat),
                 axis=r(feats.axis if feats.axis is not None else UP),
                 extent=r(feats.extent),
+                reachable_by=arms_reaching(feats.pos, feats.extent, [a for a in frame.arms if a in BASE]),
             )
             for name, feats in frame.objects.items()
         ]
         arms = []
         for name, arm in frame.arms.items():
             held = [obj for (a, obj) in sorted(frame.holding) if a == name]
+            reach = {"base": BASE[name], "reach_top": TOP_REACH, "reach_side": SIDE_REACH} if name in BASE else {}
             arms.append(
                 ArmState(
                     name=name,
@@ -138,6 +151,23 @@ class Scene(_Model):
                     width=round(float(arm.width), decimals),
                     closed=bool(arm.closed),
                     holding=held[0] if held else None,
+                    **reach,
                 )
             )
         return cls(objects=objects, arms=arms, regions=list(regions), notes=notes)
+
+
+#: An object at least this tall (m) is taken with a side grasp, which reaches farther than a top one.
+SIDE_GRASP_HEIGHT = 0.08
+
+
+def grasp_reach(extent: Iterable[float]) -> float:
+    """How far (m, from an arm's base) an arm reaches to grasp an object of this size on the table."""
+    return SIDE_REACH if max(list(extent)[2:3] or [0.0]) >= SIDE_GRASP_HEIGHT else TOP_REACH
+
+
+def arms_reaching(pos: Iterable[float], extent: Iterable[float], arms: Iterable[str] = tuple(BASE)) -> list[str]:
+    """The arms that can grasp an object of ``extent`` lying at ``pos`` (its centre), by the measured reach."""
+    x, y = list(pos)[:2]
+    limit = grasp_reach(extent)
+    return [arm for arm in arms if table_distance(arm, (x, y)) <= limit]

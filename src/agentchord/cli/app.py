@@ -115,6 +115,7 @@ def plan(instruction, task, seed, goal_path, reasoner, perception, output, rende
     from agentchord.agents.exceptions import ReasonerError
     from agentchord.agents.observe import observe, task_regions
     from agentchord.agents.pipeline import make_reasoner, plan_task
+    from agentchord.episode import planned_success
     from agentchord.execution.trace import Trace
     from agentchord.graph.loader import dump_graph
     from agentchord.sim.tasks import SIM_TASKS
@@ -138,7 +139,7 @@ def plan(instruction, task, seed, goal_path, reasoner, perception, output, rende
     except ReasonerError as exc:
         raise click.UsageError(str(exc) + failed_calls_trace(exc, trace_path)) from exc
     console = Console()
-    graph = _with_success(result.graph, task, goal or getattr(agent, "last_goal", None), scene)
+    graph = planned_success(result.graph, task, goal or getattr(agent, "last_goal", None), scene)
     dump_graph(graph, output)
     modes = sum(len(e.failures) for e in graph.edges)
     console.print(f"[bold]{task}[/bold] (seed {seed}): {len(result.nominal.edges)} nominal edges, {modes} failure modes, "
@@ -159,22 +160,6 @@ def plan(instruction, task, seed, goal_path, reasoner, perception, output, rende
         for call in result.calls:
             trace.add(0, "reasoner_call", **call.to_trace_event())
         console.print(f"trace: {trace.write(trace_path)}")
-
-
-def _with_success(graph, task: str, goal, scene):
-    """``graph`` saying what success means for it: its own goal where the run of a planned graph judges that.
-
-    The same choice as ``run --instruction`` makes (``planned_goal_tracker``): a goal with the task's
-    own outcome keeps the task's check; another one (the bottle handed over in the pour scene) is
-    judged by its goal spec and the goal node's constraints.
-    """
-    from agentchord.episode import planned_goal_tracker
-    from agentchord.graph.models import Success
-    from agentchord.sim.tasks import GoalTracker
-
-    own_goal = isinstance(planned_goal_tracker(task, goal, graph, scene), GoalTracker)
-    spec = goal.model_dump(mode="json") if goal is not None and own_goal else None
-    return graph.model_copy(update={"success": Success(judge="goal" if own_goal else "task", goal_spec=spec)})
 
 
 def _check_plan_outputs(output, render_path, trace_path, goal_path=None) -> None:

@@ -51,14 +51,17 @@ def _load_or_exit(path: Path) -> TaskGraph:
 
 @graph_group.command("check")
 @click.argument("files", nargs=-1, required=True, type=click.Path(dir_okay=False, path_type=Path))
-@click.option("--task", "task", default=None, help="Also check the graph's objects against this simulated task's scene.")
-def check_command(files: tuple[Path, ...], task: str | None) -> None:
+@click.option("--task", "task", default=None, help="Also check the graph against this simulated task's scene: its objects, and each arm's reach.")
+@click.option("--seed", type=click.IntRange(0), default=0, show_default=True, help="Seed of the task's scene (with --task).")
+def check_command(files: tuple[Path, ...], task: str | None, seed: int) -> None:
     """Validate graph FILES: print one line per problem, exit 2 if any.
 
     A valid file prints ``FILE: ok (N nodes, M edges, K failure modes)``. With ``--task``,
-    each graph must also name only objects of that task's scene (as ``run`` requires).
+    each graph must also name only objects of that task's scene (as ``run`` requires), and
+    every nominal grasp and place must lie within the reach of its arm in the scene of
+    ``--seed`` (the message names the edge, the arm, how far, and what would do instead).
     """
-    scene = _scene_objects(task) if task is not None else None
+    names, scene = _task_scene(task, seed) if task is not None else ([], None)
     failed = False
     for path in files:
         try:
@@ -66,7 +69,12 @@ def check_command(files: tuple[Path, ...], task: str | None) -> None:
         except GraphFileError as error:
             problems = error.problems
         else:
-            found = check_graph(graph) + (check_scene(graph, scene, task) if scene is not None else [])
+            found = check_graph(graph)
+            if scene is not None:
+                from agentchord.agents.reach_check import reach_problems
+
+                found += check_scene(graph, names, task)
+                found += reach_problems(graph, scene) if not found else []
             problems = [f"{path}: {problem}" for problem in found]
         if problems:
             failed = True
@@ -79,15 +87,16 @@ def check_command(files: tuple[Path, ...], task: str | None) -> None:
     sys.exit(EXIT_BAD_INPUT if failed else 0)
 
 
-def _scene_objects(task: str) -> list[str]:
-    """The names the feature frame of ``task``'s scene holds (objects, cloth points)."""
+def _task_scene(task: str, seed: int):
+    """The names the feature frame of ``task``'s scene holds (objects, cloth points), and the scene the agents see."""
+    from agentchord.agents.observe import observe, task_regions
     from agentchord.sim.tasks import SIM_TASKS
     from agentchord.sim.trial import open_world
 
     if task not in SIM_TASKS:
         raise click.BadParameter(f"unknown task {task!r} (tasks: {', '.join(SIM_TASKS)})", param_hint="--task")
-    world = open_world(task, 0)
-    return [*world.object_names, *world.cloth_point_names]
+    world = open_world(task, seed)
+    return [*world.object_names, *world.cloth_point_names], observe(world, task_regions(SIM_TASKS[task]))
 
 
 @graph_group.command("render")

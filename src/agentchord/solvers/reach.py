@@ -65,6 +65,53 @@ class ReachModel:
         return bool(self.slack(point) >= 0.0)
 
 
+#: Where each arm's base stands on the table plane (x, y), m: the waist axis, under the shoulder pivot.
+BASE = MappingProxyType({arm: (shoulder[0], shoulder[1]) for arm, shoulder in SHOULDER.items()})
+#: Horizontal distance (m) from an arm's base within which it reaches a point on the table from
+#: above (a top grasp, or setting an object down), tool 3-10 cm above the table. Measured with
+#: ``measure_table_reach``: every top-down pose from 0.10 to 0.58-0.60 m out was reached, at every
+#: azimuth tried (-60 to 60 degrees from straight ahead); 2 cm kept in hand.
+TOP_REACH = 0.58
+#: The same for a side grasp (tool level, approaching away from the base): 0.76-0.78 m measured.
+SIDE_REACH = 0.74
+
+
+def table_distance(arm: str, xy: tuple[float, float] | np.ndarray) -> float:
+    """Horizontal distance (m) of a table point from ``arm``'s base."""
+    bx, by = BASE[arm]
+    return float(np.hypot(float(xy[0]) - bx, float(xy[1]) - by))
+
+
+def measure_table_reach(arm: str, kind: str = "top", heights: tuple[float, ...] = (0.03, 0.06, 0.1),
+                        azimuths_deg: tuple[float, ...] = (-60, -30, 0, 30, 60)) -> float:
+    """The farthest horizontal distance (m) from ``arm``'s base at which the IK reaches a grasp pose
+    of ``kind`` (``top``: straight down; ``side``: level, approaching away from the base) at every
+    height and azimuth given (slow: about 10 s).
+    """
+    from agentchord.solvers.ik import BimanualIK, solve_from_scratch
+    from agentchord.solvers.poses import grasp_frame, pose_from_matrix, top_down_rotation
+
+    ik = BimanualIK(iterations=150, avoid_arm_collisions=False, converged_step=1e-4)
+    q = ik.configuration.q.copy()
+    base = np.asarray(BASE[arm])
+    ahead = 1.0 if arm == "left" else -1.0
+    farthest = []
+    for z in heights:
+        for azimuth in np.radians(azimuths_deg):
+            direction = np.array([ahead * np.cos(azimuth), np.sin(azimuth)])
+            if kind == "top":
+                rotation = top_down_rotation(np.array([-direction[1], direction[0], 0.0]))
+            else:
+                rotation = grasp_frame(np.array([direction[0], direction[1], 0.0]))
+            best = 0.0
+            for radius in np.arange(0.30, 0.90, 0.01):
+                pose = pose_from_matrix(np.array([*(base + radius * direction), z]), rotation)
+                if solve_from_scratch(ik, q, arm, [pose], tolerance=0.005) is not None:
+                    best = float(radius)
+            farthest.append(best)
+    return min(farthest)
+
+
 #: The measured reach model of each arm.
 REACH: MappingProxyType[str, ReachModel] = MappingProxyType(
     {arm: ReachModel(np.array(shoulder), REACH_MIN, REACH_MAX) for arm, shoulder in SHOULDER.items()}

@@ -18,8 +18,10 @@ from agentchord.agents.scene import Scene
 #: How to read the scene's numbers; the same words head every agent's scene.
 SCENE_LEGEND = (
     "world frame, metres; quat = w, x, y, z; extent = full size along the object's principal axes; "
-    "axis = its bottom-to-top direction; regions = named discs on the table (centre x, y and radius) "
-    "that an instruction may name"
+    "axis = its bottom-to-top direction; reachable_by = the arms that can grasp it where it lies; "
+    "an arm's base = where it stands (x, y), reach_top / reach_side = how far from its base it reaches "
+    "on the table from above / with a side grasp of a tall object; regions = named discs on the table "
+    "(centre x, y and radius) that an instruction may name"
 )
 
 

@@ -31,6 +31,8 @@ from agentchord.agents.reasoner import (
     ReasonerAttempt,
     ReasonerCall,
 )
+from agentchord.agents.rules.feasibility import stated_goal
+from agentchord.agents.rules.goals import GoalSpec
 from agentchord.graph.models import TaskGraph
 
 
@@ -48,6 +50,7 @@ class LlmReasoner:
         name: ``llm``.
         config: The settings.
         calls: Every call made so far, failed ones included.
+        last_goal: The goal the last composer reply stated.
     """
 
     name = "llm"
@@ -62,6 +65,8 @@ class LlmReasoner:
     ) -> None:
         self.config = config if config is not None else LlmConfig.from_env()
         self.calls: list[ReasonerCall] = []
+        #: The goal the last composer reply stated (``success.goal_spec``).
+        self.last_goal: GoalSpec | None = None
         self._client = client if client is not None else make_client(self.config)
         self._sleep = sleep
         self._clock = clock
@@ -80,8 +85,13 @@ class LlmReasoner:
         return self._modes[0]
 
     def compose(self, request: ComposeRequest) -> TaskGraph:
-        """The nominal task graph (see :class:`~agentchord.agents.reasoner.Reasoner`)."""
-        return self._ask(_expect(request, ComposeRequest))
+        """The nominal task graph (see :class:`~agentchord.agents.reasoner.Reasoner`), its goal in ``success``.
+
+        The goal it states is kept as ``last_goal``: the episode is judged by it.
+        """
+        graph = self._ask(_expect(request, ComposeRequest))
+        self.last_goal = stated_goal(graph)
+        return graph
 
     def arrange(self, request: ArrangeRequest) -> TaskGraph:
         """The recovery-augmented graph (see :class:`~agentchord.agents.reasoner.Reasoner`)."""

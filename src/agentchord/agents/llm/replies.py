@@ -14,6 +14,7 @@ from pydantic import ValidationError
 from agentchord.agents.llm.config import ENV_MAX_REPLY
 from agentchord.agents.checks import check_reply
 from agentchord.agents.reasoner import AgentRequest, ComposeRequest, ReasonerAttempt
+from agentchord.agents.rules.feasibility import stated_goal_problems
 from agentchord.graph.loader import validation_messages
 from agentchord.graph.models import TaskGraph
 from agentchord.guard.documents import check_shape
@@ -61,7 +62,10 @@ def parse_reply(
         graph = TaskGraph.model_validate(data)
     except ValidationError as error:
         return None, validation_messages(error, data)
-    return graph, [str(problem) for problem in check_reply(request, graph)]
+    problems = check_reply(request, graph)
+    if isinstance(request, ComposeRequest):
+        problems += stated_goal_problems(graph, request.scene)
+    return graph, [str(problem) for problem in problems]
 
 
 _FENCE = re.compile(r"```(?:json|JSON)?[ \t]*\n(.*?)```", re.DOTALL)
@@ -130,8 +134,10 @@ def _fill_from_request(data: dict[str, Any], request: AgentRequest) -> dict[str,
         if request.task:
             defaults["task"] = request.task
     else:
+        # The arranger and the conductor keep the composer's goal: one that leaves it out keeps it.
         graph = request.graph
-        defaults = {"task": graph.task, "instruction": graph.instruction, "objects": list(graph.objects)}
+        defaults = {"task": graph.task, "instruction": graph.instruction, "objects": list(graph.objects),
+                    "success": graph.success.model_dump(mode="json")}
     return {**{k: v for k, v in defaults.items() if k not in data}, **data}
 
 

@@ -14,6 +14,7 @@ not have:
 ``{{templates}}``         the monitor templates, Eq. 14-19 (``agentchord.expr.TEMPLATES``)
 ``{{expression_rules}}``  syntax of the expression language
 ``{{trigger_defaults}}``  default margin and window of a failure mode
+``{{goal_language}}``     the goal predicates a composer states its goal in (``agents.rules.goals``)
 ``{{example_*}}``         the worked example: the library single-arm pour graph
 ========================  ===========================================================
 
@@ -41,6 +42,13 @@ from agentchord.graph.models import FailureMode, TaskGraph
 
 #: The task whose library graph is the worked example of every prompt.
 EXAMPLE_TASK = "single_arm_pour_water"
+#: The goal its composer states (``success.goal_spec``), as the offline composer reads its instruction.
+EXAMPLE_GOAL = {"goals": [{"kind": "poured", "source": "bottle", "target": "cup", "arm": "right"},
+                          {"kind": "placed", "obj": "bottle"}], "home": True}
+#: How many of the example's nominal edges keep their failure modes and branches in the arranger's
+#: and the conductor's prompts: the grasp and the carry show every kind of mode; the whole graph
+#: would cost 3,000 tokens more per request.
+EXAMPLE_EDGES_SHOWN = 2
 
 _PLACEHOLDER = re.compile(r"\{\{\s*([a-z_]+)\s*\}\}")
 
@@ -98,11 +106,13 @@ def placeholders() -> dict[str, str]:
         "templates": template_table(),
         "expression_rules": expression_rules(),
         "trigger_defaults": trigger_defaults(),
+        "goal_language": goal_language(),
         "example_task": example.task,
         "example_instruction": example.instruction,
         "example_objects": ", ".join(example.objects),
         "example_nominal": graph_json(nominal_part(example)),
-        "example_augmented": graph_json(example),
+        "example_edges_shown": str(EXAMPLE_EDGES_SHOWN),
+        "example_augmented": graph_json(example_excerpt(example, EXAMPLE_EDGES_SHOWN)),
     }
 
 
@@ -247,6 +257,28 @@ def expression_rules() -> str:
     )
 
 
+def goal_language() -> str:
+    """The goal predicates (``kind`` and fields), each with what it means: the composer's ``success.goal_spec``."""
+    from agentchord.agents.rules.goals import GOAL_KINDS
+
+    lines = []
+    for cls in GOAL_KINDS:
+        fields = cls.model_fields
+        kind = fields["kind"].get_default()
+        doc = inspect.cleandoc(cls.__doc__ or "").splitlines()
+        summary = doc[0].replace("``", "`") if doc else ""
+        names = []
+        for name, field in fields.items():
+            if name == "kind":
+                continue
+            text = f"`{name}`" if field.is_required() else f"`{name}` (default {json.dumps(_plain(field.get_default()))})"
+            names.append(text)
+        lines.append(f"- `{kind}`: {summary} Fields: {', '.join(names)}.")
+        attributes = _attribute_docs(cls)
+        lines += [f"    - `{name}`: {text.replace('``None``', 'null').replace('``', '`')}" for name, text in attributes.items() if name in fields]
+    return "\n".join(lines)
+
+
 def trigger_defaults() -> str:
     """The default margin and window of a failure mode (Eq. 12)."""
     fields = FailureMode.model_fields
@@ -292,7 +324,30 @@ def nominal_part(graph: TaskGraph) -> TaskGraph:
     )
 
 
+def example_excerpt(graph: TaskGraph, edges: int) -> TaskGraph:
+    """The augmented ``graph`` with failure modes on its first ``edges`` nominal edges only, and the
+    recovery nodes and edges their branches bring (a worked example the size of a few edges)."""
+    from agentchord.agents.replies import branch_reach
+    from agentchord.graph.progress import nominal_path
+
+    shown = nominal_path(graph)[:edges]
+    kept: set[str] = set()
+    for edge_id in shown:
+        for failure in graph.edge(edge_id).failures:
+            kept |= set(branch_reach(graph, edge_id, failure.name))
+    nodes = [n for n in graph.nodes if not n.is_recovery or n.id in kept]
+    kept_edges = []
+    for edge in graph.edges:
+        if edge.is_recovery and edge.id not in kept:
+            continue
+        if not edge.is_recovery and edge.id not in shown:
+            edge = edge.model_copy(update={"failures": []})
+        kept_edges.append(edge)
+    return graph.model_copy(update={"nodes": nodes, "edges": kept_edges})
+
+
 def _example_graph() -> TaskGraph:
+    from agentchord.graph.models import Success
     from agentchord.library import load_task_graph  # the task library imports the graph loader only
 
-    return load_task_graph(EXAMPLE_TASK)
+    return load_task_graph(EXAMPLE_TASK).model_copy(update={"success": Success(judge="goal", goal_spec=EXAMPLE_GOAL)})

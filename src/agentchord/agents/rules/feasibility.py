@@ -9,9 +9,13 @@ goal naming an object the scene does not have.
 
 from __future__ import annotations
 
-from agentchord.agents.scene import Scene, SceneObject
+from pydantic import ValidationError
+
 from agentchord.agents.rules import knowledge as kb
 from agentchord.agents.rules.goals import GoalSpec, Inside, Placed, Poured, static_problems
+from agentchord.agents.scene import Scene, SceneObject
+from agentchord.graph.models import TaskGraph
+from agentchord.graph.validation import Problem
 
 #: Fraction of the container's smaller horizontal size an object's smaller horizontal size may fill.
 FIT_FRACTION = 0.95
@@ -59,3 +63,38 @@ def _fit(where: str, obj: SceneObject, container: SceneObject, verb: str) -> lis
             f"({inner * 100:.1f} cm inside)"
         ]
     return []
+
+
+def stated_goal(graph: TaskGraph) -> GoalSpec | None:
+    """The goal a composer stated in ``success.goal_spec`` (None when it stated none, or an invalid one)."""
+    if not graph.success.goal_spec:
+        return None
+    try:
+        return GoalSpec.model_validate(graph.success.goal_spec)
+    except ValidationError:
+        return None
+
+
+def stated_goal_problems(graph: TaskGraph, scene: Scene) -> list[Problem]:
+    """What is wrong with the goal the composer states: missing, not a goal spec, or not in this scene.
+
+    The goal spec is what the episode is judged by when the instruction is not the task's own
+    (``agentchord schema goal``): its objects must be the scene's, its regions the scene's, and
+    it must be possible in the scene (nothing put into a block, ...).
+    """
+    where = "success.goal_spec"
+    if not graph.success.goal_spec:
+        return [Problem(where, "state the goal: what must hold at the end, as a goal spec ({\"goals\": [...], \"home\": true})")]
+    try:
+        goal = GoalSpec.model_validate(graph.success.goal_spec)
+    except ValidationError as error:
+        return [
+            Problem(".".join([where, *(str(part) for part in detail["loc"])]) if detail["loc"] else where,
+                    detail["msg"].removeprefix("Value error, "))
+            for detail in error.errors()
+        ]
+    problems = []
+    for line in goal_problems(goal, scene):  # "goals[1]: what is wrong"
+        head, _, rest = line.partition(": ")
+        problems.append(Problem(f"{where}.{head}", rest) if head.startswith("goals[") and rest else Problem(where, line))
+    return problems

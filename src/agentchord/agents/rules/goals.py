@@ -133,6 +133,8 @@ class Folded(_Goal):
 
 
 Goal = Annotated[Poured | Placed | Inside | On | HandedOver | Folded, Field(discriminator="kind")]
+#: Every goal predicate, in the order the prompts list them.
+GOAL_KINDS: tuple[type[_Goal], ...] = (Poured, Placed, Inside, On, HandedOver, Folded)
 
 
 class GoalSpec(BaseModel):

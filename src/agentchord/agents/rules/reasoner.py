@@ -31,7 +31,7 @@ from agentchord.agents.rules.conductor import Conductor
 from agentchord.agents.rules.feasibility import goal_problems
 from agentchord.agents.rules.goals import GoalSpec
 from agentchord.agents.rules.instructions import ground_instruction
-from agentchord.graph.models import TaskGraph
+from agentchord.graph.models import Success, TaskGraph
 
 
 class RulesReasoner:
@@ -66,7 +66,9 @@ class RulesReasoner:
             if problems := goal_problems(goal, request.scene):
                 raise InfeasibleGoalError(problems)
             self.last_goal = goal
-            return compose(goal, request.scene, request.task, request.instruction).graph
+            graph = compose(goal, request.scene, request.task, request.instruction).graph
+            # The composer states the goal it planned for, as the LLM's does: the episode is judged by it.
+            return graph.model_copy(update={"success": Success(judge="goal", goal_spec=goal.model_dump(mode="json"))})
 
         return self._call(request, answer)
 
