@@ -86,13 +86,16 @@ def _seeds(text: str) -> list[int]:
 
 
 def sizes() -> None:
-    """Each agent's prompt per case (tokens = characters / 4), the skill notes' share in brackets."""
-    print(f"{'case':28} {'composer':>16} {'arranger':>16} {'conductor':>16}")
+    """Each agent's prompt per case (tokens = characters / 4): the whole request, the system prompt's
+    share (the agent's prompt file and skill notes: what a prompt change moves) and the skill notes'.
+    The rest is the user message: the scene and, for the arranger and the conductor, the graph so far."""
+    print("tokens: request (system prompt / skill notes)")
+    print(f"{'case':24} {'composer':>20} {'arranger':>20} {'conductor':>20}")
     for name in cases():
         try:
             graph, calls = plan_case(name)
         except FixtureError as error:
-            print(f"{name:28} (not planned: {error})")
+            print(f"{name:24} (not planned: {error})")
             continue
         book = FixtureBook.load(CASES_DIR / name)
         scene = observe(open_world(book.case.task, book.case.seed), task_regions(SIM_TASKS[book.case.task]))
@@ -102,8 +105,8 @@ def sizes() -> None:
         cells = []
         for request in requests:
             size = prompt_size(request)
-            cells.append(f"{size.tokens:>7} ({-(-size.notes_chars // 4):>5})")
-        print(f"{name:28} {cells[0]:>16} {cells[1]:>16} {cells[2]:>16}")
+            cells.append(f"{size.tokens:>6} ({-(-size.system_chars // 4):>5} / {-(-size.notes_chars // 4):>3})")
+        print(f"{name:24} {cells[0]:>20} {cells[1]:>20} {cells[2]:>20}")
 
 
 def main(argv: list[str] | None = None) -> int:

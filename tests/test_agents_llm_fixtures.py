@@ -24,10 +24,17 @@ from agentchord.agents.llm.fixtures import (
 )
 from agentchord.agents.llm.sizes import estimate_tokens, prompt_size
 from agentchord.agents.llm.skills import SkillNotesError, graph_features, parse_skill_notes, select_notes, skill_notes
+from agentchord.agents.observe import observe, task_regions
+from agentchord.agents.rules.goals import GoalSpec
+from agentchord.agents.rules.instructions import ground_instruction
 from agentchord.agents.scene import ArmState, Region
 from agentchord.cli import main
+from agentchord.episode import EpisodeSpec, run_episode
 from agentchord.graph.loader import load_graph
 from agentchord.graph.models import TaskGraph
+from agentchord.library import load_task_graph
+from agentchord.sim.tasks import SIM_TASKS
+from agentchord.sim.trial import open_world
 
 CASES_DIR = Path(__file__).parent / "data" / "llm"
 CASES = sorted(p.name for p in CASES_DIR.iterdir() if (p / "case.yaml").is_file())
@@ -213,3 +220,94 @@ def test_planned_graph_succeeds_undisturbed(case):
     graph, _ = plan_case(case)
     rows = run_episodes(FixtureBook.load(CASES_DIR / case).case.task, graph, [0, 1, 2], None)
     assert all(row["success"] for row in rows), rows
+
+
+# --- the goal each composer reply states -----------------------------------------------------
+
+
+def _agrees(a: dict, b: dict) -> bool:
+    """Whether two goal predicates ask for the same thing: kind, objects, roles and region equal, places
+    within 4 cm, yaws within 20 degrees (a long axis either way); an arm or a yaw that one of them
+    leaves open (the instruction names none) matches any."""
+    for key in a.keys() | b.keys():
+        x, y = a.get(key), b.get(key)
+        if key in ("arm", "yaw") and (x is None or y is None):
+            continue
+        if key in ("at", "offset"):
+            x, y = x or (0.0, 0.0), y or (0.0, 0.0)
+            if max(abs(float(p) - float(q)) for p, q in zip(x, y)) > 0.04:
+                return False
+        elif key == "yaw":
+            if abs((float(x) - float(y) + 90) % 180 - 90) > 20:
+                return False
+        elif key == "hold_target":
+            continue  # how the pour is steadied, not what it achieves
+        elif x != y:
+            return False
+    return True
+
+
+def _same_goal(a: GoalSpec, b: GoalSpec) -> bool:
+    left = [g.model_dump(mode="json") for g in a.goals]
+    right = [g.model_dump(mode="json") for g in b.goals]
+    if len(left) != len(right):
+        return False
+    unmatched = list(right)
+    for item in left:
+        match = next((other for other in unmatched if _agrees(item, other)), None)
+        if match is None:
+            return False
+        unmatched.remove(match)
+    return True
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_each_composer_states_the_goal_the_offline_reasoner_reads(case):
+    """The goal a reply states (``success.goal_spec``) is the one the rules reasoner reads in the same
+    instruction and scene: the episode is judged the same whichever reasoner planned it."""
+    book = FixtureBook.load(CASES_DIR / case)
+    reply = json.loads((CASES_DIR / case / "01-composer.reply.json").read_text(encoding="utf-8"))
+    stated = GoalSpec.model_validate(reply["success"]["goal_spec"])
+    scene = observe(open_world(book.case.task, book.case.seed), task_regions(SIM_TASKS[book.case.task]))
+    offline = ground_instruction(book.case.instruction, scene)
+    assert _same_goal(stated, offline), (stated.model_dump(mode="json", exclude_defaults=True), offline.model_dump(mode="json", exclude_defaults=True))
+
+
+def test_an_llm_plan_is_judged_by_the_goal_its_composer_stated(tmp_path, monkeypatch):
+    """A hand-over the other way round than the scene's own task: done as asked it is a SUCCESS (not
+    the task's check, which wants the left arm to give); done the task's way, it is a FAILURE."""
+    book = FixtureBook.load(CASES_DIR / "handover_reversed")
+    with ReplayServer(fixture_responder(book)) as server:
+        monkeypatch.setenv("AGENTCHORD_LLM_BASE_URL", server.base_url)
+        monkeypatch.setenv("AGENTCHORD_LLM_MODEL", "fixture")
+        monkeypatch.setenv("AGENTCHORD_LLM_API_KEY", "none")
+        planned = CliRunner().invoke(main, ["plan", book.case.instruction, "--task", "handover_block", "--reasoner", "llm",
+                                            "-o", str(tmp_path / "g.yaml")])
+    assert planned.exit_code == 0, planned.output
+    assert "judged by this graph's own goal" in planned.output
+    graph = load_graph(tmp_path / "g.yaml")
+    goal = GoalSpec.model_validate(graph.success.goal_spec)
+    assert graph.success.judge == "goal" and (goal.goals[0].giver, goal.goals[0].receiver) == ("right", "left")
+
+    done_right = run_episode(EpisodeSpec(task="handover_block", seed=0, graph=graph))
+    assert done_right.success, done_right.reason
+    the_tasks_way = load_task_graph("handover_block").model_copy(update={"success": graph.success})
+    done_wrong = run_episode(EpisodeSpec(task="handover_block", seed=0, graph=the_tasks_way))
+    assert not done_wrong.success and "handed over" in done_wrong.reason, done_wrong.reason
+    # The task's own check would have called the wrong one a success.
+    assert run_episode(EpisodeSpec(task="handover_block", seed=0)).success
+
+
+def test_run_with_an_llm_instruction_is_judged_by_the_stated_goal(monkeypatch):
+    """`run --instruction --reasoner llm` (the robot moves on the composed graph, the arranger and the
+    conductor answer while it moves) judges the episode by the goal the composer stated."""
+    book = FixtureBook.load(CASES_DIR / "handover_reversed")
+    with ReplayServer(fixture_responder(book)) as server:
+        monkeypatch.setenv("AGENTCHORD_LLM_BASE_URL", server.base_url)
+        monkeypatch.setenv("AGENTCHORD_LLM_MODEL", "fixture")
+        monkeypatch.setenv("AGENTCHORD_LLM_API_KEY", "none")
+        result = CliRunner().invoke(main, ["run", "handover_block", "--instruction", book.case.instruction,
+                                           "--reasoner", "llm", "--seed", "0"])
+    assert not book.problems, book.problems
+    assert result.exit_code == 0, result.output
+    assert "every goal predicate holds at the end" in result.output

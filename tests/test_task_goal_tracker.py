@@ -78,7 +78,7 @@ def _scene(task: str, seed: int = 0):
 def test_a_planned_paper_task_keeps_its_own_check_only_when_the_goal_has_its_outcome(task, instruction, own_check):
     scene = _scene(task)
     goal = ground_instruction(instruction, scene)
-    tracker = planned_goal_tracker(task, goal, load_task_graph(task), scene)
+    tracker = planned_goal_tracker(task, goal, load_task_graph(task).model_copy(update={"instruction": instruction}), scene)
     assert isinstance(tracker, GoalTracker) is not own_check
     if own_check:
         assert type(tracker) is type(SIM_TASKS[task].success_tracker())

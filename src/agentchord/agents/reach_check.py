@@ -67,11 +67,11 @@ def reach_problems(graph: TaskGraph, scene: Scene) -> list[Problem]:
                     problems += _beyond(edge_id, index[edge_id], arm, f"grasp of {obj} where it lies", point, reach)
                 where[obj] = None
             elif call.fn == "place" and isinstance(obj, str) and obj in objects:
-                point = _place_point(args, where)
-                if point is not None:
+                placed = _place_point(args, where)
+                if placed is not None:
                     reach = reach_of.get(obj, TOP_REACH)
-                    problems += _beyond(edge_id, index[edge_id], arm, f"place of {obj}", point, reach)
-                where[obj] = point
+                    problems += _beyond(edge_id, index[edge_id], arm, f"place of {obj}", placed, reach)
+                where[obj] = placed
             elif call.fn in ("move_to_obj", "move_by_offset", "move_to_target", "rotate_eef") and isinstance(obj, str):
                 where[obj] = None
     return problems

@@ -143,7 +143,7 @@ class Scene(_Model):
         arms = []
         for name, arm in frame.arms.items():
             held = [obj for (a, obj) in sorted(frame.holding) if a == name]
-            reach = {"base": BASE[name], "reach_top": TOP_REACH, "reach_side": SIDE_REACH} if name in BASE else {}
+            known = name in BASE  # a robot of our own: its measured reach
             arms.append(
                 ArmState(
                     name=name,
@@ -151,7 +151,9 @@ class Scene(_Model):
                     width=round(float(arm.width), decimals),
                     closed=bool(arm.closed),
                     holding=held[0] if held else None,
-                    **reach,
+                    base=BASE[name] if known else None,
+                    reach_top=TOP_REACH if known else None,
+                    reach_side=SIDE_REACH if known else None,
                 )
             )
         return cls(objects=objects, arms=arms, regions=list(regions), notes=notes)

@@ -63,6 +63,7 @@ def initial_state(scene: Scene, goal: GoalSpec | None = None) -> frozenset[Fact]
         if obj.name in held:
             continue
         facts.add(("on_table", obj.name))
+        facts |= {("reach", arm, obj.name) for arm in (ARMS if obj.reachable_by is None else obj.reachable_by)}
         if kb.keeps_upright(obj):
             facts.add(("upright", obj.name) if obj.axis[2] > 0.8 else ("fallen", obj.name))
     if goal is not None:

@@ -9,13 +9,14 @@ the facts of :mod:`~agentchord.agents.rules.facts`.
 
 from __future__ import annotations
 
-from agentchord.agents.scene import Scene, SceneObject
+from agentchord.agents.scene import Scene, SceneObject, grasp_reach
 from agentchord.agents.rules import knowledge as kb
 from agentchord.agents.rules.constraints import rounded
 from agentchord.agents.rules.facts import ARMS, placed_key, poured_into
 from agentchord.agents.rules.goals import GoalSpec, HandedOver, Inside, On, Placed, Poured
 from agentchord.agents.rules.planner import Fact, Operator
 from agentchord.robot.aloha import other_arm
+from agentchord.solvers.reach import table_distance
 
 
 def _call(fn: str, **args) -> dict:
@@ -104,7 +105,9 @@ def _one_arm_ops(
     ops = [] if not may_grasp else [
         Operator(
             name=f"grasp({arm}, {name})", arms=(arm,), objects=(name,),
-            pre=frozenset({("free", arm), ("on_table", name)}),
+            # Only where the arm reaches it (``reach`` facts: the scene's ``reachable_by``, then
+            # wherever a place or a hand-off on the table left it).
+            pre=frozenset({("free", arm), ("on_table", name), ("reach", arm, name)}),
             add=frozenset({("holding", arm, name)} | ({("upright", name)} if kb.keeps_upright(obj) else set())),
             delete=frozenset({("free", arm), ("home", arm), ("on_table", name), ("at", name, "*"), ("fallen", name), ("pour_ready", "*", "*", name)}),
             cost=190 + reach,
@@ -126,18 +129,55 @@ def _one_arm_ops(
         if wanted_arm and wanted_arm != arm:
             continue
         args, extra_pre = _place_args(obj, key, scene)
+        point = _place_point(args, scene)
+        reachers = set(ARMS) if point is None else {a for a in ARMS if table_distance(a, point) <= grasp_reach(obj.extent)}
+        if arm not in reachers:
+            continue  # the place is beyond this arm's reach: the other arm's, after a hand-off
         pre = {("holding", arm, name)} | extra_pre | ({("lifted", arm)} if kb.is_flat(obj) else set())
         ops.append(
             Operator(
                 name=f"place({arm}, {name}, {key})", arms=(arm,), objects=(name,),
                 # A container is not moved from under a vessel still tilted over it.
                 pre=frozenset(pre), pre_not=frozenset({("tilted", arm), ("under_pour", name)}),
-                add=frozenset({("free", arm), ("on_table", name), ("at", name, key)}),
-                delete=_released(arm, name), cost=170 + reach,
+                add=frozenset({("free", arm), ("on_table", name), ("at", name, key)} | {("reach", a, name) for a in reachers}),
+                delete=_released(arm, name) | {("reach", a, name) for a in set(ARMS) - reachers}, cost=170 + reach,
                 steps=({arm: _call("place", **args)},), semantic=f"The {name} released {_where(key)}.", skill="place",
             )
         )
+    if may_grasp or handed:
+        ops.append(_handoff_op(arm, obj))
     return ops
+
+
+#: Cost (ticks) of setting an object down for the other arm, on top of the places it saves.
+HANDOFF_COST = 260
+
+
+def _handoff_op(arm: str, obj: SceneObject) -> Operator:
+    """``arm`` sets ``obj`` down on a free spot both arms reach (chosen when it runs), for the other arm:
+    how an object on one side of the table reaches a place or an arm on the other."""
+    name, other = obj.name, other_arm(arm)
+    pre = {("holding", arm, name)} | ({("lifted", arm)} if kb.is_flat(obj) else set())
+    return Operator(
+        name=f"handoff({arm}, {name})", arms=(arm,), objects=(name,),
+        pre=frozenset(pre), pre_not=frozenset({("tilted", arm), ("reach", other, name)}),
+        add=frozenset({("free", arm), ("on_table", name), ("reach", arm, name), ("reach", other, name)}),
+        delete=_released(arm, name) | {("at", name, "*")}, cost=HANDOFF_COST,
+        steps=({arm: _call("place", obj=name, within_reach=other)}, {arm: _call("back")}),
+        semantic=f"The {name} set down where the {other} arm reaches it.", skill="place",
+    )
+
+
+def _place_point(args: dict, scene: Scene) -> tuple[float, float] | None:
+    """The table point a place's arguments name (from the anchor's observed place when relative)."""
+    target = args.get("target")
+    if target is None:
+        return None
+    anchor = args.get("relative_to")
+    if anchor is None:
+        return float(target[0]), float(target[1])
+    found = next((o for o in scene.objects if o.name == anchor), None)
+    return None if found is None else (found.pos[0] + float(target[0]), found.pos[1] + float(target[1]))
 
 
 def _grasp_args(obj: SceneObject) -> dict:
