@@ -144,7 +144,7 @@ def _run_in(world: World, spec: EpisodeSpec, on_tick: Callable[[Executor], None]
         disturbance=spec.make_disturbance(),
         disturbance_setting=spec.disturbances if spec.disturbance is None else None,
         seed=spec.seed,
-        config=spec.config,
+        config=spec.config if spec.config is not None else ExecutorConfig(pace=getattr(task, "pace", 1.0)),
         on_tick=on_tick,
         perception=spec.perception,
         repairer=repairer,

@@ -5,6 +5,7 @@ from agentchord.graph.catalog import (  # noqa: F401
     ACTIONS,
     ActionSpec,
     GraspArgs,
+    InsertArgs,
     MoveByOffsetArgs,
     MoveToObjArgs,
     MoveToTargetArgs,

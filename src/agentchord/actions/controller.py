@@ -15,7 +15,7 @@ from scipy.spatial.transform import Rotation
 
 from agentchord.features.frame import FeatureFrame
 from agentchord.robot.aloha import ARM_PREFIX
-from agentchord.solvers.ik import BimanualIK, PoseTarget
+from agentchord.solvers.ik import ARM_CLEARANCE, BimanualIK, PoseTarget
 from agentchord.worlds.protocol import ArmCommand, World
 
 #: QP iterations per call of a scratch (trial) IK solve.
@@ -42,6 +42,10 @@ class ArmTarget:
     grip_closed_settled: bool = False
 
 
+#: The grippers are apart again after a hand-off once their collision proxies are this far apart (m).
+PASSING_APART = 2 * ARM_CLEARANCE
+
+
 class RobotController:
     """Turns per-arm targets into joint commands every tick.
 
@@ -63,6 +67,11 @@ class RobotController:
         #: program, so an action run on its own never moves the other arm.
         self.free_arms: frozenset[str] = frozenset()
         self._scratch_ik: dict[bool, BimanualIK] = {}
+        #: The object passed from hand to hand now (:meth:`pass_hand_to_hand`), if any.
+        self.passing: str | None = None
+        self._hands_met = False
+        #: How fast the actions move, as a multiple of their speeds (2: every motion in half the time).
+        self.pace = 1.0
         self.sync_from_world()
 
     def scratch_ik(self, avoid_other_arm: bool = True) -> BimanualIK:
@@ -111,8 +120,36 @@ class RobotController:
             target.grip_closed_settled = False
         target.grip = float(np.clip(grip, 0.0, 1.0))
 
+    def pass_hand_to_hand(self, obj: str) -> None:
+        """Let the grippers meet while ``obj`` passes between them (the forearms still keep apart).
+
+        The IK keeps its whole-arm guard off until neither hand holds ``obj`` and the grippers are
+        apart again: the giver must be free to open and withdraw from beside the taker's fingers.
+        """
+        self.passing = obj
+        self._hands_met = False
+        self.ik.hand_to_hand = True
+
+    def end_passing(self) -> None:
+        """Back to the whole-arm guard now if the grippers are apart (a hand-off given up before they met)."""
+        if self.passing is not None and self.ik.whole_arm_clearance() > PASSING_APART:
+            self.passing = None
+            self.ik.hand_to_hand = False
+
+    def _watch_passing(self) -> None:
+        # The guard comes back once the hands have met and parted with the object in one hand.
+        if self.passing is None or self.frame is None:
+            return
+        apart = self.ik.whole_arm_clearance() > PASSING_APART
+        self._hands_met = self._hands_met or not apart
+        held = sum(1 for _, name in self.frame.holding if name == self.passing)
+        if self._hands_met and apart and held < 2:
+            self.passing = None
+            self.ik.hand_to_hand = False
+
     def step(self) -> None:
         """Solve the IK, send joint and gripper targets, advance the world one tick."""
+        self._watch_passing()
         cartesian = {arm: t.pose for arm, t in self.targets.items() if t.joints is None}
         for arm, target in self.targets.items():
             if target.joints is not None:

@@ -21,6 +21,7 @@ from agentchord.actions.controller import RobotController
 from agentchord.actions.grasping.drag_clear import drag_clear, plan_drag
 from agentchord.actions.grasping.finger_clearance import TopGraspChoice, clear_top_grasp, crossing_over, swept_hits
 from agentchord.actions.grasping.geometry import quat_matrix, wrist_margin
+from agentchord.actions.grasping.hand_off import giver_of, hand_off_frame
 from agentchord.actions.grasping.in_hand import grasp_height_share
 from agentchord.actions.grasping.make_way import make_way
 from agentchord.actions.motion import (
@@ -65,6 +66,10 @@ class PlacedCheck(Protocol):
 
 class GraspMissed(ActionFailed):
     """The fingers closed but the object is not between them."""
+
+
+#: An object this near (m) a closed or half-closed hand may rest on its fingers: the hand opens and backs off first.
+LET_GO_NEAR = 0.08
 
 
 class HeldBackByOtherArm(GraspMissed):
@@ -188,6 +193,8 @@ class Grasp(ArmAction):
     def _mode(self, robot: RobotController) -> str:
         """How the object is taken now: ``top``, ``side`` (upright or leaning a little) or ``fallen`` (lying)."""
         feats = robot.frame.objects[self.args.obj]
+        if giver_of(robot.frame, self.arm, self.args.obj) is not None:
+            return "hand_off"  # small, in the other hand: taken under its fingers (grasping.hand_off)
         tilt = tilt_deg(feats.axis)
         mode = self.args.mode
         if mode == "auto":
@@ -210,6 +217,9 @@ class Grasp(ArmAction):
         elif mode == "fallen":
             rotation, point = self._fallen_frame(robot)
             pre = point + np.array([0.0, 0.0, self.args.pre_grasp_dis])
+        elif mode == "hand_off":
+            rotation, point = self._hand_off_frame(robot)
+            pre = point - self.args.pre_grasp_dis * rotation[:, 0]
         else:
             pre, point, rotation = self._side_plan(robot)
         return [pose_from_matrix(pre, rotation), pose_from_matrix(point, rotation)]
@@ -223,7 +233,9 @@ class Grasp(ArmAction):
         if feats.pos[2] < -0.02:
             raise ActionFailed(f"{self.args.obj} fell off the table")
         mode = self._mode(robot)
-        if mode == "top":
+        if mode == "hand_off":
+            yield from self._hand_off_grasp(robot)
+        elif mode == "top":
             yield from self._top_grasp(robot)
         elif mode == "side":
             yield from self._side_grasp(robot)
@@ -231,6 +243,28 @@ class Grasp(ArmAction):
             yield from self._fallen_grasp(robot)
             if self.args.reseat and tilt_deg(robot.frame.objects[self.args.obj].axis) > self.RESEAT_TILT_DEG:
                 yield from self._reseat(robot)
+
+    def _hand_off_frame(self, robot: RobotController) -> tuple[np.ndarray, np.ndarray]:
+        giver = giver_of(robot.frame, self.arm, self.args.obj)
+        if giver is None:
+            raise GraspMissed(f"{self.args.obj} is no longer in the other hand")
+        return hand_off_frame(robot.frame, self.arm, self.args.obj, giver, robot.world.arm_base(self.arm))
+
+    def _hand_off_grasp(self, robot: RobotController) -> Iterator[None]:
+        """Take a small object from the other hand, in the air: in under its fingers, close, no lift."""
+        try:
+            rotation, point = self._hand_off_frame(robot)
+        except ValueError as error:  # no room under the giver's fingers
+            raise ActionFailed(str(error)) from None
+        robot.pass_hand_to_hand(self.args.obj)
+        arm = self.arm
+        try:
+            yield from move_to(robot, arm, pose_from_matrix(point - self.args.pre_grasp_dis * rotation[:, 0], rotation))
+            yield from move_to(robot, arm, pose_from_matrix(point, rotation), speed=0.15)
+            yield from self._close_and_check(robot)
+        except (ActionFailed, GraspMissed):
+            robot.end_passing()
+            raise
 
     def _reseat(self, robot: RobotController) -> Iterator[None]:
         """Put an object just set upright in hand down on the table, side-grasp it again.
@@ -263,7 +297,8 @@ class Grasp(ArmAction):
         # After a drop the object may still rest on the fingers (a rolled tool stacks them
         # vertically): open, roll the tool back level and back off so it falls free.
         arm = self.arm
-        if robot.targets[arm].grip > 0.0 or robot.frame.arms[arm].width < 0.05:
+        near = float(np.linalg.norm(robot.frame.objects[self.args.obj].pos - robot.frame.arms[arm].ee)) < LET_GO_NEAR
+        if near and (robot.targets[arm].grip > 0.0 or robot.frame.arms[arm].width < 0.05):
             robot.set_grip(arm, 0.0)
             approach = robot.rotation(arm)[:, 0]
             if abs(approach[2]) > 0.9:  # a top grasp: just rise

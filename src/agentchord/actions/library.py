@@ -21,6 +21,7 @@ from agentchord.actions.grasp import (
     GraspMissed,
 )
 from agentchord.actions.gripper import CloseGripper, OpenGripper
+from agentchord.actions.insert import Insert
 from agentchord.actions.move import Back, MoveByOffset, MoveToObj, MoveToTarget, RotateEef
 from agentchord.actions.place import (
     LEVEL_CLEARANCE,
@@ -44,6 +45,7 @@ __all__ = [
     "CloseGripper",
     "Grasp",
     "GraspMissed",
+    "Insert",
     "MoveByOffset",
     "MoveToObj",
     "MoveToTarget",
@@ -55,7 +57,7 @@ __all__ = [
 
 
 PROGRAMS: dict[str, type[ArmAction]] = {
-    cls.name: cls for cls in (Grasp, MoveToObj, MoveToTarget, MoveByOffset, RotateEef, Place, Back, OpenGripper, CloseGripper)
+    cls.name: cls for cls in (Grasp, MoveToObj, MoveToTarget, MoveByOffset, RotateEef, Place, Back, OpenGripper, CloseGripper, Insert)
 }
 
 

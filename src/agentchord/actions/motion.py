@@ -64,7 +64,7 @@ def move_to(robot: RobotController, arm: str, goal: PoseTarget, speed: float = L
     angle = (quat_to_rotation(start.quat).inv() * quat_to_rotation(goal.quat)).magnitude()
     distance = float(np.linalg.norm(goal.pos - start.pos))
     # Min-jerk peaks at 1.875x the mean speed: size the duration for the peak.
-    ticks = max(int(np.ceil(1.875 * max(distance / speed, angle / ANGULAR_SPEED) * 50)), 5)
+    ticks = max(int(np.ceil(1.875 * max(distance / speed, angle / ANGULAR_SPEED) * 50 / robot.pace)), 5)
     for pose in line_poses(start, goal, [min_jerk(k / ticks) for k in range(1, ticks + 1)]):
         robot.set_pose(arm, pose)
         yield
@@ -269,7 +269,7 @@ def move_joints(robot: RobotController, arm: str, q_goal: np.ndarray, speed: flo
     """Joint-space move at ``speed`` rad/s for the largest joint change."""
     q0 = robot.ik.arm_q(arm)
     span = float(np.max(np.abs(q_goal - q0)))
-    ticks = max(int(np.ceil(1.875 * span / speed * 50)), 5)
+    ticks = max(int(np.ceil(1.875 * span / speed * 50 / robot.pace)), 5)
     for k in range(1, ticks + 1):
         robot.set_joints(arm, q0 + min_jerk(k / ticks) * (q_goal - q0))
         yield

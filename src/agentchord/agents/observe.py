@@ -59,4 +59,5 @@ def observe(world: World, regions: list[Region] | None = None, perception: str =
         spec = world.object_spec(name) if name in world.object_names else None
         words = name.replace("_", " ")
         descriptions[name] = f"{colour_name(spec.rgba)} {words}" if spec is not None else words
-    return Scene.from_frame(frame, descriptions=descriptions, regions=regions or [])
+    # A world may say more of its scene than poses and sizes (gym-aloha's: the socket's bore).
+    return Scene.from_frame(frame, descriptions=descriptions, regions=regions or [], notes=getattr(world, "scene_notes", ""))

@@ -75,6 +75,9 @@ class ExecutorConfig:
     #: jittering in contact, a tray rocking after release, a bottle knocked over as the arm got home)
     #: to come to rest; the last edge's monitors keep watching meanwhile.
     settle_ticks: int = 25
+    #: How fast the actions move, as a multiple of their speeds (a task with a time budget, as
+    #: gym-aloha's 8 s, runs them faster: ``RobotController.pace``).
+    pace: float = 1.0
 
 
 class Executor(RecoverySwitching, PlanArrivals):
@@ -127,6 +130,7 @@ class Executor(RecoverySwitching, PlanArrivals):
         for removed in filtered.removed:
             self.trace.add(0, "branch_removed", failure=removed.failure, edge=removed.edge, reason=removed.reason)
         self.robot = RobotController(world)
+        self.robot.pace = self.config.pace
         self.extractor = make_extractor(perception, world, lambda arm: self.robot.targets[arm].grip_closed_settled)
         self.robot.frame = self.extractor.frame
         self.feasibility = FeasibilityChecker(self.robot)
@@ -283,6 +287,12 @@ class Executor(RecoverySwitching, PlanArrivals):
     def _tick(self) -> tuple[bool, str] | None:
         frame = self.extractor.update()
         self.tracker.observe(frame)
+        # An environment whose episode ends the moment its task is done (gym-aloha: reward 4 terminates).
+        terminated = getattr(self.tracker, "terminated", None)
+        verdict = terminated(self.world) if terminated is not None else None
+        if verdict is not None:
+            self.trace.add(self.world.tick, "terminated", node=self.node, reason=verdict.reason)
+            return verdict.success, verdict.reason
         self.motion.observe(frame)
         if self.settling_since is not None:
             # The last edge's failure modes hold until the scene is at rest: a bottle knocked over

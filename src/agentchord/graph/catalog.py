@@ -121,6 +121,15 @@ class MoveByOffsetArgs(_Args):
     frame: Literal["extrinsic", "intrinsic"] = "extrinsic"
 
 
+class InsertArgs(_Args):
+    """Insert the held ``obj`` into ``into``'s opening along ``into``'s long axis: aligned first, ``standoff`` before the opening, then pushed in."""
+
+    obj: str
+    into: str
+    depth: float = Field(0.03, ge=0.0, le=0.15, description="How far (m) past the opening the held object's tip goes.")
+    standoff: float = Field(0.03, ge=0.005, le=0.15, description="Gap (m) before the opening where the tip is aligned first.")
+
+
 class NoArgs(_Args):
     """No arguments."""
 
@@ -154,6 +163,7 @@ ACTIONS: dict[str, ActionSpec] = {
         ActionSpec("place", PlaceArgs, 170, ("obj", "relative_to"), holds_object=True),
         ActionSpec("move_to_target", MoveToTargetArgs, 110),
         ActionSpec("move_by_offset", MoveByOffsetArgs, 60),
+        ActionSpec("insert", InsertArgs, 120, ("obj", "into"), holds_object=True),
         ActionSpec("back", NoArgs, 100),
         ActionSpec("open_gripper", NoArgs, 25),
         ActionSpec("close_gripper", NoArgs, 25),

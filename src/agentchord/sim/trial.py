@@ -29,4 +29,7 @@ def open_world(task: str, seed: int) -> SimWorld:
     """
     if task not in SIM_TASKS:
         raise KeyError(f"unknown task {task!r} (tasks: {', '.join(SIM_TASKS)})")
+    opener = getattr(SIM_TASKS[task], "open_world", None)
+    if opener is not None:  # an environment we did not write (gym-aloha): its own world and sampler
+        return opener(seed)
     return SimWorld(SIM_TASKS[task].sample_scene(scene_rng(seed)))

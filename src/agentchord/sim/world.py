@@ -140,10 +140,9 @@ class SimWorld:
         self.object_spec(obj)
         tool = None
         if out_of is not None:
-            site = self._tcp_site[out_of]
 
             def tool() -> tuple[np.ndarray, np.ndarray]:
-                return self.data.site_xpos[site].copy(), self.data.site_xmat[site].reshape(3, 3).copy()
+                return self.tcp_pose(out_of)
         hand = PersonHand(self.model, self.data, self._object_body[obj], waypoints, tool)
         self._hands.append(hand)
         return hand

@@ -35,6 +35,8 @@ ARM_PROXIMITY = 0.35
 ARM_CLEARANCE = 0.02
 #: Levenberg-Marquardt damping of every QP (mink's ``damping``).
 DAMPING = 1e-4
+#: The collision proxies from this index on are the gripper's (``robot.aloha.COLLISION_PROXIES``).
+HAND_PROXIES_FROM = 2
 #: DAQP's "no lower bound" on a constraint row (what qpsolvers passes for ``G x <= h``).
 NO_LOWER_BOUND = -1e30
 
@@ -72,10 +74,22 @@ class BimanualIK:
                 (self.model.geom(a).id, self.model.geom(b).id) for a in geoms["left"] for b in geoms["right"]
             ]
             self._fromto = np.zeros(6)
-            self.arm_collision_limit = mink.CollisionAvoidanceLimit(
+            self._all_pairs = self._proxy_pairs
+            self.arm_collision_limit = self._whole_arms_limit = mink.CollisionAvoidanceLimit(
                 self.model, [(geoms["left"], geoms["right"])],
                 minimum_distance_from_collisions=ARM_CLEARANCE, collision_detection_distance=0.2, gain=0.5,
             )
+            # Hand to hand (a small object passed between the grippers): the hands may meet (the
+            # grippers and wrists), the forearms still keep apart.
+            forearms = {arm: names[:HAND_PROXIES_FROM] for arm, names in geoms.items()}
+            self._hand_to_hand_pairs = [
+                (self.model.geom(a).id, self.model.geom(b).id) for a in forearms["left"] for b in forearms["right"]
+            ]
+            self._hand_to_hand_limit = mink.CollisionAvoidanceLimit(
+                self.model, [(forearms["left"], forearms["right"])],
+                minimum_distance_from_collisions=ARM_CLEARANCE, collision_detection_distance=0.2, gain=0.5,
+            )
+        self._hand_to_hand = False
         self._arm_qadr = {
             arm: np.array([self.model.joint(f"{prefix}/{name}").qposadr[0] for name in ARM_JOINTS])
             for arm, prefix in ARM_PREFIX.items()
@@ -126,6 +140,19 @@ class BimanualIK:
     def arm_q(self, arm: str) -> np.ndarray:
         """The solver's current joint solution for one arm."""
         return self.configuration.q[self._arm_qadr[arm]].copy()
+
+    @property
+    def hand_to_hand(self) -> bool:
+        """Whether the grippers may meet (a small object passed from hand to hand); the forearms keep apart."""
+        return self._hand_to_hand
+
+    @hand_to_hand.setter
+    def hand_to_hand(self, value: bool) -> None:
+        if self.arm_collision_limit is None or value == self._hand_to_hand:
+            return
+        self._hand_to_hand = value
+        self.arm_collision_limit = self._hand_to_hand_limit if value else self._whole_arms_limit
+        self._proxy_pairs = self._hand_to_hand_pairs if value else self._all_pairs
 
     def tcp_pose(self, arm: str) -> PoseTarget:
         """Forward kinematics of the current solution."""
@@ -217,6 +244,16 @@ class BimanualIK:
         if exitflag <= 0:
             raise mink.NoSolutionFound("daqp")
         return step / self.dt
+
+    def whole_arm_clearance(self) -> float:
+        """Smallest distance (m) between the two arms' proxies, the grippers' included even hand to hand."""
+        if self.arm_collision_limit is None:
+            return float("inf")
+        pairs, self._proxy_pairs = self._proxy_pairs, self._all_pairs
+        try:
+            return self.arm_clearance()
+        finally:
+            self._proxy_pairs = pairs
 
     def arm_clearance(self) -> float:
         """Smallest distance (m) between the two arms' collision proxies (negative: overlap)."""

@@ -37,7 +37,7 @@ SKILLS_FILE = "skills.md"
 #: Agents a paragraph may be addressed to.
 AGENT_TAGS = ("composer", "arranger", "conductor")
 #: What a graph or a scene may do or hold that selects a note (a note's ``Does:`` line).
-GRAPH_FEATURES = ("regions", "handover", "two_arm_carry", "cloth", "placed_relative", "thin_flat", "placed_inside", "pouring")
+GRAPH_FEATURES = ("regions", "handover", "two_arm_carry", "cloth", "placed_relative", "thin_flat", "placed_inside", "pouring", "insertion")
 #: An object less tall than this (m) and narrower than :data:`THIN_WIDTH` is thin (cutlery); a point
 #: (a cloth corner, 8 mm) is not.
 THIN_HEIGHT = 0.02
@@ -159,7 +159,7 @@ def graph_features(graph: TaskGraph, scene: Scene) -> set[str]:
     carry, one step in which both arms grasp the same object; a place relative to another object
     at an offset is a placement beside it (in front, behind ...), at its centre a placement into
     or onto it; a thin object is one less than :data:`THIN_HEIGHT` tall that an arm grasps; a pour,
-    a ``rotate_eef``.
+    a ``rotate_eef``; an insertion, an ``insert``.
     """
     try:
         path = nominal_path(graph)
@@ -194,6 +194,8 @@ def graph_features(graph: TaskGraph, scene: Scene) -> set[str]:
                     held.pop(arm, None)
                 elif call.fn == "rotate_eef":
                     features.add("pouring")
+                elif call.fn == "insert":
+                    features.add("insertion")
     return features
 
 

@@ -56,6 +56,10 @@ def fact_constraints(fact: Fact, scene: Scene) -> list[str]:
     if kind == "handed":
         _, o, g, r = fact
         return [f"holding({g}, {o}) - 0.5"]
+    if kind == "mated":
+        return [f"0.1 - {fact[1]}.bottom[2]", f"0.1 - {fact[2]}.bottom[2]"]
+    if kind == "inserted":
+        return [f"norm(xy({fact[1]}.pos - {fact[2]}.pos)) - 0.5 * ({fact[1]}.extent[0] + {fact[2]}.extent[0])"]
     if kind == "over":
         far = _fold_partner(fact[2])
         return [f"norm(xy({fact[2]}.pos - {far}.pos)) - 0.06"]

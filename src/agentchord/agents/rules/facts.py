@@ -23,7 +23,7 @@ import math
 
 from agentchord.agents.scene import ArmState, Scene, SceneObject
 from agentchord.agents.rules import knowledge as kb
-from agentchord.agents.rules.goals import Folded, GoalSpec, HandedOver, Inside, On, Placed, Poured
+from agentchord.agents.rules.goals import Folded, GoalSpec, HandedOver, Inserted, Inside, On, Placed, Poured
 from agentchord.agents.rules.planner import Fact
 from agentchord.robot.aloha import ARMS  # re-exported: the arms, as facts name them
 
@@ -174,8 +174,11 @@ def goal_facts(goal: GoalSpec, scene: Scene) -> list[frozenset[Fact]]:
             wanted.add(("handed", g.obj, g.giver, g.receiver))
         elif isinstance(g, Folded):
             wanted |= {("at", f"{g.cloth}_bl", f"fold:{g.cloth}_tl"), ("at", f"{g.cloth}_br", f"fold:{g.cloth}_tr")}
+        elif isinstance(g, Inserted):
+            wanted.add(("inserted", g.obj, g.into))
         stages.append(frozenset(wanted))
-    if goal.home:
+    # An insertion ends the task with both hands on the mated pair: nobody goes home after it.
+    if goal.home and not any(isinstance(g, Inserted) for g in goal.goals):
         stages.append(frozenset(wanted | {("home", "left"), ("home", "right")}))
     return stages
 

@@ -118,6 +118,26 @@ class HandedOver(_Goal):
         return [self.obj]
 
 
+class Inserted(_Goal):
+    """``obj`` inserted into ``into``'s opening along its axis, in mid-air: a peg into a socket, each held by one arm.
+
+    The hands keep holding the mated pair: an insertion ends the task where it happens.
+
+    Attributes:
+        obj: The object inserted (held by ``arm``).
+        into: The object with the opening (a socket, held by the other arm).
+        arm: The arm that inserts; ``None`` lets the planner choose (the one that reaches ``obj``).
+    """
+
+    kind: Literal["inserted"] = "inserted"
+    obj: ObjectName
+    into: ObjectName
+    arm: Arm | None = None
+
+    def objects(self) -> list[str]:
+        return [self.obj, self.into]
+
+
 class Folded(_Goal):
     """A cloth folded in half: its near corners laid on its far corners.
 
@@ -132,9 +152,9 @@ class Folded(_Goal):
         return [f"{self.cloth}_{c}" for c in ("bl", "br", "tl", "tr")]
 
 
-Goal = Annotated[Poured | Placed | Inside | On | HandedOver | Folded, Field(discriminator="kind")]
+Goal = Annotated[Poured | Placed | Inside | On | HandedOver | Inserted | Folded, Field(discriminator="kind")]
 #: Every goal predicate, in the order the prompts list them.
-GOAL_KINDS: tuple[type[_Goal], ...] = (Poured, Placed, Inside, On, HandedOver, Folded)
+GOAL_KINDS: tuple[type[_Goal], ...] = (Poured, Placed, Inside, On, HandedOver, Inserted, Folded)
 
 
 class GoalSpec(BaseModel):
@@ -213,6 +233,8 @@ def static_problems(spec: GoalSpec) -> list[str]:
             problems.append(f"goals[{index}]: {goal.obj!r} cannot be placed relative to itself")
         if isinstance(goal, Placed) and sum(x is not None for x in (goal.region, goal.at, goal.relative_to)) > 1:
             problems.append(f"goals[{index}]: say where {goal.obj!r} goes one way only: region, at or relative_to")
+        if isinstance(goal, Inserted) and goal.obj == goal.into:
+            problems.append(f"goals[{index}]: {goal.obj!r} cannot be inserted into itself")
         if isinstance(goal, HandedOver) and goal.giver == goal.receiver:
             problems.append(f"goals[{index}]: the {goal.giver} arm cannot hand {goal.obj!r} over to itself")
         if relation is None:

@@ -29,7 +29,7 @@ from agentchord.agents.exceptions import InstructionNotGroundedError
 from agentchord.agents.observe import COLOURS
 from agentchord.agents.scene import Scene
 from agentchord.agents.rules import knowledge as kb
-from agentchord.agents.rules.goals import Folded, Goal, GoalSpec, HandedOver, Inside, On, Placed, Poured
+from agentchord.agents.rules.goals import Folded, Goal, GoalSpec, HandedOver, Inserted, Inside, On, Placed, Poured
 from agentchord.agents.rules.language import Clause, NounPhrase, ParseError, Where, grammar_words, parse_prepared, prepare
 from agentchord.agents.rules.phrasing import Rewritten, known_words as phrasing_words
 from agentchord.agents.rules.references import (
@@ -294,7 +294,7 @@ def read_instruction(instruction: str, scene: Scene) -> Reading:
     ctx = Context(scene, instruction)
     reading = Reading(instruction, clauses, prepared=prepared, words=ctx.read)
     for clause in clauses:
-        reading.goals.append(_BUILD[clause.verb](clause, ctx))
+        reading.goals.append([_into_socket(goal, ctx) for goal in _BUILD[clause.verb](clause, ctx)])
         if clause.arm or clause.giver or clause.receiver:
             for role, arm in (("arm", clause.arm), ("from", clause.giver), ("to", clause.receiver)):
                 if arm:
@@ -307,6 +307,13 @@ def read_instruction(instruction: str, scene: Scene) -> Reading:
         reading.clauses.append(Clause(verb="place", text="(still in hand: put back where it was)", objects=[NounPhrase(words=(g.obj,)) for g in rest]))
         reading.goals.append(rest)
     return reading
+
+
+def _into_socket(goal: Goal, ctx: Context) -> Goal:
+    """"Put X into Y" where Y is a socket (its opening at its ends, not on top): X is inserted, in the air."""
+    if isinstance(goal, Inside) and goal.container in ctx.objects and kb.is_socket(ctx.objects[goal.container]):
+        return Inserted(obj=goal.obj, into=goal.container, arm=goal.arm)
+    return goal
 
 
 _VOCABULARY: dict[tuple[str, ...], tuple[frozenset[str], frozenset[str]]] = {}

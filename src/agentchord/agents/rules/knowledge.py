@@ -18,6 +18,19 @@ from agentchord.agents.scene import SceneObject
 
 #: Words that make an object a container (something can be poured or put into it).
 CONTAINER_WORDS = frozenset({"cup", "mug", "glass", "bowl", "tray", "box", "basket", "bin", "pot", "jar"})
+#: An object no larger than this (m) is handed over from a top grasp by its upper half, raised by
+#: HANDOFF_GIVER_RAISE (m): the receiver takes its lower half under the giver's fingertips.
+SMALL_HANDOFF = 0.06
+HANDOFF_GIVER_RAISE = 0.012
+#: Where the giver brings a small object for the hand-off (m; x mirrored for a left giver).
+HANDOFF_POSE = (0.02, 0.5, 0.22)
+#: Where the inserting arm presents the peg (its tool; x on its own side) and where the other arm holds the socket (m).
+INSERT_PRESENT = (0.14, 0.5, 0.2)
+INSERT_HOLD = (0.1, 0.5, 0.2)
+#: How far (m) from its centre along its long axis each of the pair is taken: near its far end.
+INSERT_GRIP_OFFSET = 0.03
+#: Words for an object with an opening at its end, not on top (a peg goes in along its axis, in the air).
+SOCKET_WORDS = frozenset({"socket", "sleeve", "tube", "receptacle"})
 #: Words that make an object a pouring vessel.
 POURABLE_WORDS = frozenset({"bottle", "jug", "pitcher", "kettle", "carafe", "flask"})
 #: Suffixes of a cloth's corner points (bottom = near edge, top = far edge; l = -x, r = +x).
@@ -93,6 +106,11 @@ def words(obj: SceneObject) -> set[str]:
 def is_container(obj: SceneObject) -> bool:
     """Whether things can be poured or put into the object."""
     return bool(words(obj) & CONTAINER_WORDS)
+
+
+def is_socket(obj: SceneObject) -> bool:
+    """Whether the object is taken by inserting another along its axis (a socket)."""
+    return bool(words(obj) & SOCKET_WORDS)
 
 
 def is_pourable(obj: SceneObject) -> bool:

@@ -13,7 +13,7 @@ from agentchord.agents.scene import Scene, SceneObject, grasp_reach
 from agentchord.agents.rules import knowledge as kb
 from agentchord.agents.rules.constraints import rounded
 from agentchord.agents.rules.facts import ARMS, placed_key, poured_into
-from agentchord.agents.rules.goals import GoalSpec, HandedOver, Inside, On, Placed, Poured
+from agentchord.agents.rules.goals import GoalSpec, HandedOver, Inserted, Inside, On, Placed, Poured
 from agentchord.agents.rules.planner import Fact, Operator
 from agentchord.robot.aloha import other_arm
 from agentchord.solvers.reach import table_distance
@@ -59,6 +59,8 @@ def ground(scene: Scene, goal: GoalSpec) -> list[Operator]:
     for g in goal.goals:
         if isinstance(g, Poured):
             ops += _pour_ops(g)
+        if isinstance(g, Inserted) and g.obj in objects and g.into in objects:
+            ops += _insert_ops(g, objects[g.obj], objects[g.into])
         if isinstance(g, HandedOver):
             ops += _handover_ops(g, objects.get(g.obj))
         elif isinstance(g, (Placed, Inside, On)) and g.arm and held_by.get(g.obj, g.arm) != g.arm and g.obj not in handed:
@@ -109,10 +111,12 @@ def _one_arm_ops(
             # wherever a place or a hand-off on the table left it).
             pre=frozenset({("free", arm), ("on_table", name), ("reach", arm, name)}),
             add=frozenset({("holding", arm, name)} | ({("upright", name)} if kb.keeps_upright(obj) else set())),
-            delete=frozenset({("free", arm), ("home", arm), ("on_table", name), ("at", name, "*"), ("fallen", name), ("pour_ready", "*", "*", name)}),
+            # Taken off the table, it is wherever the hand brings it: reached again once set down.
+            delete=frozenset({("free", arm), ("home", arm), ("on_table", name), ("at", name, "*"), ("fallen", name),
+                              ("pour_ready", "*", "*", name), ("reach", "*", name)}),
             cost=190 + reach,
             # The giver of a handover holds the object high: the receiver takes it low.
-            steps=({arm: _call("grasp", **_grasp_args(obj), **({"height": kb.HANDOVER_GIVER_HEIGHT} if handed else {}))},),
+            steps=({arm: _call("grasp", **_grasp_args(obj), **(_giver_hold(obj) if handed else {}))},),
             semantic=f"{arm.capitalize()} gripper holds the {name}.", skill="grasp",
         )
     ]
@@ -126,11 +130,12 @@ def _one_arm_ops(
             )
         )
     for key, wanted_arm in dests:
-        if wanted_arm and wanted_arm != arm:
-            continue
         args, extra_pre = _place_args(obj, key, scene)
         point = _place_point(args, scene)
         reachers = set(ARMS) if point is None else {a for a in ARMS if table_distance(a, point) <= grasp_reach(obj.extent)}
+        # The arm the goal names places it, where it reaches the place; else the arm that does.
+        if wanted_arm and wanted_arm != arm and wanted_arm in reachers:
+            continue
         if arm not in reachers:
             continue  # the place is beyond this arm's reach: the other arm's, after a hand-off
         pre = {("holding", arm, name)} | extra_pre | ({("lifted", arm)} if kb.is_flat(obj) else set())
@@ -178,6 +183,14 @@ def _place_point(args: dict, scene: Scene) -> tuple[float, float] | None:
         return float(target[0]), float(target[1])
     found = next((o for o in scene.objects if o.name == anchor), None)
     return None if found is None else (found.pos[0] + float(target[0]), found.pos[1] + float(target[1]))
+
+
+def _giver_hold(obj: SceneObject) -> dict:
+    """How the giver of a hand-over holds the object: a bar high on its side (the receiver takes it low);
+    a small object from above by its upper half (the receiver takes it under the giver's fingertips)."""
+    if _grasp_args(obj).get("mode") == "top" and max(obj.extent) <= kb.SMALL_HANDOFF:
+        return {"offset": [0.0, 0.0, kb.HANDOFF_GIVER_RAISE]}
+    return {"height": kb.HANDOVER_GIVER_HEIGHT}
 
 
 def _grasp_args(obj: SceneObject) -> dict:
@@ -318,6 +331,18 @@ def _handover_ops(goal: HandedOver, obj: SceneObject | None) -> list[Operator]:
     yaw_g, yaw_r = (0.0, 180.0) if g == "left" else (180.0, 0.0)
     retreat = [-kb.HANDOVER_RETREAT if g == "left" else kb.HANDOVER_RETREAT, 0.0, 0.03]
     high = {**(_grasp_args(obj) if obj is not None else {"obj": o}), "height": kb.HANDOVER_GIVER_HEIGHT}
+    if obj is not None and "offset" in _giver_hold(obj):
+        # A small object held from above: offered where it is held (the hand keeps its orientation),
+        # taken under the giver's fingertips (the grasp's hand-off), the giver then lets go.
+        offer = {g: _call("move_to_target", pos=[-kb.HANDOFF_POSE[0] if g == "left" else kb.HANDOFF_POSE[0], *kb.HANDOFF_POSE[1:]])}
+        take = ({r: _call("grasp", obj=o, lift=0.0)}, {g: _call("open_gripper")}, {g: _call("back")})
+    else:
+        offer = {g: _call("move_to_target", pos=list(kb.HANDOVER_POSE), yaw=yaw_g)}
+        take = (
+            {r: _call("grasp", obj=o, height=kb.HANDOVER_RECEIVER_HEIGHT, lift=0.0, yaw=yaw_r)},
+            {g: _call("open_gripper")},
+            {g: _call("move_by_offset", offset=retreat)},
+        )
     return [
         Operator(
             # Held low (a fallen bar taken by its middle, seen in a re-plan): set it down standing, take it high.
@@ -329,7 +354,7 @@ def _handover_ops(goal: HandedOver, obj: SceneObject | None) -> list[Operator]:
         Operator(
             name=f"offer({g}, {o})", arms=(g,), objects=(o,), pre=frozenset({("holding", g, o)}),
             pre_not=frozenset({("handover_ready", g, o), ("grip_low", g)}), add=frozenset({("handover_ready", g, o)}), cost=110,
-            steps=({g: _call("move_to_target", pos=list(kb.HANDOVER_POSE), yaw=yaw_g)},),
+            steps=(offer,),
             semantic=f"The {o} held up by the {g} arm at the handover pose.", skill="offer",
         ),
         Operator(
@@ -337,11 +362,7 @@ def _handover_ops(goal: HandedOver, obj: SceneObject | None) -> list[Operator]:
             pre=frozenset({("handover_ready", g, o), ("holding", g, o), ("free", r)}),
             add=frozenset({("holding", r, o), ("free", g), ("handed", o, g, r)}),
             delete=_released(g, o) | {("free", r), ("home", r)}, cost=300,
-            steps=(
-                {r: _call("grasp", obj=o, height=kb.HANDOVER_RECEIVER_HEIGHT, lift=0.0, yaw=yaw_r)},
-                {g: _call("open_gripper")},
-                {g: _call("move_by_offset", offset=retreat)},
-            ),
+            steps=take,
             semantic=f"The {r} gripper holds the {o}; the {g} gripper released it.", skill="handover",
         ),
     ]
@@ -397,3 +418,43 @@ def _set_upright_ops(obj: SceneObject) -> list[Operator]:
             )
         )
     return ops
+
+
+def _insert_ops(goal: Inserted, obj: SceneObject, host: SceneObject) -> list[Operator]:
+    """Insertion in mid-air: each arm takes one of the pair from above near its far end (the peg's tip and
+    the socket's opening stay free), both present them facing each other, the peg's arm inserts."""
+    arm = goal.arm or ("right" if obj.pos[0] >= host.pos[0] else "left")
+    other = other_arm(arm)
+    name, into = obj.name, host.name
+    grasps = {arm: _call("grasp", obj=name, mode="top", offset_frame="object", offset=_far_end(obj, host)),
+              other: _call("grasp", obj=into, mode="top", offset_frame="object", offset=_far_end(host, obj))}
+    side = 1.0 if arm == "right" else -1.0
+    present = {arm: _call("move_to_target", pos=[side * kb.INSERT_PRESENT[0], kb.INSERT_PRESENT[1], kb.INSERT_PRESENT[2]]),
+               other: _call("move_to_target", pos=[-side * kb.INSERT_HOLD[0], kb.INSERT_HOLD[1], kb.INSERT_HOLD[2]])}
+    holds = frozenset({("holding", arm, name), ("holding", other, into)})
+    return [
+        Operator(
+            name=f"grasp_pair({arm}, {name}, {other}, {into})", arms=(arm, other), objects=(name, into),
+            pre=frozenset({("free", arm), ("free", other), ("on_table", name), ("on_table", into), ("reach", arm, name), ("reach", other, into)}),
+            add=holds, delete=frozenset({("free", arm), ("free", other), ("home", arm), ("home", other), ("on_table", name), ("on_table", into)}),
+            cost=200, steps=(grasps,), semantic=f"{arm.capitalize()} gripper holds the {name}, {other} the {into}.", skill="grasp",
+        ),
+        Operator(
+            name=f"present({name}, {into})", arms=(arm, other), objects=(name, into), pre=holds,
+            pre_not=frozenset({("mated", name, into)}), add=frozenset({("mated", name, into)}), cost=110,
+            steps=(present,), semantic=f"The {name} and the {into} held up facing each other.", skill="move",
+        ),
+        Operator(
+            name=f"insert({arm}, {name}, {into})", arms=(arm,), objects=(name, into), pre=holds | {("mated", name, into)},
+            add=frozenset({("inserted", name, into)}), cost=120,
+            steps=({arm: _call("insert", obj=name, into=into)},), semantic=f"The {name} inside the {into}.", skill="insert",
+        ),
+    ]
+
+
+def _far_end(obj: SceneObject, other: SceneObject) -> list[float]:
+    """Object-frame offset of a top grasp near the end of ``obj``'s long axis away from ``other``."""
+    w, x, y, z = obj.quat
+    yaw_axis = [1 - 2 * (y * y + z * z), 2 * (x * y + w * z)]  # the object's x axis, in the table plane
+    along = yaw_axis[0] * (other.pos[0] - obj.pos[0]) + yaw_axis[1] * (other.pos[1] - obj.pos[1])
+    return [-kb.INSERT_GRIP_OFFSET if along > 0 else kb.INSERT_GRIP_OFFSET, 0.0, 0.0]

@@ -1,0 +1,48 @@
+"""gym-aloha's Insertion (LeRobot's ``gym_aloha/AlohaInsertion-v0``), judged by its own reward.
+
+One arm takes a 12 cm peg, the other a socket (four plates around a 3.6 cm bore, a pin inside), and
+the peg goes into the socket in mid-air. The environment is gym-aloha's, unmodified
+(:mod:`agentchord.sim.gym_aloha`): its sampler (peg x in [0.1, 0.2], socket x in [-0.2, -0.1],
+both y in [0.4, 0.6], from the seed) and its reward, 4 when the peg touches the pin. Success is
+that within :data:`STEP_LIMIT` steps (its rate within LeRobot's 400 is reported beside it).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from agentchord.sim.gym_aloha import INSERTION, GymAlohaWorld
+from agentchord.sim.tasks.gym_aloha_judge import RewardTracker
+
+#: Steps within which its reward must reach 4: twice LeRobot's 8 s evaluation (the rate within 400 is reported too).
+STEP_LIMIT = 800
+
+
+@dataclass
+class GymAlohaInsertion:
+    """The task: its world per seed, its reward as the judge."""
+
+    name: str = "gym_aloha_insertion"
+    description: str = "gym-aloha (LeRobot) Insertion: the peg into the socket, in mid-air"
+    instruction: str = "Insert the peg into the socket."
+    #: Our actions at twice their speed, as for Transfer Cube.
+    pace: float = 2.0
+
+    @property
+    def regions(self) -> dict:
+        """No named regions."""
+        return {}
+
+    def open_world(self, seed: int) -> GymAlohaWorld:
+        """gym-aloha's environment reset with ``seed`` (its own sampler)."""
+        return GymAlohaWorld(INSERTION, seed)
+
+    def sample_scene(self, rng):
+        raise NotImplementedError(f"{self.name} runs gym-aloha's own scene: open it with open_world(seed)")
+
+    def success_tracker(self) -> RewardTracker:
+        """Its reward reaching 4 within :data:`STEP_LIMIT` steps."""
+        return RewardTracker(step_limit=STEP_LIMIT, disturbed_step_limit=2 * STEP_LIMIT, what="the peg inserted, touching the pin")
+
+
+TASK = GymAlohaInsertion()
