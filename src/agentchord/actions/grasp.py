@@ -68,8 +68,8 @@ class GraspMissed(ActionFailed):
     """The fingers closed but the object is not between them."""
 
 
-#: An object this near (m) a closed or half-closed hand may rest on its fingers: the hand opens and backs off first.
-LET_GO_NEAR = 0.08
+#: An arm within this (rad, every joint) of its home configuration is at home.
+AT_HOME_RAD = 0.05
 
 
 class HeldBackByOtherArm(GraspMissed):
@@ -297,8 +297,9 @@ class Grasp(ArmAction):
         # After a drop the object may still rest on the fingers (a rolled tool stacks them
         # vertically): open, roll the tool back level and back off so it falls free.
         arm = self.arm
-        near = float(np.linalg.norm(robot.frame.objects[self.args.obj].pos - robot.frame.arms[arm].ee)) < LET_GO_NEAR
-        if near and (robot.targets[arm].grip > 0.0 or robot.frame.arms[arm].width < 0.05):
+        # A closed hand at home holds nothing on its fingers (gym-aloha starts its episodes so): it only opens.
+        at_home = float(np.max(np.abs(robot.frame.arms[arm].q - HOME_Q))) < AT_HOME_RAD
+        if not at_home and (robot.targets[arm].grip > 0.0 or robot.frame.arms[arm].width < 0.05):
             robot.set_grip(arm, 0.0)
             approach = robot.rotation(arm)[:, 0]
             if abs(approach[2]) > 0.9:  # a top grasp: just rise

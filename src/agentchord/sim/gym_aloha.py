@@ -178,10 +178,9 @@ class GymAlohaWorld(SimWorld):
         self._fault_until: dict[str, int] = {}
         self._push_until: dict[int, int] = {}
         self._hands = []
-        # Its start pose: the arms at home, the grippers where its reset leaves them, until commanded.
-        start = np.asarray(gym_sim.START_ARM_POSE)
-        lo, hi = FINGER_RANGE
-        self.commands = {arm: ArmCommand(q=HOME_Q.copy(), grip=float(np.clip((hi - start[6]) / (hi - lo), 0.0, 1.0))) for arm in ARM_PREFIX}
+        # Its start pose: the arms at home; the grippers, which its reset leaves nearly closed, are
+        # commanded open from the first step (our robot's rest state).
+        self.commands = {arm: ArmCommand(q=HOME_Q.copy(), grip=0.0) for arm in ARM_PREFIX}
         self.tick = 0
         self.reward = 0
         self.best_reward = 0
