@@ -261,6 +261,12 @@ def _same_goal(a: GoalSpec, b: GoalSpec) -> bool:
     return True
 
 
+#: Cases whose instruction leaves the end open, read two ways: the offline reasoner puts what is left in
+#: a hand back where it was taken from (the arms end empty); the model keeps it held. Their goals must
+#: differ by exactly that trailing put-back.
+LEFT_IN_HAND = {"gym_transfer_cube": "the left hand keeps the cube (\"hand it to the left arm\" says no more)"}
+
+
 @pytest.mark.parametrize("case", CASES)
 def test_each_composer_states_the_goal_the_offline_reasoner_reads(case):
     """The goal a reply states (``success.goal_spec``) is the one the rules reasoner reads in the same
@@ -270,6 +276,10 @@ def test_each_composer_states_the_goal_the_offline_reasoner_reads(case):
     stated = GoalSpec.model_validate(reply["success"]["goal_spec"])
     scene = observe(open_world(book.case.task, book.case.seed), task_regions(SIM_TASKS[book.case.task]))
     offline = ground_instruction(book.case.instruction, scene)
+    if case in LEFT_IN_HAND:
+        put_back = offline.goals[-1]
+        assert put_back.kind == "placed" and put_back.region is None and put_back.at is None and put_back.relative_to is None
+        offline = offline.model_copy(update={"goals": offline.goals[:-1]})
     assert _same_goal(stated, offline), (stated.model_dump(mode="json", exclude_defaults=True), offline.model_dump(mode="json", exclude_defaults=True))
 
 

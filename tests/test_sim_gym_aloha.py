@@ -104,3 +104,59 @@ def test_our_actions_replayed_through_its_own_env_step_reach_reward_4_at_the_sam
     rewards = [env.step(action)[1] for action in world.actions]
     env.close()
     assert rewards.index(SUCCESS_REWARD) + 1 == world.first_success_tick == result.steps
+
+
+@pytest.mark.parametrize("task,instruction,kinds", [
+    ("gym_aloha_transfer_cube", "Pick up the cube with the right arm and hand it to the left arm.", ["handed_over", "placed"]),
+    ("gym_aloha_transfer_cube", "Pass the cube from the right hand to the left hand.", ["handed_over", "placed"]),
+    ("gym_aloha_transfer_cube", "With the right arm, grab the cube and give it to the left arm.", ["handed_over", "placed"]),
+    ("gym_aloha_insertion", "Insert the peg into the socket.", ["inserted"]),
+    ("gym_aloha_insertion", "Put the peg in the socket.", ["inserted"]),
+    ("gym_aloha_insertion", "Slide the red peg into the blue socket.", ["inserted"]),
+])
+def test_the_offline_planner_plans_both_tasks_from_plain_instructions(task, instruction, kinds):
+    from agentchord.agents.observe import observe
+    from agentchord.agents.pipeline import make_reasoner, plan_task
+
+    scene = observe(open_world(task, 0))
+    reasoner = make_reasoner("rules")
+    result = plan_task(instruction, scene, reasoner, task=task)
+    assert [g.kind for g in reasoner.last_goal.goals] == kinds
+    actions = [call.fn for edge in result.nominal.edges for _, call in edge.calls]
+    assert ("insert" in actions) == (kinds == ["inserted"])
+
+
+@pytest.mark.parametrize("task,instruction", [
+    ("gym_aloha_transfer_cube", "Pick up the cube with the right arm and hand it to the left arm."),
+    ("gym_aloha_insertion", "Insert the peg into the socket."),
+])
+def test_an_offline_plan_succeeds_by_its_reward(task, instruction):
+    result = run_episode(EpisodeSpec(task=task, seed=1, instruction=instruction))
+    assert result.success, result.reason
+
+
+def test_a_gym_aloha_task_is_not_served_over_the_world_protocol_which_cannot_carry_its_reward():
+    from click.testing import CliRunner
+
+    from agentchord.cli import main
+
+    result = CliRunner().invoke(main, ["run", "gym_aloha_transfer_cube", "--world", "tcp://127.0.0.1:5599"])
+    assert result.exit_code == 2 and "judged by gym-aloha's own reward" in result.output
+    served = CliRunner().invoke(main, ["serve", "--task", "gym_aloha_insertion"])
+    assert served.exit_code == 2 and "the world protocol cannot carry it" in served.output
+
+
+@pytest.mark.parametrize("args", [
+    ["run", "gym_aloha_transfer_cube", "--video", "v.mp4", "--camera", "angle"],
+    ["run", "gym_aloha_insertion", "--perception", "rgbd"],
+    ["demo", "--task", "gym_aloha_insertion", "--perception", "rgbd"],
+    ["record", "gym_aloha_transfer_cube", "--out", "ds"],
+])
+def test_rendering_its_cameras_is_refused_with_a_reason_not_a_crash(args, tmp_path, monkeypatch):
+    from click.testing import CliRunner
+
+    from agentchord.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    result = CliRunner().invoke(main, args)
+    assert result.exit_code == 2 and "cannot render yet" in result.output, result.output

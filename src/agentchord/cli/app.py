@@ -24,6 +24,7 @@ from agentchord.cli.support import (
     GuardedGroup,
     catches_sigterm,
     check_outputs,
+    check_served,
     check_task_name,
     failed_calls_trace,
     load_goal_option,
@@ -78,6 +79,7 @@ def serve(task, port, host, seed, release_after) -> None:
     first closes it or sends nothing for --release-after seconds.
     """
     check_task_name(task, "--task")
+    check_served(task, "the world protocol")
     import zmq
 
     from agentchord.sim.serve import WorldServer, bind_host

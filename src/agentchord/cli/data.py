@@ -57,7 +57,7 @@ def record_command(task, episodes, out, p, disturb, protocol, only_recovered, ke
     """
     import sys
 
-    from agentchord.cli.support import disturbance_setting
+    from agentchord.cli.support import check_rendered, disturbance_setting
     from agentchord.library import library_tasks
     from agentchord.sim.tasks import SIM_TASKS
 
@@ -65,6 +65,7 @@ def record_command(task, episodes, out, p, disturb, protocol, only_recovered, ke
         raise click.BadParameter(f"unknown task {task!r} (tasks: {', '.join(SIM_TASKS)})", param_hint="TASK")
     if task not in library_tasks():
         raise click.BadParameter(f"{task!r} has no library graph to record", param_hint="TASK")
+    check_rendered(task, "a recorded dataset")
     cameras = () if tuple(cameras) == ("none",) else tuple(cameras)
     from agentchord.data.record import ResumeError, record_settings, recorded_state
 

@@ -17,6 +17,8 @@ from agentchord.cli.support import (
     FiniteFloatRange,
     check_outputs,
     disturbance_setting,
+    check_rendered,
+    check_served,
     check_task_name,
     failed_calls_trace,
     load_goal_option,
@@ -90,6 +92,10 @@ def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, inst
     from agentchord.episode import EpisodeSpec
 
     check_task_name(task, "TASK")
+    if world is not None:
+        check_served(task, "--world")
+    if video_path is not None or perception == "rgbd":
+        check_rendered(task, "--video" if video_path is not None else "--perception rgbd")
     if world is not None and video_path is not None:
         raise click.UsageError("--video renders the simulator in this process: it cannot be used with --world")
     if world is not None and rerun_path is not None:
@@ -367,6 +373,10 @@ def demo(task, trials, first_seed, p, disturb, protocol, perception, strategies,
     if unknown or not names:
         raise click.BadParameter(f"unknown strategy {unknown} (choose from {', '.join(METHOD_NAMES)})", param_hint="--strategies")
     check_task_name(task, "--task")
+    if world is not None:
+        check_served(task, "--world")
+    if perception == "rgbd":
+        check_rendered(task, "--perception rgbd")
     if world is not None and workers not in (None, 1):
         raise click.BadParameter("one remote world runs one episode at a time: use --workers 1 with --world", param_hint="--workers")
     check_outputs(("--json", json_path, ()))

@@ -273,6 +273,26 @@ def check_task_name(task: str, param_hint: str) -> None:
         raise click.BadParameter(f"unknown task {task!r} (tasks: {', '.join(SIM_TASKS)})", param_hint=param_hint)
 
 
+def check_served(task: str, what: str) -> None:
+    """Refuse to serve, or to drive over the world protocol, a task judged by its environment's own reward
+    (gym-aloha's): the protocol does not carry that reward yet, and a remote episode could not be judged."""
+    from agentchord.sim.tasks import SIM_TASKS
+
+    if hasattr(SIM_TASKS.get(task), "open_world"):
+        raise click.UsageError(f"{task} is judged by gym-aloha's own reward, read in this process; {what} cannot carry it "
+                               "yet: run it without a served world")
+
+
+def check_rendered(task: str, what: str) -> None:
+    """Refuse to render a task run in gym-aloha's own physics (videos, RGB-D, datasets): rendering its
+    cameras through ours is not done yet (its dm_control physics keeps its own GL context)."""
+    from agentchord.sim.tasks import SIM_TASKS
+
+    if hasattr(SIM_TASKS.get(task), "open_world"):
+        raise click.UsageError(f"{task} runs in gym-aloha's own physics, whose cameras {what} cannot render yet: "
+                               "run it with the oracle features and without a video")
+
+
 def load_goal_option(goal_path: str | None):
     """The goal spec of ``--goal`` (None without the option); an unreadable or invalid file is a usage error."""
     if goal_path is None:

@@ -291,7 +291,12 @@ class Executor(RecoverySwitching, PlanArrivals):
         terminated = getattr(self.tracker, "terminated", None)
         verdict = terminated(self.world) if terminated is not None else None
         if verdict is not None:
-            self.trace.add(self.world.tick, "terminated", node=self.node, reason=verdict.reason)
+            # Its judge ends the episode; the graph's own goal is judged beside it, and the record
+            # says where the two disagree (a left finger touching the cube is its success, while the
+            # graph's goal asks for the left hand alone to hold it).
+            goal_holds = self.constraints_hold(self.graph.goal)
+            self.trace.add(self.world.tick, "terminated", node=self.node, reason=verdict.reason, graph_goal_holds=goal_holds,
+                           graph_goal=self.graph.goal, violated=[] if goal_holds else self.violated_constraints(self.graph.goal))
             return verdict.success, verdict.reason
         self.motion.observe(frame)
         if self.settling_since is not None:
