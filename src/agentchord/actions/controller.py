@@ -123,8 +123,8 @@ class RobotController:
     def pass_hand_to_hand(self, obj: str) -> None:
         """Let the grippers meet while ``obj`` passes between them (the forearms still keep apart).
 
-        The IK keeps its whole-arm guard off until neither hand holds ``obj`` and the grippers are
-        apart again: the giver must be free to open and withdraw from beside the taker's fingers.
+        The IK keeps its whole-arm guard off until the hands have met and parted again with ``obj``
+        in one hand (or none): the giver must be free to open and withdraw from beside the taker's fingers.
         """
         self.passing = obj
         self._hands_met = False

@@ -208,13 +208,7 @@ class GymAlohaWorld(SimWorld):
                 hand.apply(self.model.opt.timestep)
             self.physics.step(1)
         gym_task.after_step(self.physics)
-        self._hands = [hand for hand in self._hands if not hand.done]
-        self.tick += 1
-        for body, until in list(self._push_until.items()):
-            if self.tick >= until:
-                self.data.xfrc_applied[body] = 0.0
-                del self._push_until[body]
-        self._contacts = {(a, b) for a, b in self.data.contact.geom[: self.data.ncon].tolist()}
+        self._after_step()
         self.reward = int(gym_task.get_reward(self.physics))
         self.best_reward = max(self.best_reward, self.reward)
         if self.reward == SUCCESS_REWARD and self.first_success_tick is None:

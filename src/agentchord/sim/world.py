@@ -174,6 +174,10 @@ class SimWorld:
             for hand in self._hands:
                 hand.apply(self.model.opt.timestep)
             mujoco.mj_step(self.model, self.data)
+        self._after_step()
+
+    def _after_step(self) -> None:
+        """A tick's bookkeeping once its physics ran: hands done, pushes over, the contacts it left."""
         self._hands = [hand for hand in self._hands if not hand.done]
         self.tick += 1
         for body, until in list(self._push_until.items()):

@@ -17,7 +17,7 @@ from agentchord.sim.tasks.goal_tracker import GoalTracker
 def _discover() -> dict[str, SimTask]:
     tasks: dict[str, SimTask] = {}
     for module_info in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
-        if module_info.name in ("base", "goal_tracker", "gym_aloha_judge"):
+        if module_info.name in ("base", "goal_tracker", "gym_aloha_common"):
             continue
         module = importlib.import_module(f"{__name__}.{module_info.name}")
         task = getattr(module, "TASK", None)

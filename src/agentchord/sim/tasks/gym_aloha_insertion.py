@@ -9,40 +9,17 @@ that within :data:`STEP_LIMIT` steps (its rate within LeRobot's 400 is reported 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
-from agentchord.sim.gym_aloha import INSERTION, GymAlohaWorld
-from agentchord.sim.tasks.gym_aloha_judge import RewardTracker
+from agentchord.sim.gym_aloha import INSERTION
+from agentchord.sim.tasks.gym_aloha_common import GymAlohaSimTask
 
 #: Steps within which its reward must reach 4: twice LeRobot's 8 s evaluation (the rate within 400 is reported too).
 STEP_LIMIT = 800
 
-
-@dataclass
-class GymAlohaInsertion:
-    """The task: its world per seed, its reward as the judge."""
-
-    name: str = "gym_aloha_insertion"
-    description: str = "gym-aloha (LeRobot) Insertion: the peg into the socket, in mid-air"
-    instruction: str = "Insert the peg into the socket."
-    #: Our actions at twice their speed, as for Transfer Cube.
-    pace: float = 2.0
-
-    @property
-    def regions(self) -> dict:
-        """No named regions."""
-        return {}
-
-    def open_world(self, seed: int) -> GymAlohaWorld:
-        """gym-aloha's environment reset with ``seed`` (its own sampler)."""
-        return GymAlohaWorld(INSERTION, seed)
-
-    def sample_scene(self, rng):
-        raise NotImplementedError(f"{self.name} runs gym-aloha's own scene: open it with open_world(seed)")
-
-    def success_tracker(self) -> RewardTracker:
-        """Its reward reaching 4 within :data:`STEP_LIMIT` steps."""
-        return RewardTracker(step_limit=STEP_LIMIT, disturbed_step_limit=2 * STEP_LIMIT, what="the peg inserted, touching the pin")
-
-
-TASK = GymAlohaInsertion()
+TASK = GymAlohaSimTask(
+    name="gym_aloha_insertion",
+    description="gym-aloha (LeRobot) Insertion: the peg into the socket, in mid-air",
+    instruction="Insert the peg into the socket.",
+    world=INSERTION,
+    step_limit=STEP_LIMIT,
+    what="the peg inserted, touching the pin",
+)

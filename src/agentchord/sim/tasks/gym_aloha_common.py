@@ -1,4 +1,4 @@
-"""The success check of a gym-aloha task: its own reward, as its world records it every step."""
+"""What gym-aloha's tasks share: their world per seed, and their judge, its own reward as its world records it."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 from agentchord.features.frame import FeatureFrame
 from agentchord.harness import Verdict
-from agentchord.sim.gym_aloha import SUCCESS_REWARD
+from agentchord.sim.gym_aloha import SUCCESS_REWARD, GymAlohaTask, GymAlohaWorld
 
 
 @dataclass
@@ -50,3 +50,43 @@ class RewardTracker:
         if first > limit:
             return Verdict(False, f"gym-aloha's reward reached {SUCCESS_REWARD} at step {first}, after its limit of {limit}")
         return Verdict(True, f"gym-aloha's reward {SUCCESS_REWARD} at step {first} (limit {limit}): {self.what}")
+
+
+@dataclass
+class GymAlohaSimTask:
+    """One of gym-aloha's tasks as a task of ours: its own world per seed, its reward as the judge.
+
+    Attributes:
+        name: Our name of the task.
+        description: One line.
+        instruction: Its instruction in words.
+        world: Which of its tasks (``sim.gym_aloha``).
+        step_limit: Steps within which its reward must reach 4, undisturbed (twice as many disturbed).
+        what: What reward 4 means, in words.
+        pace: Our actions' speed on it (its reward counts within LeRobot's 8 s).
+    """
+
+    name: str
+    description: str
+    instruction: str
+    world: GymAlohaTask
+    step_limit: int
+    what: str
+    pace: float = 2.0
+
+    @property
+    def regions(self) -> dict:
+        """No named regions."""
+        return {}
+
+    def open_world(self, seed: int) -> GymAlohaWorld:
+        """Its environment reset with ``seed`` (its own sampler)."""
+        return GymAlohaWorld(self.world, seed)
+
+    def sample_scene(self, rng):
+        """Not a scene of ours: its world is gym-aloha's (:meth:`open_world`)."""
+        raise NotImplementedError(f"{self.name} runs gym-aloha's own scene: open it with open_world(seed)")
+
+    def success_tracker(self) -> RewardTracker:
+        """Its reward reaching 4 within :attr:`step_limit` steps (twice that where a disturbance acted)."""
+        return RewardTracker(step_limit=self.step_limit, disturbed_step_limit=2 * self.step_limit, what=self.what)
