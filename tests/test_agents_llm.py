@@ -479,3 +479,19 @@ def test_settings_an_endpoint_cannot_use_are_refused_when_read(settings, problem
     with pytest.raises(ReasonerConfigError) as caught:
         LlmConfig(**values)
     assert any(problem in line for line in caught.value.problems)
+
+
+def test_credentials_in_the_base_url_are_never_printed_nor_recorded(scene, nominal):
+    from agentchord.agents.llm.config import redact_url
+
+    assert redact_url("http://user:s3cret@127.0.0.1:9/v1") == "http://***@127.0.0.1:9/v1"
+    assert redact_url("https://api.openai.com/v1") == "https://api.openai.com/v1"
+    config = LlmConfig(base_url="http://user:s3cret@127.0.0.1:9/v1", model="m", api_key="k", timeout_s=1.0, max_retries=0,
+                       deadline_s=5.0)
+    llm = LlmReasoner(config, sleep=lambda s: None)
+    from agentchord.agents.exceptions import ReasonerError
+
+    with pytest.raises(ReasonerError) as caught:
+        llm.compose(compose_request(nominal, scene))
+    assert "s3cret" not in str(caught.value) and "***@127.0.0.1:9" in str(caught.value)
+    assert "s3cret" not in json.dumps(llm.calls[-1].to_trace_event())

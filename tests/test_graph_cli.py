@@ -106,6 +106,14 @@ def test_render_of_unloadable_file(runner: CliRunner, tmp_path: Path) -> None:
     assert result.output.startswith(f"{bad}: line 2, column 1: invalid YAML:")
 
 
+def test_filter_refuses_to_overwrite_its_own_input(runner: CliRunner, tmp_path: Path) -> None:
+    path = _regressive(tmp_path)
+    before = path.read_text()
+    result = runner.invoke(main, ["graph", "filter", str(path), "-o", str(path)])
+    assert result.exit_code == 2, result.output
+    assert "FILE" in result.output and path.read_text() == before  # its comments and the branch kept
+
+
 def test_filter_says_what_it_removes_and_why(runner: CliRunner, tmp_path: Path) -> None:
     path = _regressive(tmp_path)
     out = tmp_path / "filtered.yaml"

@@ -144,7 +144,7 @@ def render_command(file: Path, output: Path, style: str) -> None:
 )
 def filter_command(file: Path, output: Path | None) -> None:
     """Apply the forward-moving filter (Eq. 8) to FILE: say which recovery branches it removes and why."""
-    check_outputs(("-o", output, GRAPH_SUFFIXES))
+    check_outputs(("-o", output, GRAPH_SUFFIXES), inputs=(("FILE", file),))
     graph = _load_or_exit(file)
     try:
         result = forward_filter(graph)

@@ -114,13 +114,18 @@ class LlmConfig:
         if isinstance(self.base_url, str) and self.base_url.strip():
             url = urllib.parse.urlsplit(self.base_url.strip())
             if url.scheme not in ("http", "https") or not url.netloc:
-                problems.append(f"base_url: expected an http:// or https:// URL with a host, got {self.base_url!r}")
+                problems.append(f"base_url: expected an http:// or https:// URL with a host, got {redact_url(self.base_url)!r}")
         if self.temperature is not None and not (_finite_number(self.temperature) and 0 <= self.temperature <= 2):
             problems.append(f"temperature: expected a number from 0 to 2 or None, got {self.temperature!r}")
         if self.max_tokens is not None and self.max_tokens < 1:
             problems.append(f"max_tokens: expected a positive integer or None, got {self.max_tokens!r}")
         if problems:
             raise ReasonerConfigError("invalid LLM reasoner settings:", problems=problems)
+
+    @property
+    def endpoint(self) -> str:
+        """The base URL as it may be shown and recorded: credentials in it (``user:pw@``) masked."""
+        return redact_url(self.base_url)
 
     @classmethod
     def from_env(cls, env: Mapping[str, str] | None = None, **overrides: Any) -> LlmConfig:
@@ -188,3 +193,15 @@ class LlmConfig:
 
 def _finite_number(value: Any) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def redact_url(url: str) -> str:
+    """``url`` with any credentials in it (``http://user:pw@host/...``) masked as ``***``: safe to print and record."""
+    try:
+        parts = urllib.parse.urlsplit(url)
+    except ValueError:
+        return url
+    if parts.username is None and parts.password is None:
+        return url
+    host = parts.netloc.rsplit("@", 1)[-1]
+    return urllib.parse.urlunsplit(parts._replace(netloc=f"***@{host}"))

@@ -110,7 +110,7 @@ class LlmReasoner:
             agent=agent,
             reasoner=self.name,
             model=config.model,
-            endpoint=config.base_url,
+            endpoint=config.endpoint,
             request=request.model_dump(mode="json"),
             settings=config.settings(),
         )
@@ -183,7 +183,7 @@ class LlmReasoner:
             left = deadline - time.monotonic()
             if left <= 0:
                 raise ReasonerTransportError(
-                    f"{agent}: no valid reply from {config.base_url} within the deadline of "
+                    f"{agent}: no valid reply from {config.endpoint} within the deadline of "
                     f"{config.deadline_s:g} s ({ENV_DEADLINE}):",
                     problems=attempt.transport_errors or ["the deadline passed before a request could be sent"],
                 )
@@ -220,7 +220,7 @@ class LlmReasoner:
                 if retries >= config.max_retries:
                     attempt.transport_errors.append(line)
                     raise ReasonerTransportError(
-                        f"{agent}: no reply from {config.base_url} after {retries + 1} "
+                        f"{agent}: no reply from {config.endpoint} after {retries + 1} "
                         f"tr{'ies' if retries else 'y'}:",
                         problems=attempt.transport_errors,
                     ) from None
@@ -228,7 +228,7 @@ class LlmReasoner:
             except openai.OpenAIError as error:  # e.g. a response the client cannot read: not worth retrying
                 attempt.transport_errors.append(f"{type(error).__name__}: {error}")
                 raise ReasonerTransportError(
-                    f"{agent}: the request to {config.base_url} failed:", problems=attempt.transport_errors
+                    f"{agent}: the request to {config.endpoint} failed:", problems=attempt.transport_errors
                 ) from error
             else:
                 attempt.response_format = mode

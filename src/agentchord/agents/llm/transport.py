@@ -86,7 +86,7 @@ def status_message(agent: str, config: LlmConfig, status: int, retries: int) -> 
         404: f" (check {ENV_BASE_URL}, which usually ends in /v1, and {ENV_MODEL})",
     }.get(status, "")
     tries = f" after {retries + 1} tries" if retries else ""
-    return f"{agent}: {config.base_url} answered HTTP {status}{tries}{hint}:"
+    return f"{agent}: {config.endpoint} answered HTTP {status}{tries}{hint}:"
 
 
 def make_client(config: LlmConfig) -> openai.OpenAI:
