@@ -219,3 +219,16 @@ def test_run_and_demo_accept_every_method_bench_compares():
     from agentchord.execution.methods import METHODS
 
     assert set(METHOD_NAMES) == set(METHODS)
+
+
+@pytest.mark.parametrize("args", [
+    ["run", "blocks_and_cup"],
+    ["demo", "--task", "blocks_and_cup", "--trials", "1"],
+    ["bench", "--tasks", "blocks_and_cup", "--trials", "1"],
+])
+def test_a_task_without_a_library_graph_is_refused_up_front_not_run(args, tmp_path, monkeypatch):
+    """blocks_and_cup has no fixed goal: without --instruction or --goal there is nothing to run (issue 58)."""
+    monkeypatch.chdir(tmp_path)
+    result = CliRunner().invoke(main, args + (["--out", str(tmp_path / "b")] if args[0] == "bench" else []))
+    assert result.exit_code == 2, result.output
+    assert "blocks_and_cup" in result.output and "library graph" in result.output

@@ -100,11 +100,19 @@ def bench_command(tasks, methods, ps, protocol, trials, first_seed, out_dir, bac
 
     from agentchord.bench.tables import TASK_TITLES
 
-    aliases = {"all": list(SIM_TASKS), "paper": list(TASK_TITLES)}
+    from agentchord.library import library_tasks
+
+    # A sweep runs each task's library graph (or plans its library instruction): "all" is every task that has one.
+    runnable = [t for t in SIM_TASKS if t in library_tasks()]
+    aliases = {"all": runnable, "paper": list(TASK_TITLES)}
     task_names = aliases.get(tasks.strip(), None) or _csv_list(tasks)
     unknown = [t for t in task_names if t not in SIM_TASKS]
     if unknown or not task_names:
-        raise click.BadParameter(f"unknown task(s) {', '.join(unknown) or '(none given)'} (tasks: {', '.join(SIM_TASKS)}, or paper, or all)",
+        raise click.BadParameter(f"unknown task(s) {', '.join(unknown) or '(none given)'} (tasks: {', '.join(runnable)}, or paper, or all)",
+                                 param_hint="--tasks")
+    no_graph = [t for t in task_names if t not in runnable]
+    if no_graph:
+        raise click.BadParameter(f"{', '.join(no_graph)} has no library graph to sweep (tasks: {', '.join(runnable)}, or paper, or all)",
                                  param_hint="--tasks")
     method_names = list(METHODS) if methods is None else _csv_list(methods)
     unknown = [m for m in method_names if m not in METHODS]

@@ -17,6 +17,7 @@ from agentchord.cli.support import (
     FiniteFloatRange,
     check_outputs,
     disturbance_setting,
+    check_graph_source,
     check_rendered,
     check_served,
     check_task_name,
@@ -92,6 +93,7 @@ def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, inst
     from agentchord.episode import EpisodeSpec
 
     check_task_name(task, "TASK")
+    check_graph_source(task, "TASK", graph_path, instruction, goal_path)
     if world is not None:
         check_served(task, "--world")
     if video_path is not None or perception == "rgbd":
@@ -373,6 +375,7 @@ def demo(task, trials, first_seed, p, disturb, protocol, perception, strategies,
     if unknown or not names:
         raise click.BadParameter(f"unknown strategy {unknown} (choose from {', '.join(METHOD_NAMES)})", param_hint="--strategies")
     check_task_name(task, "--task")
+    check_graph_source(task, "--task", instruction)
     if world is not None:
         check_served(task, "--world")
     if perception == "rgbd":

@@ -273,6 +273,16 @@ def check_task_name(task: str, param_hint: str) -> None:
         raise click.BadParameter(f"unknown task {task!r} (tasks: {', '.join(SIM_TASKS)})", param_hint=param_hint)
 
 
+def check_graph_source(task: str, param_hint: str, *given: object) -> None:
+    """Refuse a task with no library graph when no graph, instruction or goal is given to run instead
+    (``blocks_and_cup``: its goal is whatever it is asked), naming what to give."""
+    from agentchord.library import library_tasks
+
+    if not any(g is not None for g in given) and task not in library_tasks():
+        raise click.BadParameter(f"{task!r} has no library graph: give --instruction or --goal (or --graph) to plan what to do in it",
+                                 param_hint=param_hint)
+
+
 def check_served(task: str, what: str) -> None:
     """Refuse to serve, or to drive over the world protocol, a task judged by its environment's own reward
     (gym-aloha's): the protocol does not carry that reward yet, and a remote episode could not be judged."""
