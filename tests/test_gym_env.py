@@ -116,3 +116,14 @@ def test_an_action_outside_the_action_space_is_a_clear_error(action, message) ->
         assert np.all(np.isfinite(obs["agent_pos"])) and env.world.tick == 1
     finally:
         env.close()
+
+
+@pytest.mark.parametrize("kwargs,field", [
+    ({"max_steps": None}, "max_steps"), ({"max_steps": "10"}, "max_steps"), ({"max_steps": 0}, "max_steps"),
+    ({"max_steps": True}, "max_steps"), ({"image_size": (0, 0)}, "image_size"), ({"image_size": (240,)}, "image_size"),
+    ({"disturb": 42}, "disturb"),
+])
+def test_bad_arguments_are_refused_at_construction_naming_the_argument(kwargs, field):
+    """Each used to be accepted and fail later, at the first step or the first image (issue 58)."""
+    with pytest.raises(ValueError, match=f"^{field}: expected"):
+        AgentChordEnv("single_arm_pour_water", **kwargs)

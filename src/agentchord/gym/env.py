@@ -74,6 +74,14 @@ class AgentChordEnv(gym.Env):
             raise ValueError(f"unknown obs_type {obs_type!r} (choose from: {', '.join(OBS_TYPES)})")
         if render_mode not in (None, "rgb_array"):
             raise ValueError(f"unknown render_mode {render_mode!r} (rgb_array or None)")
+        # What a careless caller passes fails here, named, not at the first step (issue 58).
+        if isinstance(max_steps, bool) or not isinstance(max_steps, int) or max_steps < 1:
+            raise ValueError(f"max_steps: expected a whole number of ticks >= 1, got {max_steps!r}")
+        if (not isinstance(image_size, (tuple, list)) or len(image_size) != 2
+                or not all(isinstance(v, int) and not isinstance(v, bool) and v >= 1 for v in image_size)):
+            raise ValueError(f"image_size: expected (height, width) in pixels, each >= 1, got {image_size!r}")
+        if disturb is not None and not isinstance(disturb, str):
+            raise ValueError(f"disturb: expected None, a protocol ('real', 'stress') or kinds ('drop,pull'), got {disturb!r}")
         self.task = task
         self.disturbances = disturbance_setting(disturb, window)
         self.obs_type = obs_type
