@@ -232,3 +232,24 @@ def test_a_task_without_a_library_graph_is_refused_up_front_not_run(args, tmp_pa
     result = CliRunner().invoke(main, args + (["--out", str(tmp_path / "b")] if args[0] == "bench" else []))
     assert result.exit_code == 2, result.output
     assert "blocks_and_cup" in result.output and "library graph" in result.output
+
+
+def test_run_prints_names_from_a_graph_file_as_written(tmp_path):
+    """Rich markup in a node id or a failure name is printed as text, never interpreted (issue 58)."""
+    import yaml
+
+    from agentchord.library import library_path
+
+    data = yaml.safe_load(library_path("single_arm_pour_water").read_text())
+    data["start"] = "[link=file:///etc/passwd]v0"
+    for node in data["nodes"]:
+        if node["id"] == "v0":
+            node["id"] = data["start"]
+    for edge in data["edges"]:
+        for end in ("source", "target"):
+            if edge[end] == "v0":
+                edge[end] = data["start"]
+    path = tmp_path / "g.yaml"
+    path.write_text(yaml.safe_dump(data))
+    result = CliRunner().invoke(main, ["run", "single_arm_pour_water", "--graph", str(path), "--seed", "1"])
+    assert "[link=file:///etc/passwd]v0" in result.output, result.output

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import click
 from rich.console import Console
+from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
 from agentchord.cli.support import (
@@ -283,8 +284,20 @@ def _write_outputs(console: Console, outputs) -> None:
         raise BadInput("\n".join(failed))
 
 
+def plain(value):
+    """A name or text from a graph file or a model, as it is: Rich markup escaped, control characters shown
+    as escapes (an id ``[link=file:///etc/passwd]e1`` or a failure named with an ANSI sequence prints as written)."""
+    if isinstance(value, str):
+        shown = "".join(ch if ch.isprintable() or ch == " " else ch.encode("unicode_escape").decode("ascii") for ch in value)
+        return escape(shown)
+    if isinstance(value, (list, tuple)):
+        return [plain(item) for item in value]
+    return value
+
+
 def _print_episode(console: Console, result) -> None:
-    for event in result.trace.events:
+    for raw in result.trace.events:
+        event = {key: plain(value) for key, value in raw.items()}
         kind = event["event"]
         tick = f"[dim]{event['tick']:5d}[/dim]"
         if kind == "edge_start":
@@ -334,14 +347,14 @@ def _print_episode(console: Console, result) -> None:
         elif kind == "branch_removed":
             console.print(f"{tick}  forward-moving filter removed {event['failure']} on {event['edge']}: {event['reason']}")
     verdict = "[green]SUCCESS[/green]" if result.success else "[red]FAILURE[/red]"
-    console.print(f"{verdict}: {result.reason}")
+    console.print(f"{verdict}: {plain(result.reason)}")
     console.print(f"steps {result.steps}  robot time {result.time_s:.2f} s  wall {result.wall_s:.2f} s  "
                   f"failures detected {result.failures_detected}  recoveries {result.recoveries}")
     if result.reasoning_calls:
         calls = ", ".join(f"{n} {kind}" for kind, n in result.reasoning_calls.items())
         console.print(f"execution time {result.exec_time_s:.2f} s = robot {result.time_s:.2f} + compute {result.compute_s:.2f} "
                       f"+ reasoning {result.reasoning_s:.2f} s (modelled; calls: {calls}; re-plans {result.replans})")
-    console.print("path: " + " -> ".join(result.path))
+    console.print("path: " + " -> ".join(plain(list(result.path))))
 
 
 @click.command()
