@@ -1,0 +1,453 @@
+"""Label the blind evaluation set (issue 59): the goal each instruction means, written to labels.yaml.
+
+The four writers' files (writer_A.yaml ... writer_D.yaml) hold 210 instructions, each with the
+writer's own ``meaning`` (the intended end state) and ``possible``. This script states, per id, the
+goal the instruction means as a goal spec's goals (``agentchord schema goal``), written with the
+label helpers of ../build_corpus.py and its conventions (docs/language.md): ``put X down``/``back``
+is ``placed`` with no place; ``beside``/``next to`` is ``rel()`` (the side the object is on; a flat
+utensil beside a flat anchor at 17 cm, turned along y); ``move X left|right|nearer`` a bit is
+``nudge()`` (10 cm), and ``forward`` for the coffee tray is its ``forward`` region; an object still
+held when the instruction ends is put back where it was, by the arm that holds it (``complete()``);
+an arm is in a goal only when it is said for that clause (an arm addressed as a heading, ``Right
+arm: a, b, c``, is said for every step under it) or the object was taken or handed over by a
+said arm. ``refused`` where the scene cannot do what is asked (an object, place or action it lacks)
+or the goal language cannot say it (the reason is in ``WHY``).
+
+Labelling policy for amounts: ``poured`` states no amount, so a vague amount (``some``, ``a
+little``, ``a splash``, ``fill it up``) is a pour; a stated fraction (``about half``, ``till it's
+half full``) cannot be said and is refused.
+
+The labels were written from the instructions and the writers' meanings only: no composer, planner
+or benchmark was run on the instructions. Each goal list is validated as a ``GoalSpec`` and checked
+against its scene (``goal_problems``: the objects and regions exist, things fit).
+
+    .venv/bin/python tests/data/language/blind/build_labels.py   # rewrites labels.yaml
+"""
+
+from __future__ import annotations
+
+import sys
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+HERE = Path(__file__).parent
+sys.path.insert(0, str(HERE.parent))
+
+from build_corpus import (
+    REFUSE,
+    _Dumper,
+    _Flow,
+    _scene,
+    at,
+    complete,
+    fold,
+    hand,
+    into,
+    nudge,
+    on,
+    pour,
+    put,
+    region,
+    rel,
+)
+
+from agentchord.agents.observe import observe, task_regions
+from agentchord.agents.rules.feasibility import goal_problems
+from agentchord.agents.rules.goals import GoalSpec
+from agentchord.sim.tasks import SIM_TASKS
+from agentchord.sim.world import SimWorld
+
+P1, P2, T, H, C, W, B = (
+    "single_arm_pour_water",
+    "dual_arm_pour_water",
+    "rearrange_table",
+    "handover_block",
+    "setup_coffee_tray",
+    "fold_towel",
+    "blocks_and_cup",
+)
+
+
+def at_xy(obj: str, x: float, y: float, arm: str | None = None) -> dict:
+    """``obj`` placed at a table point (m) that no region word names (another object's spot, beside a region)."""
+    goal = {"kind": "placed", "obj": obj, "at": [round(x, 3), round(y, 3)]}
+    if arm:
+        goal["arm"] = arm
+    return goal
+
+
+def spot(task: str, obj: str) -> tuple[float, float]:
+    """Where ``obj`` stands at the start (the scene the labels are written in: seed 0)."""
+    pos = _scene(task)[obj].pos
+    return round(float(pos[0]), 3), round(float(pos[1]), 3)
+
+
+def beside_region(task: str, obj: str, name: str, arm: str | None = None) -> dict:
+    """``obj`` placed just beside (outside) a named region, on the side the object is on: the
+    region's radius, the object's half-size and the 4 cm gap of ``rel()``."""
+    reg = next(r for r in task_regions(SIM_TASKS[task]) if r.name == name)
+    o = _scene(task)[obj]
+    d = reg.radius + 0.5 * max(o.extent[:2]) + 0.04
+    side = -1.0 if o.pos[0] < reg.center[0] else 1.0
+    return at_xy(obj, reg.center[0] + side * d, reg.center[1], arm)
+
+
+# Frequently meant goals.
+POUR1 = [pour(), put("bottle")]
+POUR2 = [pour(hold=True), put("cup"), put("bottle")]
+#: The dual pour with the cup lifted by the left arm and the right arm pouring (the bottle's put-down
+#: has no arm: it was not taken by a said arm, the pour was; as corpus_test's hand entries).
+POUR2_LR = [pour(arm="right", hold=True), put("cup", "left"), put("bottle")]
+FORK_L = rel(T, "fork", "plate", "left")
+SPOON_R = rel(T, "spoon", "plate", "right")
+SETTING = [FORK_L, SPOON_R]
+SETTING_ARMS = [rel(T, "fork", "plate", "left", "left"), rel(T, "spoon", "plate", "right", "right")]
+HANDOVER = [hand("block"), region("block", "target", "right")]
+COFFEE = [into("capsule", "tray"), region("tray", "forward")]
+COFFEE_LEFT = [into("capsule", "tray", "left"), region("tray", "forward")]
+CAPSULE_HANDOVER = [hand("capsule"), into("capsule", "tray", "right")]
+FOLD = [fold()]
+TARGET = [region("block", "target")]
+TRAY_FWD = [region("tray", "forward")]
+
+LABELS: dict[str, object] = {
+    # --- writer A ----------------------------------------------------------------------------
+    # "right arm:" heads the whole instruction: said for the put-down too.
+    "A-001": [pour(arm="right"), put("bottle", "right")],
+    "A-002": POUR1,  # "some water": no amount to state (policy above)
+    "A-003": POUR1,
+    "A-004": POUR1,  # "fill the cup up a little": a vague amount, a pour
+    "A-005": REFUSE,
+    "A-006": REFUSE,
+    # The left arm picks the bottle up (said), pours, and stands it beside the cup (on the side it is on: right).
+    "A-007": [pour(arm="left"), rel(P1, "bottle", "cup", "beside", "left")],
+    "A-008": POUR2_LR,
+    "A-009": POUR2_LR,
+    "A-010": POUR2,
+    "A-011": POUR2,  # "do the pour with the cup held up": hold_target, arms unsaid
+    "A-012": POUR2,
+    "A-013": POUR2_LR,
+    "A-014": [pour(arm="left", hold=True), put("cup", "right"), put("bottle")],
+    "A-015": SETTING,
+    "A-016": SETTING_ARMS,
+    "A-017": SETTING,
+    "A-018": [SPOON_R],
+    "A-019": SETTING,
+    "A-020": [on("spoon", "plate")],
+    "A-021": REFUSE,
+    "A-022": HANDOVER,
+    "A-023": HANDOVER,
+    "A-024": HANDOVER,  # "via handover": left to right (the block is on the left, the target on the right)
+    "A-025": HANDOVER,
+    # "then just hold it there": the end state (the block held in the air) cannot be said: every
+    # goal spec ends with the arms at home and the convention puts a held object back down.
+    "A-026": REFUSE,
+    "A-027": TARGET,
+    "A-028": REFUSE,
+    "A-029": COFFEE,
+    "A-030": COFFEE_LEFT,
+    "A-031": COFFEE,  # "farther back" = away from the robot (the writer's meaning): the forward spot
+    "A-032": COFFEE,
+    "A-033": [into("capsule", "tray")],
+    # "forward about 10 cm": the scene's forward spot (12 cm away; the direction names the region).
+    "A-034": TRAY_FWD,
+    "A-035": CAPSULE_HANDOVER,
+    "A-036": FOLD,
+    "A-037": FOLD,
+    "A-038": FOLD,  # the natural fold: near corners onto far corners
+    "A-039": FOLD,
+    "A-040": FOLD,
+    "A-041": FOLD,
+    "A-042": REFUSE,
+    "A-043": REFUSE,
+    "A-044": [into("red_block", "cup")],
+    "A-045": [on("blue_block", "red_block")],
+    "A-046": [into("red_block", "cup"), into("blue_block", "cup")],
+    # Handed right -> left, then the left arm puts it beside the red cube (on its right, the side it is on).
+    "A-047": [hand("blue_block", "right", "left"), rel(B, "blue_block", "red_block", "beside", "left")],
+    "A-048": [on("red_block", "blue_block"), nudge(B, "cup", "right")],  # "over to the right a bit": a nudge
+    "A-049": [into("blue_block", "cup")],
+    # "way over to the left" / "over to the right side": the table's side points (the red block is
+    # already near the left side point; no farther place is sayable without inventing coordinates).
+    "A-050": [at("red_block", "left"), at("blue_block", "right")],
+    # --- writer B ----------------------------------------------------------------------------
+    "B-001": POUR1,
+    "B-002": [pour(arm="right"), put("bottle", "right")],  # the right hand takes the bottle
+    "B-003": [pour(arm="right"), put("bottle", "right")],  # "right arm:" heads grab, pour, set down
+    "B-004": POUR1,  # "just a little ... don't overflow": a vague amount, a pour
+    "B-005": [rel(P1, "cup", "bottle")],  # next to the bottle, on its left (where the cup is)
+    "B-006": REFUSE,
+    "B-007": [rel(P1, "bottle", "cup", "left")],
+    # "pour water into it with the bottle in your right hand": the right arm pours; the bottle's
+    # put-down has no arm (it was not taken in a clause of its own).
+    "B-008": POUR2_LR,
+    "B-009": POUR2_LR,
+    # "You can hold the cup up ... if that's easier": optional, so no hold_target; the cup never
+    # moves, the bottle goes back.
+    "B-010": POUR1,
+    "B-011": [hand("cup", "left", "right"), rel(P2, "cup", "bottle", "beside", "right")],
+    # Swap the two places: absolute points (each the other's start). Expressible as the end state,
+    # though the planner has to clear the cup's spot first.
+    "B-012": [at_xy("bottle", *spot(P2, "cup")), at_xy("cup", *spot(P2, "bottle"))],
+    "B-013": POUR2,  # "one in each hand": no arm named for which
+    # Held cup, a little water (a pour), then the cup put down "a bit more to the left" (a nudge
+    # from where it stood) and the bottle back.
+    "B-014": [pour(hold=True), nudge(P2, "cup", "left"), put("bottle")],
+    "B-015": SETTING,
+    "B-016": SETTING_ARMS,
+    "B-017": SETTING,
+    "B-018": [on("spoon", "plate"), on("fork", "plate")],
+    # "to the left side, near to the fork": beside the fork (its right side, where the spoon comes
+    # from); by the helper's flat-anchor rule that is 17 cm and turned along y.
+    "B-019": [rel(T, "spoon", "fork")],
+    # "a bit closer to the plate": the writer means near (left of) the plate: beside it.
+    "B-020": [FORK_L],
+    "B-021": REFUSE,
+    "B-022": HANDOVER,
+    "B-023": HANDOVER,
+    "B-024": TARGET,
+    "B-025": REFUSE,
+    "B-026": [hand("block"), put("block", "right")],  # back where it was, by the right arm
+    # "next to the target, not on it": the target is a region, not an object, so beside it is an
+    # absolute point just outside its radius, on the side the block comes from (the left).
+    "B-027": [hand("block"), beside_region(H, "block", "target", "right")],
+    "B-028": REFUSE,
+    "B-029": COFFEE,
+    "B-030": COFFEE_LEFT,
+    "B-031": [into("capsule", "tray")],
+    "B-032": TRAY_FWD,
+    "B-033": COFFEE,
+    "B-034": CAPSULE_HANDOVER,
+    "B-035": REFUSE,
+    "B-036": FOLD,
+    "B-037": FOLD,
+    "B-038": FOLD,
+    "B-039": FOLD,
+    "B-040": FOLD,
+    "B-041": REFUSE,
+    "B-042": REFUSE,
+    "B-043": [into("red_block", "cup")],
+    "B-044": [into("red_block", "cup"), into("blue_block", "cup")],
+    "B-045": [on("red_block", "blue_block")],
+    "B-046": [rel(B, "red_block", "cup", "left", "left"), rel(B, "blue_block", "cup", "right", "right")],
+    "B-047": [nudge(B, "blue_block", "right")],  # "to the right a bit, maybe 10 cm": the 10 cm nudge
+    # The blue block into the cup, then the cup (with it) onto the red block: expressible; the writer
+    # means it (a 9 cm bowl on a 4 cm cube is precarious).
+    "B-048": [into("blue_block", "cup"), on("cup", "red_block")],
+    "B-049": [hand("red_block"), into("red_block", "cup", "right")],
+    "B-050": [rel(B, "red_block", "blue_block", "behind")],
+    # --- writer C ----------------------------------------------------------------------------
+    "C-001": [pour(arm="right"), put("bottle", "right")],  # "Right arm, grab the bottle, ...": said for every step
+    "C-002": POUR1,
+    "C-003": REFUSE,
+    "C-004": [pour(arm="left"), put("bottle")],  # "use the left arm to pour ..., and leave the bottle ...": the pour's arm
+    # "a bit closer to the bottle": a nudge towards it (the bottle is to the cup's right), not beside it.
+    "C-005": [nudge(P1, "cup", "right"), pour(arm="right"), put("bottle")],
+    "C-006": POUR1,
+    "C-007": REFUSE,
+    "C-008": [hand("bottle", "right", "left"), pour(arm="left"), put("bottle", "left")],
+    # "Then both of you set them back down": each arm its own object (the writer's meaning).
+    "C-009": [pour(arm="right", hold=True), put("cup", "left"), put("bottle", "right")],
+    "C-010": POUR2,
+    # Nothing said about putting down: by the convention the held cup and bottle go back, each by
+    # the arm holding it (the writer's meaning would end with the cup still held: not sayable).
+    "C-011": POUR2_LR,
+    "C-012": POUR2,
+    # Both taken by said arms: the right arm pours, each puts its own back.
+    "C-013": [pour(arm="right", hold=True), put("cup", "left"), put("bottle", "right")],
+    "C-014": REFUSE,
+    # End state only; "back standing in the same spot" could hint the cup was lifted, but the writer
+    # says holding is not specified: the plain pour, the bottle back.
+    "C-015": POUR1,
+    "C-016": SETTING_ARMS,
+    "C-017": SETTING,
+    "C-018": SETTING,
+    "C-019": SETTING,
+    "C-020": [on("spoon", "plate")],
+    "C-021": [rel(T, "fork", "plate", "right"), rel(T, "spoon", "plate", "left")],
+    "C-022": REFUSE,
+    "C-023": HANDOVER,
+    "C-024": HANDOVER,
+    "C-025": HANDOVER,
+    "C-026": TARGET,
+    "C-027": HANDOVER,
+    "C-028": [region("block", "target", "right")],  # right arm only, no handover
+    "C-029": HANDOVER,  # "pull the right arm back": the arms end at home (home: true)
+    "C-030": COFFEE_LEFT,
+    "C-031": COFFEE,
+    "C-032": COFFEE,  # "forward about ten centimetres": the forward spot (12 cm)
+    "C-033": COFFEE,
+    "C-034": TRAY_FWD,
+    "C-035": CAPSULE_HANDOVER,
+    "C-036": REFUSE,
+    "C-037": FOLD,
+    "C-038": FOLD,
+    "C-039": FOLD,
+    "C-040": FOLD,
+    "C-041": FOLD,
+    "C-042": REFUSE,
+    "C-043": FOLD,
+    "C-044": [into("red_block", "cup")],
+    "C-045": [into("blue_block", "cup", "right"), into("red_block", "cup", "left")],
+    "C-046": [on("red_block", "blue_block")],
+    "C-047": [hand("blue_block", "right", "left"), rel(B, "blue_block", "red_block", "beside", "left")],
+    "C-048": [into("red_block", "cup"), into("blue_block", "cup")],  # "the bowl": the bowl-like white cup
+    "C-049": REFUSE,
+    "C-050": [nudge(B, "cup", "left"), into("blue_block", "cup")],
+    # --- writer D ----------------------------------------------------------------------------
+    "D-001": [pour(arm="right"), put("bottle")],  # "Using your right arm, pour ..., then stand ...": the pour's arm
+    "D-002": POUR1,
+    "D-003": [pour(arm="right"), put("bottle", "right")],  # "R arm:" heads grab, pour, put back
+    "D-004": POUR1,
+    "D-005": POUR1,
+    "D-006": REFUSE,
+    "D-007": [rel(P1, "cup", "bottle")],
+    "D-008": REFUSE,
+    "D-009": POUR2_LR,
+    "D-010": POUR2,
+    "D-011": POUR2_LR,
+    "D-012": POUR2,
+    # Both taken by said arms; "fill the cup up": a pour (no amount); "put them down side by side":
+    # the cup back by the left arm, the bottle beside it (on its right, the side it is on) by the right.
+    "D-014": [pour(arm="right", hold=True), put("cup", "left"), rel(P2, "bottle", "cup", "beside", "right")],
+    "D-013": POUR2_LR,
+    "D-015": [pour(arm="right"), hand("bottle", "right", "left"), at("bottle", "left", "left")],
+    "D-016": [rel(P2, "bottle", "cup")],  # moved left to be right beside the cup: on the cup's right
+    "D-017": SETTING,
+    "D-018": SETTING_ARMS,
+    "D-019": SETTING,
+    "D-020": SETTING,
+    "D-021": [on("spoon", "plate")],
+    "D-022": SETTING,  # orientation unsaid: the setting convention (turned along y) still applies
+    "D-023": [hand("spoon", "right", "left"), rel(T, "spoon", "plate", "left", "left")],
+    "D-024": REFUSE,
+    "D-025": HANDOVER,
+    "D-026": HANDOVER,
+    "D-027": TARGET,
+    "D-028": HANDOVER,
+    "D-029": TARGET,
+    "D-030": HANDOVER,
+    "D-031": [nudge(H, "block", "front")],  # "a little closer to you": 10 cm towards the robot
+    "D-032": REFUSE,
+    "D-033": COFFEE,
+    "D-034": COFFEE_LEFT,
+    "D-035": COFFEE,
+    "D-036": [into("capsule", "tray")],
+    "D-037": TRAY_FWD,
+    "D-038": COFFEE,
+    "D-039": COFFEE_LEFT,
+    "D-040": REFUSE,
+    "D-041": FOLD,
+    "D-042": FOLD,
+    "D-043": FOLD,
+    "D-044": FOLD,
+    "D-045": FOLD,
+    "D-046": FOLD,
+    "D-047": REFUSE,
+    "D-048": REFUSE,
+    "D-049": [into("red_block", "cup")],
+    "D-050": [into("blue_block", "cup"), into("red_block", "cup")],
+    "D-051": [on("red_block", "blue_block")],
+    "D-052": [on("blue_block", "red_block")],
+    "D-053": [rel(B, "red_block", "cup", "left")],
+    # The left side point of the table is close to the red block (4 cm): the convention's point all the same.
+    "D-054": [hand("blue_block", "right", "left"), at("blue_block", "left", "left")],
+    "D-055": [into("red_block", "cup"), into("blue_block", "cup")],  # order unsaid: as named ("both blocks")
+    "D-056": REFUSE,
+    "D-057": [into("red_block", "cup"), rel(B, "blue_block", "cup", "right")],
+    # The blue block already stands in front of the cup: the red one to its left makes the two side
+    # by side in front of the cup, red on the left (moving both to new points would say the same less simply).
+    "D-058": [rel(B, "red_block", "blue_block", "left")],
+    "D-059": [nudge(B, "cup", "front"), into("blue_block", "cup")],
+    "D-060": REFUSE,
+}
+
+#: Why each refused entry is refused.
+WHY = {
+    "A-005": "'pour about half into cup': a stated fraction of the water; poured states no amount",
+    "A-006": "no milk in the scene (only a bottle of water)",
+    "A-021": "no knife in the scene",
+    "A-026": "'then just hold it there': an end with the block held in the air cannot be said (a goal spec ends at home, a held object is put back)",
+    "A-028": "no cup in the handover scene",
+    "A-042": "a side fold (left half onto right half): folded is only near corners onto far corners",
+    "A-043": "no laundry basket in the scene",
+    "B-006": "no glass jug in the scene (the writer means a second vessel, not the bottle)",
+    "B-021": "no knife in the scene",
+    "B-025": "'hold it in the air ... don't put it anywhere': an end with the block held cannot be said",
+    "B-028": "no green block in the scene",
+    "B-035": "brewing coffee: no coffee machine, not a goal",
+    "B-041": "moving the whole towel flat to the left: the cloth is only its corner points and folded; no goal moves a cloth",
+    "B-042": "folding twice (quarters) and a drawer: neither in the scene nor sayable",
+    "C-003": "'till it's about half full': a stated amount; poured states no amount",
+    "C-007": "no fridge in the scene",
+    "C-014": "no orange juice or carton in the scene",
+    "C-022": "no knife in the scene",
+    "C-036": "no coffee machine in the scene",
+    "C-042": "a side fold (left to right): folded is only near corners onto far corners",
+    "C-049": "no green block in the scene",
+    "D-006": "'till it's about half full': a stated amount; poured states no amount",
+    "D-008": "no bowl in the pouring scene",
+    "D-024": "no knife in the scene",
+    "D-032": "no green block in the scene",
+    "D-040": "no coffee machine; brewing is not a goal",
+    "D-047": "one corner laid on another by one arm (a partial fold): folded is both near corners onto the far corners",
+    "D-048": "no drawer in the scene",
+    "D-056": "into the cup and out again: goals are kept once achieved, so a put-in undone later cannot be said (the end state is the start)",
+    "D-060": "no water in this scene",
+}
+
+HEADER = """# Labels of the blind evaluation set (issue 59). Built by build_labels.py; do not edit by hand.
+#
+# For each instruction of writer_A.yaml ... writer_D.yaml (210): its scene, and the goal it means
+# as a goal spec's goals (`agentchord schema goal`), or expect: refused with why (the scene cannot
+# do it, or the goal language cannot say it). Written from the instruction and the writer's
+# `meaning` by a labeller who did not write them, following build_corpus.py's label conventions
+# (docs/language.md), without running the composer on them. Each goal is a valid GoalSpec and
+# names only its scene's objects and regions (the seed-0 scene).
+"""
+
+
+def _scene_obs(task: str):
+    sim = SIM_TASKS[task]
+    return observe(SimWorld(sim.sample_scene(np.random.default_rng([0, 0x5CE7E]))), task_regions(sim))
+
+
+def main() -> None:
+    entries = []
+    for name in ("A", "B", "C", "D"):
+        entries += yaml.safe_load((HERE / f"writer_{name}.yaml").read_text(encoding="utf-8"))["entries"]
+    ids = [e["id"] for e in entries]
+    assert len(ids) == len(set(ids)) == 210, len(ids)
+    assert set(LABELS) == set(ids), (set(ids) - set(LABELS), set(LABELS) - set(ids))
+    assert set(WHY) == {k for k, v in LABELS.items() if v == REFUSE}, set(WHY) ^ {k for k, v in LABELS.items() if v == REFUSE}
+    scenes: dict = {}
+    labels: dict[str, dict] = {}
+    counts: Counter = Counter()
+    for entry in entries:
+        eid, task, label = entry["id"], entry["scene"], LABELS[entry["id"]]
+        if label == REFUSE:
+            labels[eid] = {"scene": task, "expect": "refused", "why": WHY[eid]}
+            counts[eid[0], "refused"] += 1
+            continue
+        if not entry["possible"]:
+            print(f"note: {eid} labelled though the writer marked it impossible")
+        goals = complete([dict(g) for g in label])
+        spec = GoalSpec(goals=goals)  # raises on an invalid goal
+        if task not in scenes:
+            scenes[task] = _scene_obs(task)
+        problems = goal_problems(spec, scenes[task])
+        assert not problems, (eid, problems)
+        labels[eid] = {"scene": task, "goal": [_Flow(g) for g in goals]}
+        counts[eid[0], "labelled"] += 1
+    text = yaml.dump({"labels": labels}, Dumper=_Dumper, sort_keys=False, width=200, allow_unicode=True)
+    (HERE / "labels.yaml").write_text(HEADER + text, encoding="utf-8")
+    for name in "ABCD":
+        print(f"writer {name}: {counts[name, 'labelled']} labelled, {counts[name, 'refused']} refused")
+    print(f"labels.yaml: {len(labels)} entries")
+
+
+if __name__ == "__main__":
+    main()
