@@ -128,3 +128,28 @@ def test_sigterm_during_run_video_exits_143_without_traceback_or_temporary_file(
     assert done.returncode == EXIT_TERMINATED, (done.returncode, done.stderr)
     assert done.stderr.strip() == "agentchord: terminated"
     assert list(tmp_path.iterdir()) == []
+
+
+def test_an_argument_that_is_not_utf8_is_refused_before_any_command_reads_it():
+    """Issue 58: non-UTF-8 bytes in argv (Python hands them over as lone surrogates) made the error
+    handler itself crash writing its log: two tracebacks, exit 1, an empty log."""
+    from click.testing import CliRunner
+
+    from agentchord.cli import main
+
+    result = CliRunner().invoke(main, ["run", "single_arm_pour_water", "--instruction", "pour \udcff the bottle"])
+    assert result.exit_code == 2
+    assert "argument 4 ('pour \\xff the bottle') is not valid UTF-8: byte 0xFF" in result.output
+    assert result.exception is None or isinstance(result.exception, SystemExit)
+
+
+def test_the_error_log_is_written_whatever_argv_holds(tmp_path, monkeypatch):
+    from agentchord.cli.support import write_error_log
+
+    monkeypatch.setenv("AGENTCHORD_LOG_DIR", str(tmp_path))
+    monkeypatch.setattr("sys.argv", ["agentchord", "plan", "\udcff\ud800"])
+    try:
+        raise RuntimeError("boom")
+    except RuntimeError as error:
+        log = write_error_log(error)
+    assert log is not None and "RuntimeError: boom" in log.read_text() and "\\udcff" in log.read_text()

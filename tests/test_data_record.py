@@ -349,3 +349,35 @@ def test_record_killed_after_two_episodes_and_rerun_has_four_that_lerobot_loads(
     got = json.loads(run.stdout.strip().splitlines()[-1])
     assert got["episodes"] == 4 and got["frames"] == _info(root)["total_frames"] and got["last_episode"] == 3
     assert got["image_shape"] == [3, 48, 64]
+
+
+_HOLD_RECORDING = """
+import sys, time
+from agentchord.guard.locks import lock_folder
+lock_folder(sys.argv[1], ".record.lock", "recording")
+print("locked", flush=True)
+time.sleep(30)
+"""
+
+
+def test_a_second_record_on_the_same_folder_is_refused_naming_the_first(tmp_path: Path) -> None:
+    """Issue 58: the same ``record`` started twice on one --out failed with a misleading "No such file or
+    directory", and the dataset then paired episodes with other episodes' videos."""
+    import subprocess
+    import sys
+
+    from click.testing import CliRunner
+
+    from agentchord.cli import main
+
+    out = tmp_path / "ds"
+    holder = subprocess.Popen([sys.executable, "-c", _HOLD_RECORDING, str(out)], stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "locked"
+        result = CliRunner().invoke(main, ["record", TASK, "--episodes", "1", "--out", str(out), "--camera", "none"])
+    finally:
+        holder.kill()
+        holder.wait(10)
+    assert result.exit_code == 2, result.output
+    assert f"another recording is running on this folder (pid {holder.pid}" in result.output
+    assert sorted(p.name for p in out.iterdir()) == [".record.lock"]

@@ -88,3 +88,76 @@ def test_the_control_loop_does_not_run_ahead_of_a_pending_reply():
     arrival = plan.poll(5.0)  # the loop would be 5 s ahead: it waits for the reply instead
     assert arrival is not None and 0.25 < time.perf_counter() - started < 2.0
     assert arrival.latency_s == pytest.approx(0.3, abs=0.15) and clock == [0.0]
+
+
+def _composer_then(server_reply, monkeypatch):
+    """A replay server whose first answer is the rules composer's reply for TASK, every later one ``server_reply``."""
+    from replay_server import HttpError  # noqa: F401 -- re-exported for the callers' replies
+
+    instruction = load_task_graph(TASK).instruction
+    rules = RulesReasoner()
+    plan_task(instruction, observe(open_world(TASK, 0), task_regions(SIM_TASKS[TASK])), rules, TASK)
+    composed = json.dumps(rules.calls[0].reply)
+    answered = []
+
+    def respond(body):
+        answered.append(body)
+        return Completion(composed) if len(answered) == 1 else server_reply
+
+    server = ReplayServer(respond)
+    monkeypatch.setenv("AGENTCHORD_LLM_MODEL", "replay-model")
+    monkeypatch.setenv("AGENTCHORD_LLM_API_KEY", "test-key")
+    return instruction, server
+
+
+@pytest.mark.parametrize("fallback", [True, False])
+def test_an_arranger_outage_never_leaves_the_robot_blind(monkeypatch, fallback):
+    """Issue 58: the arranger answering HTTP 500 until it gives up. Before, from that moment no monitor was
+    armed and a bottle dropped during the pour was never detected (the episode ended later, "bottle is not
+    held", 0 failures detected). Now the offline arranger writes the branches and the robot recovers; or,
+    without that fallback, the derived monitors catch the drop and the reason names the plan's failure."""
+    from replay_server import HttpError
+
+    instruction, server = _composer_then(HttpError(500, "upstream down"), monkeypatch)
+    with server:
+        monkeypatch.setenv("AGENTCHORD_LLM_BASE_URL", server.base_url)
+        result = run_episode(EpisodeSpec(TASK, seed=0, instruction=instruction, reasoner="llm", repair=False,
+                                         reasoning=ReasoningConfig(), disturbance=ScriptedDrop("rotate_eef", after=20),
+                                         arranger_fallback=fallback))
+    (replied,) = result.trace.of("plan_replied")
+    assert "500" in replied["error"] and replied["outage"]
+    assert result.drops_injected == 1 and result.drops_detected == 1, result.reason
+    if fallback:
+        assert replied["fallback"] == "rules" and result.trace.of("plan_arrived")[0]["written_by"] == "rules"
+        assert result.success and result.recoveries >= 1, result.reason
+    else:
+        assert not result.success and "the arranger's plan failed" in result.reason and "500" in result.reason
+        assert result.trace.of("unrecovered") and not result.trace.of("plan_arrived")
+
+
+def test_a_plan_that_fails_while_a_failure_waits_for_its_branch_ends_with_the_reason():
+    """Issue 58: a derived monitor caught the drop, the arms waited for the branch, then the arranger failed:
+    the trace said "no failure mode of the edge is violated: the edge goes on" with the bottle on the table.
+    Now the wait ends with the failure unrecovered and the plan's error as the reason."""
+    from agentchord.agents.prompts import nominal_part
+
+    error = "ReasonerTransportError: the arranger's endpoint answered HTTP 500 after 3 tries"
+    result = run_episode(EpisodeSpec(TASK, seed=0, graph=nominal_part(load_task_graph(TASK)), reasoning=ReasoningConfig(),
+                                     disturbance=ScriptedDrop("move_to_obj", after=5),
+                                     background=ScriptedPlan(6.0, None, error=error, outage=True)))
+    (arrived,) = result.trace.of("branch_arrived")
+    assert "edge goes on" not in arrived["then"] and "plan failed" in arrived["then"]
+    assert not result.success and "HTTP 500" in result.reason
+    assert result.failures_detected == 1 and result.drops_detected == 1
+
+
+def test_after_a_failed_plan_every_nominal_edge_keeps_its_derived_monitors():
+    from agentchord.agents.prompts import nominal_part
+
+    result = run_episode(EpisodeSpec(TASK, seed=0, graph=nominal_part(load_task_graph(TASK)), reasoning=ReasoningConfig(),
+                                     background=ScriptedPlan(0.5, None, error="ReasonerError: no valid reply")))
+    assert result.success, result.reason  # undisturbed: the composed graph is enough
+    (failed,) = result.trace.of("plan_failed")
+    assert failed["tick"] == 25 and not failed["outage"]  # taken at the tick it arrives, not when polled
+    armed = [e for e in result.trace.of("monitors_armed") if e["tick"] >= failed["tick"]]
+    assert armed and all(all(m.startswith("keeps: ") for m in e["monitors"]) for e in armed)

@@ -352,3 +352,23 @@ def test_the_goal_is_judged_once_the_scene_comes_to_rest_within_the_settle_time(
     assert len(result.trace.of("goal_settling")) == (1 if moving_for else 0)
     if not success:
         assert result.reason == "the bottle is still moving"
+
+
+def test_ticks_held_still_for_the_plan_do_not_count_against_the_tick_limit():
+    """Issue 58: with a slow model (``--latency rate=5``) AgentChord held still for a branch and ended at the
+    tick limit, while the sequential plan waited before moving and succeeded. The limit is for the robot's
+    work: here the branch comes 40 s in, the episode runs 54 s, and the 30 s limit is not reached."""
+    from agentchord.agents.prompts import nominal_part
+    from agentchord.episode import EpisodeSpec, run_episode
+    from agentchord.execution.background import ScriptedPlan
+    from agentchord.execution.executor import ExecutorConfig
+    from agentchord.execution.reasoning import ReasoningConfig
+    from agentchord.library import load_task_graph
+    from agentchord.sim.disturbances import ScriptedDrop
+
+    graph = load_task_graph("single_arm_pour_water")
+    result = run_episode(EpisodeSpec("single_arm_pour_water", seed=0, graph=nominal_part(graph), reasoning=ReasoningConfig(),
+                                     config=ExecutorConfig(tick_limit=1500), disturbance=ScriptedDrop("move_to_obj", after=5),
+                                     background=ScriptedPlan(40.0, graph)))
+    assert result.success, result.reason
+    assert result.steps > 1500 and result.steps - 50 * result.plan_wait_s < 1500

@@ -127,3 +127,16 @@ def test_bad_arguments_are_refused_at_construction_naming_the_argument(kwargs, f
     """Each used to be accepted and fail later, at the first step or the first image (issue 58)."""
     with pytest.raises(ValueError, match=f"^{field}: expected"):
         AgentChordEnv("single_arm_pour_water", **kwargs)
+
+
+def test_human_rendering_without_pygame_is_refused_at_make(monkeypatch):
+    """Issue 58: ``render_mode="human"`` was accepted by ``make``, then ``reset`` failed for want of pygame."""
+    import sys
+
+    import gymnasium
+
+    import agentchord.gym  # noqa: F401 -- registers the ids
+
+    monkeypatch.setitem(sys.modules, "pygame", None)  # as if not installed: importing it raises ImportError
+    with pytest.raises(gymnasium.error.DependencyNotInstalled, match="render_mode='rgb_array'"):
+        gymnasium.make("agentchord/BlocksAndCup-v0", render_mode="human")

@@ -5,12 +5,13 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from agentchord.agents.exceptions import ReasonerError
 from agentchord.agents.observe import observe, task_regions
 from agentchord.agents.pipeline import ReasonerRepairer, Replanner, augment_task, compose_task, make_reasoner, plan_task
 from agentchord.agents.scene import Scene
 from agentchord.agents.rules.goals import GoalSpec
 from agentchord.execution.baselines.progress import GoalEvents
-from agentchord.execution.background import ScriptedPlan, ThreadedPlan
+from agentchord.execution.background import FallbackPlan, ScriptedPlan, ThreadedPlan
 from agentchord.execution.baselines.strategies import BaselineContext
 from agentchord.execution.executor import Executor, ExecutorConfig
 from agentchord.harness import UNDISTURBED, Disturbance, DisturbanceSetting, SuccessTracker
@@ -18,6 +19,7 @@ from agentchord.execution.methods import PIPELINED_METHODS, is_baseline, make_me
 from agentchord.execution.reasoning import ReasoningConfig
 from agentchord.execution.repair import Repairer
 from agentchord.execution.result import EpisodeResult
+from agentchord.graph.exceptions import GraphNotRunnableError
 from agentchord.graph.grounding import require_runnable
 from agentchord.graph.models import Success, TaskGraph
 from agentchord.library import load_task_graph
@@ -54,6 +56,10 @@ class EpisodeSpec:
             ``agentchord serve``); None: the simulator in this process. Same seed, same episode.
         background: The rest of a pipelined plan, known in advance (``graph`` is then the composed
             graph the robot starts on): an LLM episode's latencies replayed offline.
+        arranger_fallback: When a pipelined LLM plan's arranger or conductor fails (the endpoint down,
+            every reply refused), the offline ones write the branches instead; off, the robot goes on
+            with the monitors derived from the edges' constraints only (``bench``: an outage is an
+            error to rerun, not a result).
     """
 
     task: str
@@ -72,6 +78,7 @@ class EpisodeSpec:
     reasoning: ReasoningConfig | None = None
     world: str | None = None
     background: ScriptedPlan | None = None
+    arranger_fallback: bool = True
 
     @property
     def planned(self) -> bool:
@@ -116,7 +123,7 @@ def _run_in(world: World, spec: EpisodeSpec, on_tick: Callable[[Executor], None]
             # The robot starts on the composed graph; the arranger and conductor answer while it moves.
             graph = compose_task(spec.instruction or "", first_scene, reasoner, task=spec.task)
             calls = list(reasoner.calls)
-            background = ThreadedPlan(_augmenting(graph, first_scene, reasoner, world, spec.task))
+            background = ThreadedPlan(_augmenting(graph, first_scene, reasoner, world, spec.task, spec.arranger_fallback))
         else:
             planned = plan_task(spec.instruction or "", first_scene, reasoner, task=spec.task)
             graph, calls = planned.graph, planned.calls
@@ -156,14 +163,30 @@ def _run_in(world: World, spec: EpisodeSpec, on_tick: Callable[[Executor], None]
     return result
 
 
-def _augmenting(nominal: TaskGraph, scene: Scene, reasoner, world: World, task: str):
+def _augmenting(nominal: TaskGraph, scene: Scene, reasoner, world: World, task: str, fallback: bool = True):
     """The background work of a pipelined LLM plan: arranger, filter, conductor, then the same checks a
-    graph passes before it runs (a failure is the episode's to survive, not a crash)."""
+    graph passes before it runs (a failure is the episode's to survive, not a crash).
+
+    With ``fallback``, a plan that fails (the endpoint down, every reply refused) is written by the
+    offline arranger and conductor instead, if they can (:class:`FallbackPlan`: the trace names the
+    LLM's error and who wrote the branches); if they cannot either, the LLM's failure stands.
+    """
+    names = [*world.object_names, *world.cloth_point_names]
 
     def work() -> tuple[TaskGraph, list]:
         first = len(reasoner.calls)
-        planned = augment_task(nominal, scene, reasoner)
-        require_runnable(planned.graph, [*world.object_names, *world.cloth_point_names], task, "planned graph")
+        try:
+            planned = augment_task(nominal, scene, reasoner)
+            require_runnable(planned.graph, names, task, "planned graph")
+        except (ReasonerError, GraphNotRunnableError) as error:
+            if not fallback:
+                raise
+            try:
+                offline = augment_task(nominal, scene, make_reasoner("rules"))
+                require_runnable(offline.graph, names, task, "planned graph")
+            except (ReasonerError, GraphNotRunnableError):
+                raise error from None
+            raise FallbackPlan(offline.graph, list(reasoner.calls[first:]), error, "rules") from error
         return planned.graph, list(reasoner.calls[first:])
 
     return work

@@ -69,6 +69,8 @@ def record_command(task, episodes, out, p, disturb, protocol, only_recovered, ke
     cameras = () if tuple(cameras) == ("none",) else tuple(cameras)
     from agentchord.data.record import ResumeError, record_settings, recorded_state
 
+    from agentchord.guard.locks import FolderBusyError, lock_folder
+
     disturbances = disturbance_setting(p, disturb, protocol)
     try:
         state = recorded_state(out, record_settings(task, disturbances, only_recovered, keep_failed, seed,
@@ -83,6 +85,14 @@ def record_command(task, episodes, out, p, disturb, protocol, only_recovered, ke
         raise click.BadParameter(f"no camera {unknown[0]!r} in the {task} scene (cameras: {', '.join(known)})", param_hint="--camera")
     from agentchord.data.record import record
 
+    try:  # one recording per folder, held until the process ends; then what is there is read again
+        lock_folder(out, ".record.lock", "recording")
+        state = recorded_state(out, record_settings(task, disturbances, only_recovered, keep_failed, seed,
+                                                    cameras, size, "agentchord"))
+    except FolderBusyError as exc:
+        raise BadInput(str(exc)) from None
+    except ResumeError as exc:
+        raise BadInput(f"--out {out}: {exc}") from None
     console = Console()
     if state is not None:
         console.print(f"resuming {out}: {len(state['episodes'])} episodes written, going on from seed {state['next_seed']}")

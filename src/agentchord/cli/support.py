@@ -134,6 +134,15 @@ class GuardedGroup(click.Group):
     anything else becomes :class:`InternalError` (exit status 3), its traceback in a log file.
     """
 
+    def parse_args(self, ctx: click.Context, args: list[str]) -> list[str]:
+        """Refuse an argument that is not valid UTF-8 (exit 2) before any command reads it."""
+        for position, arg in enumerate(args, start=1):
+            bad = undecodable(arg)
+            if bad is not None:
+                shown = arg.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
+                raise BadInput(f"argument {position} ('{shown}') is not valid UTF-8: byte {bad} cannot be read as text")
+        return super().parse_args(ctx, args)
+
     def invoke(self, ctx: click.Context) -> Any:
         """Run the command, translating what escapes it."""
         try:
@@ -151,6 +160,17 @@ class GuardedGroup(click.Group):
             if isinstance(error, _bad_input_types()):
                 raise BadInput(str(error)) from error
             raise InternalError(error, write_error_log(error)) from error
+
+
+def undecodable(text: str) -> str | None:
+    """The first byte of ``text`` that was not valid UTF-8 (as Python passes such argv bytes: a lone
+    surrogate, ``surrogateescape``), as ``0xFF``; None when every character is text."""
+    for char in text:
+        if "\udc80" <= char <= "\udcff":
+            return f"0x{ord(char) - 0xDC00:02X}"
+        if "\ud800" <= char <= "\udfff":
+            return f"U+{ord(char):04X}"
+    return None
 
 
 def log_dir() -> Path:
@@ -180,7 +200,7 @@ def write_error_log(error: BaseException) -> Path | None:
         try:
             folder.mkdir(parents=True, exist_ok=True)
             path = folder / f"error-{stamp}-{os.getpid()}.log"
-            path.write_text(text, encoding="utf-8")
+            path.write_text(text, encoding="utf-8", errors="backslashreplace")  # argv may hold undecodable bytes
             return path
         except OSError:
             continue

@@ -65,7 +65,7 @@ def recorded_state(out: str | Path, settings: dict) -> dict | None:
     meta_path = root / META_PATH
     try:
         if not meta_path.exists():
-            if not any(p.name != "tmp" for p in root.iterdir()):
+            if not any(p.name not in ("tmp", ".record.lock") for p in root.iterdir()):
                 return None  # empty, or interrupted before the first checkpoint
             raise ResumeError("it exists and holds no dataset that `record` wrote (no meta/agentchord.json): "
                               "give a new directory")

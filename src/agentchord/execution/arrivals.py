@@ -22,6 +22,13 @@ them what the scene is, as a derived monitor's failure does. Each case is in the
 ``modes_listed``, ``branch_arrived`` with what came of it) and in the episode's result
 (:attr:`EpisodeResult.early_failures`).
 
+A background plan that **fails** (the endpoint down, a reply refused) brings no mode and no branch:
+from then on every nominal edge keeps its derived monitors for the rest of the episode (the robot is
+never blind), a derived monitor that fires ends the episode with the failure and the plan's error as
+its reason (``unrecovered`` in the trace; a failure waiting for its branch when the plan fails ends
+the same way), and so does an edge that ends at a node whose constraints do not hold. After an
+outage the online repairer is not asked either: it would call the same endpoint.
+
 :class:`PlanArrivals` is a part of :class:`~agentchord.execution.executor.Executor` (a mixin), as
 :class:`~agentchord.execution.switching.RecoverySwitching` is.
 """
@@ -32,7 +39,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from agentchord.execution.background import ScriptedPlan, ThreadedPlan
+from agentchord.execution.background import Arrival, ScriptedPlan, ThreadedPlan
 from agentchord.execution.edge_program import EdgeProgram
 from agentchord.execution.planning import PlanSchedule
 from agentchord.expr import Vocabulary
@@ -117,10 +124,12 @@ class PlanArrivals:
     still_since: int | None
     plan_wait_ticks: int
     _derived: dict[str, EdgeMonitors]
+    plan_error: str | None
+    repairer: Any
     constraints: dict[str, Any]
     frame: Any
     background: ThreadedPlan | ScriptedPlan | None
-    _incoming: tuple[int, TaskGraph] | None
+    _incoming: tuple[int, Arrival] | None
     compute_s: float
     _compile: Callable[[TaskGraph], None]
     _on_failure: Callable[[Detection], tuple[bool, str] | None]
@@ -158,27 +167,50 @@ class PlanArrivals:
                 self.background = None
                 self._received(arrival)
         if self._incoming is not None and self.world.tick >= self._incoming[0]:
-            graph, self._incoming = self._incoming[1], None
+            arrival, self._incoming = self._incoming[1], None
+            if arrival.graph is None:
+                self._plan_failed(arrival.error or "no reply", arrival.outage)
+                return
+            graph = forward_filter(arrival.graph).graph
             self._compile(graph)
-            self.trace.add(self.world.tick, "plan_arrived", failures=len(graph.failures()), recovery_edges=len(graph.recovery_edges()))
+            if arrival.fallback is not None and arrival.outage and self.repairer is not None:
+                self.repairer = None  # it would ask the endpoint that is down
+            self.trace.add(self.world.tick, "plan_arrived", failures=len(graph.failures()), recovery_edges=len(graph.recovery_edges()),
+                           **({"written_by": arrival.fallback, "llm_error": arrival.error} if arrival.fallback else {}))
 
     def _received(self, arrival) -> None:
         schedule = self.schedule
         at = schedule.first_motion_s + arrival.latency_s
         tick = schedule.tick_of(at)
         self.trace.add(self.world.tick, "plan_replied", latency_s=round(arrival.latency_s, 4), arrives_tick=tick,
-                       error=arrival.error, calls=[c.to_trace_event(messages=False) for c in arrival.calls])
+                       error=arrival.error, outage=arrival.outage, fallback=arrival.fallback,
+                       calls=[c.to_trace_event(messages=False) for c in arrival.calls])
         listed = {edge_id: at for edge_id in schedule.modes_listed_s}
         modes: dict[tuple[str, str], float] = {}
         if arrival.graph is not None:
-            graph = forward_filter(arrival.graph).graph
-            modes = {(edge.id, failure.name): at for edge, failure in graph.failures()}
-            self._incoming = (tick, graph)
+            modes = {(edge.id, failure.name): at for edge, failure in forward_filter(arrival.graph).graph.failures()}
+        self._incoming = (tick, arrival)  # adopted (or its failure taken) at the tick it arrives
         self.schedule = PlanSchedule(schedule.calls, schedule.first_motion_s, schedule.edge_ready_s, modes, listed)
         if self.waiting is not None:
             self.waiting.until = min(self.waiting.until, tick)
         if self._early_armed is not None:
             self._rearm_tick = min(self._rearm_tick, tick)
+
+    def _plan_failed(self, error: str, outage: bool) -> None:
+        """The background plan failed: no mode or branch will come; the derived monitors stay armed."""
+        self.plan_error = error
+        repair = None
+        if outage and self.repairer is not None:
+            self.repairer, repair = None, "not asked: the endpoint is down"
+        self.trace.add(self.world.tick, "plan_failed", reason=error, outage=outage, repair=repair,
+                       then="each edge keeps the monitors derived from its constraints; a failure that needs a branch ends the episode")
+
+    def _unrecovered(self, detection: Detection) -> tuple[bool, str]:
+        """End the episode on a failure no branch will come for (the background plan failed)."""
+        reason = (f"{detection.failure.name} on {detection.edge_id}: no recovery branch, "
+                  f"the arranger's plan failed ({_headline(self.plan_error)})")
+        self.trace.add(self.world.tick, "unrecovered", edge=detection.edge_id, failure=detection.failure.name, reason=reason)
+        return False, reason
 
     # ------------------------------------------------------------ queries
     def _tick_at(self, seconds: float | None) -> int | None:
@@ -213,7 +245,15 @@ class PlanArrivals:
     # ------------------------------------------------------------ arming
     def _arm_early(self, program: EdgeProgram) -> bool:
         """Arm the monitors derived from a nominal edge's own constraints while its modes are not known yet
-        (True when so); once they are, the edge's own monitors are armed as usual."""
+        (True when so); once they are, the edge's own monitors are armed as usual. After the background
+        plan failed, a nominal edge keeps its derived monitors (no mode of it will come)."""
+        if program.kind == "nominal" and self.plan_error is not None:
+            derived = self._derived.get(program.edge_id)
+            self.armed = derived if derived is not None and derived.monitors else None
+            if self.armed is not None:
+                self.armed.reset()
+            self._early_armed = None
+            return True
         listed = self._listed_tick(program.edge_id) if program.kind == "nominal" else None
         if listed is None:
             self._early_armed = None
@@ -262,6 +302,8 @@ class PlanArrivals:
         what going on is for an edge that has ended).
         """
         derived = detection.failure.intent == DERIVED_INTENT
+        if derived and self.plan_error is not None:
+            return False  # no branch will come: :meth:`_on_failure` ends the episode with the reason
         listed = self._listed_tick(detection.edge_id) if derived else None
         if listed is not None:
             self._hurry(detection.edge_id, None)  # which modes the edge has is not known yet
@@ -284,6 +326,9 @@ class PlanArrivals:
 
         def arrived() -> tuple[bool, str] | None:
             self.program = suspended
+            if derived and self.plan_error is not None:  # the plan failed while the robot waited for it
+                self._arrived(f"no branch will come: the arranger's plan failed ({_headline(self.plan_error)})", since)
+                return self._on_failure(detection)
             if listed is not None:  # the edge's modes are known now: the one watching this constraint, or all
                 watching = self.as_arranged(detection)
                 self.trace.add(self.world.tick, "modes_listed", edge=detection.edge_id, failure=detection.failure.name,
@@ -337,7 +382,8 @@ class PlanArrivals:
             False when the edge's modes were all here (arrive as usual); otherwise what came of it now
             (None: it waits, or recovers).
         """
-        if program.kind != "nominal" or self.schedule is None or not self._pending_modes(program.edge_id):
+        failed_plan = program.kind == "nominal" and self.plan_error is not None
+        if not failed_plan and (program.kind != "nominal" or self.schedule is None or not self._pending_modes(program.edge_id)):
             return False
         values = [(c.source, c.scalar(self.frame)) for c in self.constraints[program.target]]
         violated = [(source, value) for source, value in values if value > 0.0]
@@ -347,6 +393,8 @@ class PlanArrivals:
         failure = FailureMode(name=f"reached {program.target}: {source}", monitor=source, intent=DERIVED_INTENT,
                               recovery=program.edge_id)
         detection = Detection(program.edge_id, failure, self.world.tick, self.world.tick, float(value))
+        if failed_plan:
+            return self._on_failure(detection)  # detected, counted, and unrecovered for want of a branch
         if self._early_failure(detection, resume=arrive):
             return None
         return self._on_failure(self.as_arranged(detection))  # the mode watching it is here already
@@ -452,3 +500,10 @@ class PlanArrivals:
         """Seconds the robot held still for parts of the plan, the wait under way included."""
         ongoing = self.world.tick - self.waiting.began if self.waiting is not None else 0
         return (self.plan_wait_ticks + ongoing) / CONTROL_HZ
+
+
+def _headline(error: str | None) -> str:
+    """The first line of an error, shortened for a one-line reason."""
+    lines = (error or "").strip().splitlines()
+    line = lines[0] if lines else "no reply"
+    return line if len(line) <= 200 else line[:197] + "..."

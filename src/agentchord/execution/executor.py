@@ -25,7 +25,7 @@ from agentchord.actions.base import ArmAction, Status
 from agentchord.actions.catalog import ACTIONS
 from agentchord.actions.controller import RobotController
 from agentchord.execution.arrivals import PlanArrivals, Waiting, derived_monitors
-from agentchord.execution.background import ScriptedPlan, ThreadedPlan
+from agentchord.execution.background import Arrival, ScriptedPlan, ThreadedPlan
 from agentchord.execution.binding import Binding, HoldMemory
 from agentchord.execution.edge_program import EdgeProgram
 from agentchord.execution.feasibility import FeasibilityChecker, first_grasps, off_table
@@ -53,7 +53,8 @@ class ExecutorConfig:
     """Budgets of one episode.
 
     Attributes:
-        tick_limit: Ticks before the episode ends as a failure (50 Hz).
+        tick_limit: Ticks of the robot's work before the episode ends as a failure (50 Hz); the ticks it
+            holds still waiting for a part of a pipelined plan (reasoning, not work) are not counted.
         failure_budget: Times one failure mode may fire per episode.
         max_repairs: Online repairs attempted per episode (at most one per
             (edge, target) pair); past it, unanticipated failures go unrepaired.
@@ -176,7 +177,9 @@ class Executor(RecoverySwitching, PlanArrivals):
         # While a recovery that waited for its branch begins: the tick the arms have held still since.
         self.still_since: int | None = None
         self.background = background
-        self._incoming: tuple[int, TaskGraph] | None = None
+        # Why the background plan failed, once it has (None: it has not, or there is none).
+        self.plan_error: str | None = None
+        self._incoming: tuple[int, Arrival] | None = None
 
     def _compile(self, graph: TaskGraph) -> None:
         """Adopt a (filtered) graph: compile what the tick loop evaluates.
@@ -314,8 +317,10 @@ class Executor(RecoverySwitching, PlanArrivals):
             if event is not None:
                 self.disturbances.injected(event, self.reasoning_s)
                 self.trace.add(event.tick, "disturbance", kind=event.kind, arm=event.arm, obj=event.obj, action=event.action)
-        if self.world.tick >= self.config.tick_limit:
-            return False, f"tick limit {self.config.tick_limit} reached at {self._where()}"
+        waited = round(self.plan_wait_s * CONTROL_HZ)
+        if self.world.tick - waited >= self.config.tick_limit:
+            besides = f" ({waited} more ticks held still for the plan, not counted)" if waited else ""
+            return False, f"tick limit {self.config.tick_limit} reached at {self._where()}{besides}"
         lost = self._lost_objects(frame)
         if lost is not None:
             return False, lost

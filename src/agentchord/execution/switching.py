@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING, Any
 from agentchord.actions.base import Status
 from agentchord.agents.exceptions import ReasonerError
 from agentchord.agents.reasoner import UnanticipatedFailure
+from agentchord.execution.arrivals import DERIVED_INTENT
 from agentchord.execution.binding import Binding, HoldMemory
 from agentchord.execution.edge_program import EdgeProgram
 from agentchord.execution.feasibility import FeasibilityChecker, first_grasps
@@ -77,6 +78,7 @@ class RecoverySwitching:
     _early_program_failure: Callable[[], bool]
     modes_unknown: Callable[[str], bool]
     _wait_for_grounding: Callable[[EdgeProgram], bool]
+    _unrecovered: Callable[[Detection], tuple[bool, str]]
 
     def _beyond_every_arm(self, obj: str, confirm_ik: bool) -> tuple[bool, str] | None:
         """The unrecoverable outcome when no arm can take ``obj`` where it is (else None)."""
@@ -195,6 +197,8 @@ class RecoverySwitching:
         self.trace.add(detection.tick, "failure_detected", edge=detection.edge_id, failure=detection.failure.name,
                        onset_tick=detection.onset_tick, value=detection.value, count=self.fire_counts[key])
         disturbance = self.disturbances.detection(detection.tick)
+        if detection.failure.intent == DERIVED_INTENT:  # a derived monitor past its wait: the background plan failed
+            return self._unrecovered(detection)
         if self.fire_counts[key] > self.config.failure_budget:
             return False, f"failure budget exhausted: {detection.failure.name} on {detection.edge_id} fired {self.fire_counts[key]} times"
         interrupted, self.program = self.program, None  # None after an online repair: the failed edge had ended

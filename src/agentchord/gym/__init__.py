@@ -29,7 +29,7 @@ ENV_IDS: dict[str, str] = {env_id(task): task for task in sorted(SIM_TASKS)}
 def _register() -> None:
     for eid, task in ENV_IDS.items():
         if eid not in gymnasium.registry:
-            gymnasium.register(id=eid, entry_point="agentchord.gym.env:AgentChordEnv", kwargs={"task": task},
+            gymnasium.register(id=eid, entry_point="agentchord.gym.env:make_env", kwargs={"task": task},
                                disable_env_checker=True)
 
 

@@ -216,3 +216,24 @@ class AgentChordEnv(gym.Env):
     def close(self) -> None:
         """Free the renderers."""
         self._close_cameras()
+
+
+def make_env(task: str, render_mode: str | None = None, **kwargs) -> gym.Env:
+    """The registered entry point: :class:`AgentChordEnv`, with ``render_mode="human"`` shown in a window.
+
+    A human render is the ``rgb_array`` frames in a pygame window (gymnasium's ``HumanRendering``);
+    without pygame it is refused here, at ``make``, not at the first ``reset``.
+
+    Raises:
+        gym.error.DependencyNotInstalled: ``render_mode="human"`` without pygame.
+    """
+    if render_mode != "human":
+        return AgentChordEnv(task, render_mode=render_mode, **kwargs)
+    try:
+        import pygame  # noqa: F401 -- only whether it is there
+    except ImportError:
+        raise gym.error.DependencyNotInstalled(
+            "render_mode='human' shows the frames in a pygame window, and pygame is not installed "
+            "(pip install 'gymnasium[classic-control]'); or make the environment with render_mode='rgb_array' "
+            "and show env.render()'s frames yourself") from None
+    return gym.wrappers.HumanRendering(AgentChordEnv(task, render_mode="rgb_array", **kwargs))
