@@ -148,3 +148,61 @@ def test_the_report_of_several_methods_has_the_paired_table(tmp_path):
     assert "AgentChord takes the same time as ReKep at every latency" in (tmp_path / "tables" / "latency.md").read_text()
     measured = write_report(records, tmp_path / "llm", SweepConfig(reasoner="llm"), None, trials=3, first_seed=0)
     assert not any(path.name.startswith("latency") for path in measured)
+
+
+def _llm_env(monkeypatch, server, model="replay-model"):
+    monkeypatch.setenv("AGENTCHORD_LLM_BASE_URL", server.base_url)
+    monkeypatch.setenv("AGENTCHORD_LLM_MODEL", model)
+    monkeypatch.setenv("AGENTCHORD_LLM_API_KEY", "test-key")
+    monkeypatch.setenv("AGENTCHORD_LLM_DEADLINE_S", "3")
+
+
+def test_an_llm_outage_is_the_same_rerun_record_for_every_method(tmp_path, monkeypatch):
+    """Issue 58: during an outage an AgentChord episode counted as a task failure, while the same outage for
+    agentchord-sequential became an internal-error record (exit 3). Now both are outage records: left out
+    of the tables, reported, run again on a rerun; exit 1 (the sweep is not complete)."""
+    from replay_server import Completion, HttpError, ReplayServer
+
+    from agentchord.agents.observe import observe, task_regions
+    from agentchord.agents.pipeline import plan_task
+    from agentchord.agents.rules import RulesReasoner
+    from agentchord.library import load_task_graph
+    from agentchord.sim.tasks import SIM_TASKS
+    from agentchord.sim.trial import open_world
+
+    task = "single_arm_pour_water"
+    rules = RulesReasoner()
+    plan_task(load_task_graph(task).instruction, observe(open_world(task, 0), task_regions(SIM_TASKS[task])), rules, task)
+    composed = json.dumps(rules.calls[0].reply)
+    out = tmp_path / "sweep"
+    # The pipelined method's composer answers, then the endpoint goes down; the sequential one meets it at once.
+    answers = iter([Completion(composed)])
+    with ReplayServer(lambda body: next(answers, HttpError(503, "down"))) as server:
+        _llm_env(monkeypatch, server)
+        result = CliRunner().invoke(main, ["bench", "--reasoner", "llm", "--tasks", task, "--methods",
+                                           "agentchord,agentchord-sequential", "--p", "0", "--trials", "1", "--workers", "1",
+                                           "--out", str(out)])
+    assert result.exit_code == 1, result.output
+    assert "2 episode(s) could not reach the LLM" in " ".join(result.output.split())
+    records = [json.loads(line) for line in (out / "records.jsonl").read_text().splitlines()]
+    assert sorted(r["method"] for r in records) == ["agentchord", "agentchord-sequential"]
+    assert all(r["outage"] and r["reason"].startswith("LLM outage: ") and "traceback" not in r for r in records)
+
+
+def test_an_llm_sweep_resumed_with_another_model_is_refused(tmp_path, monkeypatch):
+    """Issue 58: a --reasoner llm sweep resumed with another model or endpoint was accepted silently."""
+    from replay_server import ReplayServer
+
+    from agentchord.bench.store import RecordStore
+    from agentchord.bench.sweep import SweepConfig
+
+    out = tmp_path / "sweep"
+    RecordStore(out, SweepConfig(reasoner="llm", llm={"model": "model-a", "endpoint": "http://127.0.0.1:1/v1"})).close()
+    with ReplayServer() as server:
+        _llm_env(monkeypatch, server, model="model-b")
+        result = CliRunner().invoke(main, ["bench", "--reasoner", "llm", "--tasks", "single_arm_pour_water", "--methods",
+                                           "agentchord", "--p", "0", "--trials", "1", "--out", str(out)])
+    assert result.exit_code == 2, result.output
+    assert "another configuration (llm differ)" in " ".join(result.output.split())
+    manifest = json.loads((out / "sweep.json").read_text())
+    assert manifest["llm"] == {"model": "model-a", "endpoint": "http://127.0.0.1:1/v1"}

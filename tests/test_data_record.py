@@ -379,5 +379,5 @@ def test_a_second_record_on_the_same_folder_is_refused_naming_the_first(tmp_path
         holder.kill()
         holder.wait(10)
     assert result.exit_code == 2, result.output
-    assert f"another recording is running on this folder (pid {holder.pid}" in result.output
+    assert f"another recording is running on this directory (pid {holder.pid}" in result.output
     assert sorted(p.name for p in out.iterdir()) == [".record.lock"]

@@ -164,3 +164,22 @@ def test_the_rules_arranger_repairs_the_same_unforeseen_failure_online():
     repairs = [e for e in result.trace.of("repair") if e["accepted"]]
     assert result.success, result.reason
     assert result.repairs >= 1 and repairs[0]["failure"] == "bottle_slipped"
+
+
+def test_after_an_outage_no_more_repairs_are_asked(pour_scene):
+    """Issue 58: with the LLM server dead mid-episode, each later online repair retried it for about 15 s."""
+    from agentchord.agents.exceptions import ReasonerTransportError
+
+    calls: list[UnanticipatedFailure] = []
+
+    def down(graph: TaskGraph, failure: UnanticipatedFailure, frame: FeatureFrame) -> None:
+        calls.append(failure)
+        raise ReasonerTransportError("the arranger's endpoint could not be reached after 3 tries", agent="arranger")
+
+    executor = Executor(unanticipated_graph(), SimWorld(pour_scene), make_strategy("agentchord"),
+                        SIM_TASKS[TASK].success_tracker(), config=ExecutorConfig(max_repairs=3), repairer=down)
+    for edge in ("e2", "e3", "e4"):
+        assert executor._repair(EdgeProgram.from_edge(executor.graph.edge(edge))) is None
+    assert len(calls) == 1 and executor.repairer is None
+    (event,) = executor.trace.of("repair")
+    assert "no more repairs are asked" in event["reason"]

@@ -211,3 +211,30 @@ def test_full_style_keeps_the_old_view(pour: TaskGraph, tmp_path: Path) -> None:
     assert "rankdir=TB" in render(pour, tmp_path / "r.dot").read_text()  # readable is the default
     with pytest.raises(RenderError, match="unknown style 'tiny'; use readable, full"):
         render(pour, tmp_path / "g.dot", style="tiny")
+
+
+@needs_dot
+def test_a_node_semantic_over_16_kb_renders_with_its_label_cut(tmp_path):
+    """Issue 58: Graphviz refuses a quoted string over 16,384 characters and closed its input: BrokenPipeError, exit 3."""
+    from agentchord.library import load_task_graph
+
+    graph = load_task_graph("single_arm_pour_water")
+    long = graph.nodes[1].model_copy(update={"semantic": "bottle held " * 2000})
+    graph = graph.model_copy(update={"nodes": [graph.nodes[0], long, *graph.nodes[2:]]})
+    for suffix in (".svg", ".html"):
+        out = render(graph, tmp_path / f"g{suffix}", style="full")
+        assert "characters in all" in out.read_text()
+
+
+@needs_dot
+def test_a_layout_that_takes_too_long_is_a_render_error(tmp_path, monkeypatch):
+    """Issue 58: a dense graph (1,749 nodes and edges, under the size cap) was still laying out after 240 s."""
+    import importlib
+
+    from agentchord.library import load_task_graph
+
+    render_module = importlib.import_module("agentchord.graph.render")  # the package's ``render`` is the function
+    monkeypatch.setattr(render_module, "LAYOUT_TIMEOUT_S", 0.001)
+    with pytest.raises(RenderError, match="did not lay the graph out within 0.001 s"):
+        render(load_task_graph("dual_arm_pour_water"), tmp_path / "g.svg")
+    assert not (tmp_path / "g.svg").exists()

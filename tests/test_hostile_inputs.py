@@ -706,3 +706,17 @@ def test_an_object_too_big_for_its_container_is_refused():
     (problem,) = goal_problems(goal, scene)
     assert "'box' (12.0 cm across) does not fit into 'cup'" in problem
     assert goal_problems(GoalSpec(goals=[{"kind": "inside", "obj": "cup", "container": "box"}]), scene) == []
+
+
+@pytest.mark.parametrize("content", ['{"task": "blocks_and_cup", "nodes": [{"id": "v\\ud800"}]}',
+                                     '{"task": "blocks_and_cup", "nodes": [{"id": "v\ud800"}]}'],
+                         ids=["escaped in the reply's JSON", "raw in the content"])
+def test_a_reply_holding_a_lone_surrogate_is_refused_and_its_trace_kept(tmp_path, content):
+    """Issue 58: a composer reply holding ``"\\ud800"`` made ``plan`` exit 3 (UnicodeEncodeError) with no trace."""
+    trace = tmp_path / "calls.jsonl"
+    with HostileServer(lambda body: Reply(completion(content))) as server:
+        invoke(["plan", "put the red block into the cup", "--task", "blocks_and_cup", "--reasoner", "llm",
+                "-o", tmp_path / "g.yaml", "--trace", trace], 2, "lone surrogate", str(trace), env=_llm(server))
+    assert not (tmp_path / "g.yaml").exists()
+    events = [json.loads(line) for line in trace.read_text().splitlines()]
+    assert events[0]["event"] == "reasoner_call" and not events[0]["ok"]

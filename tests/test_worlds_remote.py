@@ -402,3 +402,19 @@ def test_a_seed_the_protocol_cannot_carry_is_refused_before_anything_is_sent():
     result = CliRunner().invoke(main, ["run", TASK, "--world", "tcp://127.0.0.1:9", "--seed", str(2**64)])
     assert result.exit_code == 2, result.output
     assert "the world protocol carries seeds from 0 to 2^63 - 1" in result.output
+
+
+def test_a_client_interrupted_while_waiting_for_a_reply_still_closes_its_trial():
+    """Issue 58: a ``run --world`` client stopped by Ctrl-C in the middle of a request left its trial open
+    (its close was sent on a REQ socket still waiting for the reply, and failed), so every other client
+    was refused until the server released it (300 s)."""
+    address, stop, thread = serve_in_thread(TASK)
+    try:
+        world = RemoteWorld(address, TASK, 0, timeout_s=10)
+        world._socket.send(pack({"op": "hello"}))  # a request in flight: the socket now waits for its reply
+        world.close()
+        with RemoteWorld(address, TASK, 1, timeout_s=10) as other:  # the world is free again at once
+            assert other.tick == 0
+    finally:
+        stop.set()
+        thread.join(5)

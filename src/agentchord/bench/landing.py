@@ -65,28 +65,32 @@ def landing(kind: str, seed: int) -> Landing | None:
         The landing, or None when the disturbance did not apply (nothing to drop at that moment).
     """
     task, obj, action, after = SCENARIOS[kind]
-    seen: dict[str, object] = {}
+    # (tick, position) at the event, and the landing once measured.
+    start: tuple[int, np.ndarray] | None = None
+    done: Landing | None = None
 
     def on_tick(executor: Executor) -> None:
-        if "done" in seen:
+        nonlocal start, done
+        if done is not None:
             return
         frame = executor.frame
         events = executor.trace.of("disturbance")
-        if events and "start" not in seen:
-            seen["start"] = (events[0]["tick"], frame.objects[obj].pos.copy())
-        if "start" not in seen:
+        if events and start is None:
+            start = (events[0]["tick"], frame.objects[obj].pos.copy())
+        if start is None:
             return
         bound = executor.trace.of("recovery_bound")
-        if bound or executor.world.tick - seen["start"][0] >= SETTLE_TICKS:
+        if bound or executor.world.tick - start[0] >= SETTLE_TICKS:
             checker = executor.feasibility
-            seen["done"] = Landing(
+            done = Landing(
                 kind=kind,
                 seed=seed,
-                moved=float(np.linalg.norm(frame.objects[obj].pos[:2] - seen["start"][1][:2])),
+                moved=float(np.linalg.norm(frame.objects[obj].pos[:2] - start[1][:2])),
                 upright=tilt_deg(frame.objects[obj].axis) < UPRIGHT_DEG,
                 off_table=bool(off_table(frame, [obj])),
                 # Reach alone: the other arm's pose and what the hands hold are not the object's doing.
-                reachable={arm: checker.check_grasp(Grasp(arm, GraspArgs(obj=obj)), hand_free=False,
+                # (model_validate, not GraspArgs(obj=obj): mypy takes the positional Field defaults for required.)
+                reachable={arm: checker.check_grasp(Grasp(arm, GraspArgs.model_validate({"obj": obj})), hand_free=False,
                                                     avoid_other_arm=False).feasible for arm in ARMS},
             )
 
@@ -94,7 +98,7 @@ def landing(kind: str, seed: int) -> Landing | None:
     # Long enough for the event and the settling after it; the rest of the episode does not matter here.
     config = ExecutorConfig(tick_limit=700)
     run_episode(EpisodeSpec(task, seed=seed, disturbance=disturbance, config=config), on_tick=on_tick)
-    return seen.get("done")  # type: ignore[return-value]
+    return done
 
 
 def summarise(landings: list[Landing]) -> dict[str, float]:

@@ -65,7 +65,9 @@ class PairedRow:
 def _difference(pairs: list[tuple[float, float]]) -> Difference | None:
     if not pairs:
         return None
-    _, (low, high) = mean_ci([a - b for a, b in pairs])
+    _, ci = mean_ci([a - b for a, b in pairs])
+    assert ci is not None  # pairs is not empty
+    low, high = ci
     return Difference(n=len(pairs), reference=mean(a for a, _ in pairs), other=mean(b for _, b in pairs),
                       low=low, high=high, reference_better=sum(a < b for a, b in pairs))
 

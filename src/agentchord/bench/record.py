@@ -10,7 +10,7 @@ Fields this build does not know are kept (a later build's additions).
 
 from __future__ import annotations
 
-from typing import Annotated, Any
+from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, Strict, StrictBool, StrictInt, StrictStr, ValidationError, model_validator
 
@@ -90,6 +90,13 @@ class ErrorRecord(_RecordKey):
     traceback: StrictStr
 
 
+class OutageRecord(_RecordKey):
+    """An episode whose LLM could not be reached (it runs again when the sweep is resumed)."""
+
+    error: StrictStr
+    outage: Literal[True]
+
+
 def check_record(record: Any) -> list[str]:
     """What is wrong with one parsed line of ``records.jsonl`` (empty when it is a valid record).
 
@@ -97,7 +104,7 @@ def check_record(record: Any) -> list[str]:
     """
     if not isinstance(record, dict):
         return [f"expected a record object, found {type(record).__name__}"]
-    model = ErrorRecord if is_error(record) else EpisodeRecord
+    model = (OutageRecord if record.get("outage") else ErrorRecord) if is_error(record) else EpisodeRecord
     try:
         model.model_validate(record)
     except ValidationError as error:

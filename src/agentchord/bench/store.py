@@ -14,8 +14,6 @@ refused, naming the process that holds it.
 
 from __future__ import annotations
 
-import datetime
-import fcntl
 import json
 import os
 from pathlib import Path
@@ -23,6 +21,8 @@ from pathlib import Path
 from agentchord.bench.exceptions import SweepStoreError
 from agentchord.bench.record import check_record
 from agentchord.bench.sweep import RECORD_VERSION, SweepConfig, is_error
+from agentchord.guard.exceptions import OutputPathError
+from agentchord.guard.locks import lock_folder
 from agentchord.guard.outputs import atomic_write_text, finite_json
 
 MANIFEST = "sweep.json"
@@ -51,30 +51,17 @@ class RecordStore:
         except OSError as error:
             raise SweepStoreError(f"{self.directory}: cannot create the directory ({error.strerror})") from None
         self.path = self.directory / RECORDS
-        self._lock = self._acquire_lock()
+        self._lock: int | None = self._acquire_lock()
         self._check_manifest(config)
         self.records: dict[str, dict] = {}
         self._load()
 
     def _acquire_lock(self) -> int:
         """Lock the directory for this process; refuse if another process holds it."""
-        path = self.directory / LOCK
         try:
-            fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
-        except OSError as error:
-            raise SweepStoreError(f"{path}: cannot open the sweep's lock ({error.strerror})") from None
-        try:
-            # lockf, not flock: a forked worker does not inherit it, so it goes with this process.
-            fcntl.lockf(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            holder = os.read(fd, 200).decode("utf-8", "replace").strip() or "another process"
-            os.close(fd)
-            raise SweepStoreError(f"{self.directory}: another sweep is running on this directory ({holder}); "
-                                  "wait for it to end, or use another --out") from None
-        os.ftruncate(fd, 0)
-        stamp = datetime.datetime.now().isoformat(timespec="seconds")
-        os.write(fd, f"pid {os.getpid()}, started {stamp}\n".encode())
-        return fd
+            return lock_folder(self.directory, LOCK, "sweep")
+        except OutputPathError as error:
+            raise SweepStoreError(f"{error.path}: {error.reason}") from None
 
     def close(self) -> None:
         """Release the directory's lock (it is released anyway when the process ends)."""

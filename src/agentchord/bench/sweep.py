@@ -12,6 +12,7 @@ import time
 import traceback
 from dataclasses import dataclass, field
 
+from agentchord.agents.exceptions import ReasonerTransportError
 from agentchord.episode import EpisodeSpec, run_episode
 from agentchord.execution.reasoning import ReasoningConfig
 from agentchord.harness import DisturbanceSetting
@@ -86,22 +87,28 @@ class SweepConfig:
             charged the modelled latency; ``llm``: every method plans from the task's instruction
             with the LLM of ``AGENTCHORD_LLM_*`` at the episode's start (re-plans too), and each
             planning call is charged the latency it measured.
+        llm: With ``reasoner`` ``llm``: the model and the endpoint (credentials masked) that answer, so that
+            a sweep resumed with another model is refused and every caption names the model.
     """
 
     reasoning: ReasoningConfig = field(default_factory=ReasoningConfig)
     perception: str = "oracle"
     reasoner: str = "rules"
+    llm: dict[str, str] | None = None
 
     def to_dict(self) -> dict:
         """JSON-ready (the sweep's manifest)."""
-        return {"record_version": RECORD_VERSION, "reasoning": self.reasoning.to_dict(), "perception": self.perception,
-                "reasoner": self.reasoner}
+        out = {"record_version": RECORD_VERSION, "reasoning": self.reasoning.to_dict(), "perception": self.perception,
+               "reasoner": self.reasoner}
+        if self.llm is not None:
+            out["llm"] = dict(self.llm)
+        return out
 
     @classmethod
     def from_dict(cls, data: dict) -> SweepConfig:
         """The config a manifest holds."""
         return cls(reasoning=ReasoningConfig.from_dict(data["reasoning"]), perception=data["perception"],
-                   reasoner=data.get("reasoner", "rules"))
+                   reasoner=data.get("reasoner", "rules"), llm=data.get("llm"))
 
 
 def sweep_keys(tasks: list[str], methods: list[str], conditions: list[Condition], trials: int, first_seed: int = 0) -> list[EpisodeKey]:
@@ -109,7 +116,7 @@ def sweep_keys(tasks: list[str], methods: list[str], conditions: list[Condition]
 
     A task, method or condition named twice is run, and counted, once.
     """
-    tasks, methods, conditions = (list(dict.fromkeys(items)) for items in (tasks, methods, conditions))
+    tasks, methods, conditions = list(dict.fromkeys(tasks)), list(dict.fromkeys(methods)), list(dict.fromkeys(conditions))
     return [
         EpisodeKey(task, method, condition, seed)
         for condition in conditions for task in tasks for method in methods
@@ -125,10 +132,11 @@ def episode_spec(key: EpisodeKey, config: SweepConfig) -> EpisodeSpec:
     # With an LLM the plan is made (and timed) in the episode, from the instruction of the graph
     # the rules run; the rules' graph is the task library's (their calls are modelled).
     instruction = load_task_graph(key.task).instruction if config.reasoner == "llm" else None
+    # An outage is an error to rerun, for every method alike: no offline arranger stands in for the LLM.
     return EpisodeSpec(
         task=key.task, strategy=key.method, seed=key.seed, disturbances=condition.setting,
         perception=config.perception, reasoning=config.reasoning,
-        instruction=instruction, reasoner=config.reasoner,
+        instruction=instruction, reasoner=config.reasoner, arranger_fallback=False,
     )
 
 
@@ -155,8 +163,13 @@ def run_record(key: EpisodeKey, config: SweepConfig) -> dict:
     started = time.perf_counter()
     try:
         result = run_episode(episode_spec(key, config))
+    except ReasonerTransportError as error:  # the plan before the first motion met an outage
+        return outage_record(key, f"{type(error).__name__}: {error.headline}", time.perf_counter() - started)
     except Exception as error:  # recorded with its traceback; the sweep goes on
         return error_record(key, error, time.perf_counter() - started)
+    outage = next((e["error"] for e in result.trace.of("plan_replied") if e.get("outage")), None)
+    if outage is not None:  # the plan in the background met one while the robot moved
+        return outage_record(key, outage, time.perf_counter() - started)
     summary = result.summary()
     injected = sum(counts[0] for counts in summary["disturbances"].values())
     return {
@@ -188,6 +201,26 @@ def error_record(key: EpisodeKey, error: BaseException, wall_s: float) -> dict:
     }
 
 
+def outage_record(key: EpisodeKey, error: str, wall_s: float) -> dict:
+    """The record of an episode whose LLM could not be reached (an outage): neither a success nor a failure
+    of the method. Every method's outage is this record, whether it met it before the first motion (a
+    sequential plan) or while the robot moved (a pipelined one); the tables leave it out and a rerun with
+    the same ``--out`` runs it again."""
+    return {
+        **_key_fields(key),
+        "success": False,
+        "reason": f"LLM outage: {error}",
+        "error": f"LLM outage: {error}",
+        "outage": True,
+        "wall_s": round(wall_s, 3),
+    }
+
+
+def is_outage(record: dict) -> bool:
+    """Whether a record is an :func:`outage_record`."""
+    return bool(record.get("outage"))
+
+
 def is_error(record: dict) -> bool:
     """Whether a record is an :func:`error_record` (the episode did not run to a verdict)."""
     return "error" in record
@@ -197,7 +230,8 @@ def describe(config: SweepConfig) -> str:
     """One line for every table's caption: the latency model and the VQA's error rates."""
     reasoning = config.reasoning
     if config.reasoner == "llm":
-        latency = (f"planning calls measured (LLM reasoner), VQA {reasoning.latency.of('vqa'):g} s and VLM "
+        model = f" {config.llm['model']} at {config.llm['endpoint']}" if config.llm else ""
+        latency = (f"planning calls measured (LLM reasoner{model}), VQA {reasoning.latency.of('vqa'):g} s and VLM "
                    f"{reasoning.latency.of('vlm'):g} s per call modelled (see docs/results.md)")
     else:
         latency = f"reasoning latency per call: {reasoning.latency.describe()} (modelled; see docs/results.md)"

@@ -124,7 +124,7 @@ def _pct(c: Cell | None) -> str:
 
 
 def _time(c: Cell | None) -> str:
-    if c is None or c.time_s is None:
+    if c is None or c.time_s is None or c.time_ci is None:  # time_ci is None exactly when time_s is
         return "-"
     low, high = c.time_ci
     return f"{c.time_s:.1f} ± {(high - low) / 2:.1f}"
@@ -228,8 +228,7 @@ def ordering(records: list[dict], method: str = "agentchord") -> dict[str, dict]
     """
     cells = group(records)
     methods = ordered({m for _, _, m in cells}, METHODS)
-    rows = {(t, c) for t, c, _ in cells}
-    rows = [row for row in rows if all((*row, m) in cells for m in methods)]
+    rows = [row for row in {(t, c) for t, c, _ in cells} if all((*row, m) in cells for m in methods)]
     out: dict[str, dict] = {}
     for metric, attr, better in (("success", "success_rate", max), ("exec_time_s", "time_s", min), ("steps_disturbed", "steps_disturbed", min)):
         means = {}

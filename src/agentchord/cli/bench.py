@@ -16,6 +16,16 @@ from agentchord.cli.support import EXIT_INTERNAL, BadInput
 TABLE_I_TASKS = "single_arm_pour_water,dual_arm_pour_water,rearrange_table"
 
 
+class EpisodesMetAnOutage(click.ClickException):
+    """Some episodes could not reach their LLM (recorded, left out of the tables, run again on a rerun):
+    exit status 1, the sweep is not complete."""
+
+    exit_code = 1
+
+    def show(self, file=None) -> None:
+        click.echo(f"agentchord: {self.format_message()}", err=True)
+
+
 class EpisodesStoppedOnErrors(click.ClickException):
     """Some episodes stopped on an internal error (recorded, left out of the tables): exit status 3."""
 
@@ -93,7 +103,7 @@ def bench_command(tasks, methods, ps, protocol, trials, first_seed, out_dir, bac
     """
     from agentchord.bench.exceptions import BenchError
     from agentchord.bench.store import RecordStore
-    from agentchord.bench.sweep import Condition, SweepConfig, describe, is_error, sweep_keys
+    from agentchord.bench.sweep import Condition, SweepConfig, describe, is_error, is_outage, sweep_keys
     from agentchord.execution.methods import METHODS
     from agentchord.execution.reasoning import ReasoningConfig
     from agentchord.sim.tasks import SIM_TASKS
@@ -128,11 +138,14 @@ def bench_command(tasks, methods, ps, protocol, trials, first_seed, out_dir, bac
         from agentchord.agents.llm import LlmConfig
 
         try:
-            LlmConfig.from_env()  # the settings are checked before any episode runs
+            llm_config = LlmConfig.from_env()  # the settings are checked before any episode runs
         except ReasonerConfigError as error:
             raise BadInput(f"--reasoner llm: {error}") from None
+        llm = {"model": llm_config.model, "endpoint": llm_config.endpoint}  # a resumed sweep must use the same
+    else:
+        llm = None
     config = SweepConfig(reasoning=ReasoningConfig(latency=latency, vqa_miss=vqa_miss, vqa_false_alarm=vqa_false_alarm,
-                                                   doremi_every=doremi_every), reasoner=reasoner)
+                                                   doremi_every=doremi_every), reasoner=reasoner, llm=llm)
     try:
         store = RecordStore(out_dir, config)  # checks the output directory before any episode runs
     except BenchError as error:
@@ -148,9 +161,11 @@ def bench_command(tasks, methods, ps, protocol, trials, first_seed, out_dir, bac
     if todo:
         _run(todo, config, store, backend, ray_address, workers, console)
     records = [store.records[key.id] for key in keys if key.id in store.records]
-    errors = [record for record in records if is_error(record)]
+    outages = [record for record in records if is_outage(record)]
+    errors = [record for record in records if is_error(record) and not is_outage(record)]
     finished = [record for record in records if not is_error(record)]
-    written = write_report(finished, Path(out_dir), config, console, trials, first_seed, left_out=len(errors)) if finished else []
+    written = (write_report(finished, Path(out_dir), config, console, trials, first_seed, left_out=len(errors), outages=len(outages))
+               if finished else [])
     console.print(f"{len(todo)} episode(s) in {time.perf_counter() - started:.0f} s; written: " + (", ".join(str(p) for p in written) or "nothing"))
     if errors:
         listed = "; ".join(f"{r['id']}: {r['error'][:160]}" for r in errors[:5]) + ("; ..." if len(errors) > 5 else "")
@@ -158,6 +173,11 @@ def bench_command(tasks, methods, ps, protocol, trials, first_seed, out_dir, bac
             f"{len(errors)} episode(s) stopped on an internal error (a bug, not a failed task) and are left out of "
             f"every table: {listed}. Each record in {store.path} holds its traceback; rerun with the same --out "
             "to run them again.")
+    if outages:
+        listed = "; ".join(f"{r['id']}" for r in outages[:5]) + ("; ..." if len(outages) > 5 else "")
+        raise EpisodesMetAnOutage(
+            f"{len(outages)} episode(s) could not reach the LLM ({outages[0]['error'][:200]}): {listed}. They are not "
+            f"results of their method and are left out of every table; rerun with the same --out when the endpoint is back.")
 
 
 def _run(todo, config, store, backend, ray_address, workers, console) -> None:
@@ -174,17 +194,19 @@ def _run(todo, config, store, backend, ray_address, workers, console) -> None:
             for _key, record in stream:
                 store.append(record)
                 if is_error(record):
-                    bar.console.print(f"[red]{escape(record['id'])}[/red]: internal error: {escape(record['error'][:200])}", highlight=False)
+                    what = "" if record.get("outage") else "internal error: "
+                    bar.console.print(f"[red]{escape(record['id'])}[/red]: {what}{escape(record['error'][:200])}", highlight=False)
                 bar.advance(job)
         except BackendError as error:
             raise BadInput(str(error)) from None
 
 
 def write_report(records: list[dict], out: Path, config, console: Console | None, trials: int, first_seed: int,
-                 left_out: int = 0) -> list[Path]:
+                 left_out: int = 0, outages: int = 0) -> list[Path]:
     """Tables (Markdown and CSV) and figures (PNG) of a sweep's records, written atomically under ``out``.
 
-    ``left_out`` episodes stopped on an internal error; the caption says so (the cells have fewer seeds).
+    ``left_out`` episodes stopped on an internal error and ``outages`` could not reach their LLM; the caption
+    says so (the cells have fewer seeds).
     """
     from agentchord.bench.figures import steps_figure, stress_figure
     from agentchord.bench.paired import REFERENCE, paired_csv, paired_markdown
@@ -204,6 +226,8 @@ def write_report(records: list[dict], out: Path, config, console: Console | None
                f"mean over successful episodes with a disturbance. {describe(config)}.")
     if left_out:
         caption += f" {left_out} episode(s) that stopped on an internal error are left out (see records.jsonl)."
+    if outages:
+        caption += f" {outages} episode(s) that could not reach the LLM are left out (see records.jsonl)."
     drops = [r for r in records if r["protocol"] is None]
     protocols = [r for r in records if r["protocol"] is not None]
     tables: list[tuple[str, str, list[dict], dict]] = []

@@ -35,13 +35,13 @@ outage the online repairer is not asked either: it would call the same endpoint.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Literal
 
-from agentchord.execution.background import Arrival, ScriptedPlan, ThreadedPlan
-from agentchord.execution.edge_program import EdgeProgram
 from agentchord.execution.planning import PlanSchedule
+from agentchord.execution.state import ExecutorState
 from agentchord.expr import Vocabulary
 from agentchord.graph.models import FailureMode, TaskGraph
 from agentchord.graph.progress import forward_filter, nominal_path
@@ -49,11 +49,13 @@ from agentchord.monitor import Detection, EdgeMonitors
 from agentchord.worlds.protocol import CONTROL_HZ
 
 if TYPE_CHECKING:
-    from agentchord.execution.trace import Trace
-    from agentchord.worlds.protocol import World
+    from agentchord.execution.background import Arrival
+    from agentchord.execution.edge_program import EdgeProgram
 
 #: The intent of a derived monitor's failure: there is no recovery before the arranger's arrives.
 DERIVED_INTENT = "wait for the arranger's branch"
+#: A node's hold constraint, spaces normalised: ``0.5 - holding(arm, obj)``.
+_HOLD = re.compile(r"0\.5 - holding\((?P<arm>left|right), (?P<obj>[A-Za-z_][A-Za-z0-9_]*)\)")
 #: Seconds standing for "not known yet": the parts of a background plan before its reply is in.
 UNKNOWN_S = 1e9
 
@@ -62,19 +64,28 @@ def derived_monitors(graph: TaskGraph, vocabulary: Vocabulary) -> dict[str, Edge
     """Per nominal edge, monitors of the constraints it must keep, known before any arranger reply.
 
     A constraint both ends of the edge share (the same text, spaces aside) must hold all along it; a
-    path constraint must too; and what one of the edge's grasps takes stays in that hand once its
+    path constraint must too; what one of the edge's grasps takes stays in that hand once its
     gripper has closed (``arm.closed * (0.5 - holding(arm, obj))``, the grasp-done signal gating
-    the hold). Each is a failure mode named ``keeps: <constraint>``.
+    the hold); and what the source node holds (``0.5 - holding(arm, obj)``) and its target does not
+    stays in the hand while the gripper is closed (the same gate: opening it to put the object down
+    ends the watch). Each is a failure mode named ``keeps: <constraint>``.
     """
     out = {}
     for edge in graph.nominal_edges():
         source = {" ".join(c.split()): c for c in graph.node(edge.source).constraints}
-        shared = [source[key] for key in (" ".join(c.split()) for c in graph.node(edge.target).constraints) if key in source]
+        target = {" ".join(c.split()) for c in graph.node(edge.target).constraints}
+        shared = [source[key] for key in target if key in source]
         # What the edge's own grasps take stays in the hand once the gripper has closed on it.
         grasped = [f"{arm}.closed * (0.5 - holding({arm}, {call.args['obj']}))" for arm, call in edge.calls
                    if call.fn == "grasp" and isinstance(call.args.get("obj"), str)]
-        kept = list(dict.fromkeys([*shared, *edge.path_constraints, *grasped]))
-        failures = [FailureMode(name=f"keeps: {c}", monitor=c, intent=DERIVED_INTENT, recovery=edge.id) for c in kept]
+        # What the source holds stays in the hand while its gripper stays closed: until the edge opens it
+        # to put the object down (a tray carried to its place, a bottle pulled out as it is set down).
+        held = [f"{m['arm']}.closed * (0.5 - holding({m['arm']}, {m['obj']}))" for key in source
+                if key not in target and (m := _HOLD.fullmatch(key)) is not None]
+        kept = list(dict.fromkeys([*shared, *edge.path_constraints, *grasped, *held]))
+        # model_validate, not FailureMode(...): mypy takes the positional Field defaults (margin, window) for required.
+        failures = [FailureMode.model_validate({"name": f"keeps: {c}", "monitor": c, "intent": DERIVED_INTENT, "recovery": edge.id})
+                    for c in kept]
         out[edge.id] = EdgeMonitors.compile(edge.model_copy(update={"failures": failures}), vocabulary)
     return out
 
@@ -104,39 +115,15 @@ class Waiting:
             self.began = self.since
 
 
-class PlanArrivals:
-    """The executor's pipelined plan: parts armed at their ticks, failures that come first wait."""
+class PlanArrivals(ExecutorState):
+    """The executor's pipelined plan: parts armed at their ticks, failures that come first wait.
 
-    world: World
-    trace: Trace
-    graph: TaskGraph
-    program: EdgeProgram | None
-    armed: EdgeMonitors | None
-    monitors: dict[str, EdgeMonitors]
-    reasoning_s: float
-    reasoning_calls: dict[str, int]
-    schedule: PlanSchedule | None
+    The executor's state it reads and sets is declared in :class:`ExecutorState`, but for its own waits.
+    """
+
+    # The wait under way (None: nothing waits), and the one whose part has just arrived (its ``then`` runs).
     waiting: Waiting | None
-    early_failures: list[dict[str, Any]]
-    _early_armed: str | None
-    _rearm_tick: int
     _arriving: Waiting | None
-    still_since: int | None
-    plan_wait_ticks: int
-    _derived: dict[str, EdgeMonitors]
-    plan_error: str | None
-    repairer: Any
-    constraints: dict[str, Any]
-    frame: Any
-    background: ThreadedPlan | ScriptedPlan | None
-    _incoming: tuple[int, Arrival] | None
-    compute_s: float
-    _compile: Callable[[TaskGraph], None]
-    _on_failure: Callable[[Detection], tuple[bool, str] | None]
-    _on_program_failed: Callable[[], tuple[bool, str] | None]
-    _start: Callable[[EdgeProgram], None]
-    _arm_monitors: Callable[[EdgeProgram], None]
-    _step: Callable[[], None]
 
     def follow_schedule(self, schedule: PlanSchedule) -> None:
         """Plan with ``schedule``: the robot waits for its first motion, the rest arrives at its ticks."""
@@ -156,6 +143,8 @@ class PlanArrivals:
         first = self.reasoning_s + self.compute_s
         path = nominal_path(self.graph)
         self.schedule = PlanSchedule((), first, {e: first for e in path}, {}, {e: first + UNKNOWN_S for e in path})
+        # Called by a strategy only when there is a background plan (``executor.background is not None``).
+        assert self.background is not None
         self.background.start()
         self.trace.add(self.world.tick, "plan_asked", agents=["arranger", "conductor"], first_motion_s=round(first, 4))
 
@@ -178,8 +167,9 @@ class PlanArrivals:
             self.trace.add(self.world.tick, "plan_arrived", failures=len(graph.failures()), recovery_edges=len(graph.recovery_edges()),
                            **({"written_by": arrival.fallback, "llm_error": arrival.error} if arrival.fallback else {}))
 
-    def _received(self, arrival) -> None:
+    def _received(self, arrival: Arrival) -> None:
         schedule = self.schedule
+        assert schedule is not None  # follow_background set it before the background plan was asked
         at = schedule.first_motion_s + arrival.latency_s
         tick = schedule.tick_of(at)
         self.trace.add(self.world.tick, "plan_replied", latency_s=round(arrival.latency_s, 4), arrives_tick=tick,
@@ -217,6 +207,7 @@ class PlanArrivals:
         """The tick a part arriving at ``seconds`` is armed, if that is still to come (None: it is here)."""
         if seconds is None:
             return None
+        assert self.schedule is not None  # ``seconds`` were read from the schedule
         tick = self.schedule.tick_of(seconds)
         return tick if self.world.tick < tick else None
 
@@ -372,7 +363,8 @@ class PlanArrivals:
         moved = [c.call.part for c in self.schedule.calls if (c.call.part, c.start_s) not in before]
         self.trace.add(self.world.tick, "plan_hurried", edge=recovery_edge or edge_id, failure=failure, moved=moved)
 
-    def _early_arrival(self, program: EdgeProgram, arrive: Callable[[], tuple[bool, str] | None]) -> tuple[bool, str] | None | bool:
+    def _early_arrival(self, program: EdgeProgram,
+                       arrive: Callable[[], tuple[bool, str] | None]) -> tuple[bool, str] | Literal[False] | None:
         """A nominal edge that ended at a node whose constraints do not hold, before its failure modes had
         all arrived: their monitors never watched the edge (a cup knocked over while the bottle was
         carried to it), so the robot waits for them as for a failure before its branch, then asks them
@@ -390,8 +382,8 @@ class PlanArrivals:
         if not violated:
             return False
         source, value = violated[0]
-        failure = FailureMode(name=f"reached {program.target}: {source}", monitor=source, intent=DERIVED_INTENT,
-                              recovery=program.edge_id)
+        failure = FailureMode.model_validate({"name": f"reached {program.target}: {source}", "monitor": source,
+                                              "intent": DERIVED_INTENT, "recovery": program.edge_id})
         detection = Detection(program.edge_id, failure, self.world.tick, self.world.tick, float(value))
         if failed_plan:
             return self._on_failure(detection)  # detected, counted, and unrecovered for want of a branch
@@ -432,7 +424,9 @@ class PlanArrivals:
         violated recovers; otherwise the skill's failure goes to the strategy as usual.
         """
         program = self.program
-        listed = self._listed_tick(program.edge_id) if program is not None and program.kind == "nominal" else None
+        if program is None or program.kind != "nominal":
+            return False
+        listed = self._listed_tick(program.edge_id)
         if listed is None:
             return False  # the strategy reads the edge's monitors; a mode it names waits for its own branch
         since = self.world.tick
@@ -454,11 +448,14 @@ class PlanArrivals:
     def _wait_for_grounding(self, program: EdgeProgram) -> bool:
         """Wait for an edge's grounding (nominal, further on in a branch, or an alternative a recovery bound)
         if the robot needs it first (True when it waits). A recovery edge's is hurried."""
-        until = self._tick_at(self.schedule.edge_ready_s.get(program.edge_id)) if self.schedule is not None else None
+        if self.schedule is None:
+            return False
+        until = self._tick_at(self.schedule.edge_ready_s.get(program.edge_id))
         if until is None:
             return False
         if program.kind == "recovery":
             self._hurry(program.edge_id, None, recovery_edge=program.edge_id)
+            assert self.schedule is not None  # _hurry replaces the schedule, never drops it
             until = self._tick_at(self.schedule.edge_ready_s.get(program.edge_id))
             if until is None:
                 return False
@@ -475,13 +472,14 @@ class PlanArrivals:
     def _arrived(self, outcome: str, since: int) -> None:
         """Record what came of a failure that waited for its branch since tick ``since``."""
         waiting = self._arriving
+        assert waiting is not None  # called from a wait's ``then``, which _tick_waiting calls once it set _arriving
         waited = self.world.tick - since
         self.early_failures.append({"edge": waiting.edge_id, "failure": waiting.failure, "tick": since,
                                     "waited_ticks": waited, "then": outcome})
         self.trace.add(self.world.tick, "branch_arrived", edge=waiting.edge_id, failure=waiting.failure,
                        waited_ticks=waited, then=outcome)
 
-    def _tick_waiting(self) -> tuple[bool, str] | None | bool:
+    def _tick_waiting(self) -> tuple[bool, str] | Literal[False] | None:
         """One tick of a wait: the arms hold still until the part arrives (the world stepped, None), or what
         came of it once it has (an outcome, or False: the tick goes on as usual, as when nothing waits)."""
         waiting = self.waiting

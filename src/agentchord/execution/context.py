@@ -11,12 +11,15 @@ from typing import TYPE_CHECKING, Protocol
 import numpy as np
 
 if TYPE_CHECKING:
+    from agentchord.execution.background import ScriptedPlan, ThreadedPlan
     from agentchord.execution.edge_program import EdgeProgram
     from agentchord.execution.planning import PlanSchedule
     from agentchord.execution.trace import Trace
+    from agentchord.expr import CompiledExpr
     from agentchord.features.frame import FeatureFrame
     from agentchord.graph.models import TaskGraph
     from agentchord.monitor import EdgeMonitors, RecoveryMap
+    from agentchord.worlds.protocol import World
 
 
 class ExecutionContext(Protocol):
@@ -24,7 +27,7 @@ class ExecutionContext(Protocol):
 
     Attributes:
         graph: The (filtered) augmented graph being run.
-        frame: The feature frame of this tick.
+        frame: The feature frame of this tick (read-only: the executor's perception owns it).
         trace: The episode's trace.
         node: The last node reached.
         program: The edge program running now (None between edges).
@@ -34,10 +37,13 @@ class ExecutionContext(Protocol):
         visited_nominal: Nominal nodes reached so far, in order.
         keyframes: Nominal node -> per arm (joint targets, grip) when it was reached.
         compute_s: The planner's own work measured in this process so far (s).
+        world: The world being run (its ``tick``).
+        replans: Re-plans adopted so far.
+        constraints: Node id -> its compiled sub-goal constraints.
+        background: The rest of a pipelined plan being asked in the background (None: none, or it has replied).
     """
 
     graph: TaskGraph
-    frame: FeatureFrame
     trace: Trace
     node: str
     program: EdgeProgram | None
@@ -47,7 +53,19 @@ class ExecutionContext(Protocol):
     visited_nominal: list[str]
     keyframes: dict[str, dict[str, tuple[np.ndarray, float]]]
     compute_s: float
-    background: object | None
+    world: World
+    replans: int
+    constraints: dict[str, list[CompiledExpr]]
+
+    @property
+    def frame(self) -> FeatureFrame:
+        """The feature frame of this tick."""
+        ...
+
+    @property
+    def background(self) -> ThreadedPlan | ScriptedPlan | None:
+        """The background plan, if one is being asked (a strategy reads whether there is one)."""
+        ...
 
     def charge(self, kind: str, agent: str, latency_s: float, measured: bool = False, compute_s: float = 0.0,
                tokens: int | None = None) -> None:
@@ -60,6 +78,10 @@ class ExecutionContext(Protocol):
 
     def follow_background(self) -> None:
         """Start on the composed graph; the rest of the plan is asked in the background."""
+        ...
+
+    def adopt(self, graph: TaskGraph) -> None:
+        """Run a re-planned graph from now on (the re-planning baselines)."""
         ...
 
     def constraints_hold(self, node_id: str) -> bool:

@@ -12,7 +12,7 @@ import numpy as np
 
 from agentchord.actions.base import ArmAction, Status
 from agentchord.actions.controller import RobotController
-from agentchord.actions.library import make_action
+from agentchord.actions.library import Grasp, MoveToTarget, Place, make_action
 from agentchord.actions.motion import grip, move_joints
 from agentchord.graph.models import Edge
 
@@ -117,10 +117,10 @@ def _link_grasps_to_places(steps: list[list[ArmAction]]) -> None:
     """Give each grasp the later place of its object by its arm (for ``skip_if_placed``)."""
     for i, step in enumerate(steps):
         for action in step:
-            if action.name != "grasp":
+            if not isinstance(action, Grasp):
                 continue
             later = (a for s in steps[i + 1:] for a in s
-                     if a.name == "place" and a.arm == action.arm and a.args.obj == action.args.obj)
+                     if isinstance(a, Place) and a.arm == action.arm and a.args.obj == action.args.obj)
             action.placed_by = next(later, None)
 
 
@@ -128,9 +128,9 @@ def _link_handoffs_to_later_moves(steps: list[list[ArmAction]]) -> None:
     """Give each hand-off place (``within_reach``) the points later steps move a tool to."""
     for i, step in enumerate(steps):
         for action in step:
-            if action.name == "place" and action.args.within_reach is not None:
+            if isinstance(action, Place) and action.args.within_reach is not None:
                 action.carried_to = tuple(np.asarray(a.args.pos[:2], dtype=float) for s in steps[i + 1:] for a in s
-                                          if a.name == "move_to_target")
+                                          if isinstance(a, MoveToTarget))
 
 
 class ReturnToKeyframe(ArmAction):

@@ -102,6 +102,9 @@ class Executor(RecoverySwitching, PlanArrivals):
         seed: The trial's seed (its scene and its schedule). Both go into the trace's ``episode_start``.
     """
 
+    # All of it (the mixins declare only the budgets they read: :class:`~agentchord.execution.state.RecoveryBudgets`).
+    config: ExecutorConfig
+
     def __init__(
         self,
         graph: TaskGraph,
@@ -326,9 +329,9 @@ class Executor(RecoverySwitching, PlanArrivals):
             return False, lost
         # A part of a pipelined plan the robot waits for; then a failure mode arriving as the edge runs.
         self._poll_background()
-        waited = self._tick_waiting()
-        if waited is not False:
-            return waited
+        held = self._tick_waiting()
+        if held is not False:
+            return held
         if self._arrivals_due():
             self._arm_arrived()
         if self.binding is not None:
@@ -505,6 +508,7 @@ class Executor(RecoverySwitching, PlanArrivals):
 
     def _on_program_done(self) -> tuple[bool, str] | None:
         program = self.program
+        assert program is not None  # called when the running program has just succeeded
         self._skipped = None
         self.trace.add(self.world.tick, "edge_end", edge=program.edge_id)
         self.program = None

@@ -97,7 +97,7 @@ def first_grasps(program: EdgeProgram) -> list[Grasp]:
                 taken.add(action.arm)
             elif action.name not in FREEING_ACTIONS:
                 busy.add(action.arm)
-        handled |= {getattr(action.args, "obj", None) for action in step} - {None}
+        handled |= {o for o in (getattr(action.args, "obj", None) for action in step) if o is not None}
     return grasps
 
 
@@ -120,6 +120,12 @@ def releases_first(program: EdgeProgram, grasp: Grasp, arm: str) -> bool:
 def places_first(program: EdgeProgram, grasp: Grasp) -> bool:
     """Whether ``grasp``'s arm sets an object down earlier in the program (its hand is freed for it)."""
     return _acts_before(program, grasp, grasp.arm, ("place",))
+
+
+def _frame(robot: RobotController) -> FeatureFrame:
+    """The robot's latest feature frame: the executor sets it before anything is checked."""
+    assert robot.frame is not None, "feasibility checked before the first feature frame"
+    return robot.frame
 
 
 class FeasibilityChecker:
@@ -155,7 +161,7 @@ class FeasibilityChecker:
             avoid_other_arm: The IK keeps clear of the other arm where it is now.
         """
         arm, obj = grasp.arm, grasp.args.obj
-        frame = self.robot.frame
+        frame = _frame(self.robot)
         if off_table(frame, [obj]):
             return GraspCheck(arm, obj, f"{obj} has left the table (z = {frame.objects[obj].pos[2]:.2f} m)")
         busy = sorted(o for a, o in frame.holding if a == arm and o != obj and not _both_corners(frame, o, obj))
@@ -194,7 +200,7 @@ class FeasibilityChecker:
         grasp of it there, beside the right hand, was taken as feasible (the right arm only going
         home), and the left arm was held back three times.
         """
-        holders = {arm for arm, obj in self.robot.frame.holding if arm != grasp.arm and obj == grasp.args.obj}
+        holders = {arm for arm, obj in _frame(self.robot).holding if arm != grasp.arm and obj == grasp.args.obj}
         keeps_it = any(not releases_first(program, grasp, arm) for arm in holders)
         return keeps_it or not others_move_first(program, grasp)
 
@@ -203,11 +209,13 @@ class FeasibilityChecker:
 
         A busy hand does not count: an object a busy arm could reach is not beyond recovery.
         """
-        checks = [self.check_grasp(Grasp(arm, GraspArgs(obj=obj)), hand_free=False, confirm_ik=confirm_ik, avoid_other_arm=False)
+        # model_validate, not GraspArgs(obj=obj): mypy takes the positional Field defaults for required.
+        checks = [self.check_grasp(Grasp(arm, GraspArgs.model_validate({"obj": obj})), hand_free=False, confirm_ik=confirm_ik,
+                                   avoid_other_arm=False)
                   for arm in ARMS]
         return [] if any(c.feasible for c in checks) else checks
 
     def where(self, obj: str) -> str:
         """Where an object is, for messages: ``(x, y, z) m``."""
-        x, y, z = self.robot.frame.objects[obj].pos
+        x, y, z = _frame(self.robot).objects[obj].pos
         return f"({x:.2f}, {y:.2f}, {z:.2f}) m"

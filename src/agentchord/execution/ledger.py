@@ -72,4 +72,5 @@ class DisturbanceLedger:
 
     def drops(self, injected: list[DisturbanceEvent]) -> tuple[int, int, int]:
         """Drops injected, detected and recovered (the paper's simulated disturbance)."""
-        return tuple(sum(e.kind == "drop" for e in group) for group in (injected, self.detected, self.recovered))
+        dropped, detected, recovered = (sum(e.kind == "drop" for e in group) for group in (injected, self.detected, self.recovered))
+        return dropped, detected, recovered

@@ -257,10 +257,10 @@ def pipelined_schedule(graph: TaskGraph, latency: AnyLatencyModel, hurries: tupl
     calls = [ScheduledCall(composer, 0.0, composer_end)]
     calls += [ScheduledCall(job.call, job.start_s, job.end_s) for job in sorted(done, key=lambda j: (j.start_s, j.priority))]
     edge_ready = {edge_id: ends[f"edge:{edge_id}"] for edge_id in path} | recovery_ready
-    first = edge_ready[path[0]] if path else composer_end
+    first_motion = edge_ready[path[0]] if path else composer_end
     listed = {edge_id: ends[f"modes:{edge_id}"] for edge_id in path}
     critical = (composer.part, f"{path[0]} grounded") if path else (composer.part,)
-    return PlanSchedule(tuple(calls), first, edge_ready, modes, listed, owners, critical, tuple(hurries), (graph, latency))
+    return PlanSchedule(tuple(calls), first_motion, edge_ready, modes, listed, owners, critical, tuple(hurries), (graph, latency))
 
 
 def _hurry(jobs: list[_Job], hurries: tuple[Hurry, ...], graph: TaskGraph, ground_key: dict[str, str]) -> None:
@@ -300,10 +300,10 @@ def _serve(jobs: list[_Job], latency: AnyLatencyModel, busy_until: list[float]) 
                 job.release_s = max(ended[job.after], job.not_before_s)
             if job.release_s is None and job.after_start in started:
                 job.release_s = max(started[job.after_start] + job.offset_s, job.not_before_s)
-        released = [j for j in pending if j.release_s is not None]
+        released = [(j, j.release_s) for j in pending if j.release_s is not None]
         slot = min(range(len(slots)), key=lambda i: slots[i])
-        now = max(slots[slot], min(j.release_s for j in released))
-        job = min((j for j in released if j.release_s <= now), key=lambda j: j.rank(now))
+        now = max(slots[slot], min(release_s for _, release_s in released))
+        job = min((j for j, release_s in released if release_s <= now), key=lambda j: j.rank(now))
         job.start_s, job.end_s = now, now + latency.price(job.call)
         slots[slot] = job.end_s
         ended[job.key] = job.end_s

@@ -19,8 +19,12 @@ ticks the robot waits for one of them.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field, fields
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
+
+if TYPE_CHECKING:
+    from agentchord.agents.reasoner import ReasonerCall
 
 #: Call kinds and what each stands for.
 CALL_KINDS = {
@@ -276,7 +280,8 @@ class ReasoningConfig:
         return cls(**{**data, "latency": latency_from_dict(data["latency"])})
 
 
-def charge_calls(executor, config: ReasoningConfig, modelled: list[ModelledCall], calls=(), wall_s: float | None = None) -> None:
+def charge_calls(executor, config: ReasoningConfig, modelled: list[ModelledCall], calls: Sequence[ReasonerCall] = (),
+                 wall_s: float | None = None) -> None:
     """Charge the calls a method makes for one planning step; the robot holds still meanwhile.
 
     Args:
@@ -289,15 +294,15 @@ def charge_calls(executor, config: ReasoningConfig, modelled: list[ModelledCall]
         wall_s: Wall time of the whole planning step, if measured here: what the LLM calls did not
             take of it is compute (the offline planner's work, the conductor's solver).
     """
-    made: dict[str, object] = {}
-    for call in calls:
-        made.setdefault(call.agent, call)
+    made: dict[str, ReasonerCall] = {}
+    for made_call in calls:
+        made.setdefault(made_call.agent, made_call)
     llm_s = sum(c.latency_s for c in calls if c.reasoner != "rules")
     rules_s = sum(c.latency_s for c in calls if c.reasoner == "rules")
     compute = max(wall_s - llm_s, 0.0) if wall_s is not None else rules_s
     for k, call in enumerate(modelled):
-        made_call = made.get(call.agent)
-        measured = made_call is not None and made_call.reasoner != "rules"
-        latency = made_call.latency_s if measured else config.latency.price(call)
+        found = made.get(call.agent)
+        measured = found is not None and found.reasoner != "rules"
+        latency = found.latency_s if found is not None and measured else config.latency.price(call)
         executor.charge(call.kind, call.agent, latency, measured=measured, compute_s=compute if k == 0 else 0.0,
                         tokens=None if measured else call.tokens)

@@ -27,6 +27,7 @@ from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from typing import NamedTuple
 
+from agentchord.actions.library import Place
 from agentchord.execution.edge_program import EdgeProgram
 from agentchord.expr.compiler import CompiledExpr
 from agentchord.graph.models import TaskGraph
@@ -90,6 +91,7 @@ class Shortcuts:
             if after is None or after == graph.goal or not holds(after):
                 break
             here = after
+            assert into is not None and middle is not None and out is not None  # after was found through them
             passed.append(middle)
             skipped.extend([into, out])
         return Ahead(here, passed, skipped) if here != node_id else None
@@ -105,7 +107,7 @@ def attach_subgoal_checks(program: EdgeProgram, constraints: Sequence[CompiledEx
     """
     for step in program.steps:
         for action in step:
-            if action.name != "place":
+            if not isinstance(action, Place):
                 continue
             reading = [c for c in constraints if action.args.obj in c.objects]
             if reading:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from agentchord.actions.library import Grasp
 from agentchord.execution.edge_program import EdgeProgram, ReturnToKeyframe
 from agentchord.execution.feasibility import first_grasps
 from agentchord.execution.planning import composer_call, pipelined_schedule, sequential_calls
@@ -17,6 +18,7 @@ from agentchord.execution.reasoning import ModelledCall, ReasoningConfig, charge
 from agentchord.monitor import Detection
 
 if TYPE_CHECKING:
+    from agentchord.actions.base import ArmAction
     from agentchord.execution.context import ExecutionContext as Executor  # the executor as a strategy sees it
     from agentchord.features.frame import FeatureFrame
     from agentchord.graph.models import TaskGraph
@@ -79,7 +81,7 @@ class RecoveryStrategy:
         monitors = executor.monitors.get(program.edge_id)
         if not self.uses_monitors or program.kind != "nominal" or monitors is None:
             return None
-        if action is None or action.name != "grasp":
+        if action is None or not isinstance(action, Grasp):
             return None
         obj = action.args.obj
         if executor.frame.is_holding(action.arm, obj):
@@ -160,7 +162,7 @@ class BacktrackStrategy(RecoveryStrategy):
         for node_id in reversed(executor.visited_nominal):
             if executor.constraints_hold(node_id):
                 keyframe = executor.keyframes[node_id]
-                actions = [ReturnToKeyframe(arm, q, grip) for arm, (q, grip) in keyframe.items()]
+                actions: list[ArmAction] = [ReturnToKeyframe(arm, q, grip) for arm, (q, grip) in keyframe.items()]
                 return [EdgeProgram(f"backtrack_to_{node_id}", node_id, [actions], kind="backtrack")]
         return []
 

@@ -11,74 +11,32 @@ edge that ends short of its target with no monitor fired is repaired online, wit
 (:mod:`agentchord.execution.repair`).
 
 :class:`RecoverySwitching` is a part of :class:`~agentchord.execution.executor.Executor` (a mixin):
-it reads and sets the executor's episode state, named in the annotations below.
+it reads and sets the executor's episode state, declared in :class:`~agentchord.execution.state.ExecutorState`.
 """
 
 from __future__ import annotations
 
 import time
 from dataclasses import replace
-from collections.abc import Callable
-from typing import TYPE_CHECKING, Any
 
 from agentchord.actions.base import Status
-from agentchord.agents.exceptions import ReasonerError
+from agentchord.agents.exceptions import ReasonerError, ReasonerTransportError
 from agentchord.agents.reasoner import UnanticipatedFailure
 from agentchord.execution.arrivals import DERIVED_INTENT
-from agentchord.execution.binding import Binding, HoldMemory
+from agentchord.execution.binding import Binding
 from agentchord.execution.edge_program import EdgeProgram
-from agentchord.execution.feasibility import FeasibilityChecker, first_grasps
-from agentchord.execution.ledger import DisturbanceLedger
-from agentchord.execution.repair import RepairRejectedError, Repairer, validate_repair
+from agentchord.execution.feasibility import first_grasps
+from agentchord.execution.repair import RepairRejectedError, validate_repair
 from agentchord.execution.result import UNRECOVERABLE
 from agentchord.execution.shortcuts import Shortcuts
+from agentchord.execution.state import ExecutorState
 from agentchord.features.frame import FeatureFrame
 from agentchord.monitor import Detection
 from agentchord.worlds.protocol import CONTROL_HZ
 
-if TYPE_CHECKING:
-    from agentchord.execution.strategies import RecoveryStrategy
-    from agentchord.execution.trace import Trace
-    from agentchord.graph.models import TaskGraph
-    from agentchord.monitor import EdgeMonitors
-    from agentchord.worlds.protocol import World
 
-
-class RecoverySwitching:
+class RecoverySwitching(ExecutorState):
     """The executor's failure handling (detection -> recovery switch -> binding -> start or resume)."""
-
-    # The executor's state this part reads and sets.
-    world: World
-    graph: TaskGraph
-    config: Any  # ExecutorConfig (its budgets); not imported: executor.py imports this module
-    strategy: RecoveryStrategy
-    trace: Trace
-    feasibility: FeasibilityChecker
-    shortcuts: Shortcuts
-    holds: HoldMemory
-    disturbances: DisturbanceLedger
-    repairer: Repairer | None
-    monitors: dict[str, EdgeMonitors]
-    program: EdgeProgram | None
-    binding: Binding | None
-    still_since: int | None  # set by a pipelined plan while a recovery that waited for its branch begins
-    armed: EdgeMonitors | None
-    recovering_from: str | None
-    fire_counts: dict[tuple[str, str], int]
-    reasoning_s: float
-    _fallbacks: list[EdgeProgram]
-    _repair_attempts: set[tuple[str, str]]
-    _skipped: tuple[str, str] | None
-    nominal_next: dict[str, str]
-    frame: FeatureFrame
-    constraints: dict[str, list[Any]]  # node -> its compiled constraints
-    _where: Callable[[], str]
-    _early_failure: Callable[[Detection], bool]
-    as_arranged: Callable[[Detection], Detection]
-    _early_program_failure: Callable[[], bool]
-    modes_unknown: Callable[[str], bool]
-    _wait_for_grounding: Callable[[EdgeProgram], bool]
-    _unrecovered: Callable[[Detection], tuple[bool, str]]
 
     def _beyond_every_arm(self, obj: str, confirm_ik: bool) -> tuple[bool, str] | None:
         """The unrecoverable outcome when no arm can take ``obj`` where it is (else None)."""
@@ -104,6 +62,7 @@ class RecoverySwitching:
     def _bind(self, frame: FeatureFrame) -> tuple[bool, str] | None:
         """One tick of a binding recovery: wait for rest, then start the first feasible candidate."""
         binding = self.binding
+        assert binding is not None  # the tick loop calls this only while a recovery binds
         waited = self.world.tick - binding.since
         if binding.holds_back(frame):
             self._resume(binding)
@@ -129,13 +88,13 @@ class RecoverySwitching:
             # budget ended the episode; the recovery runs instead.
             met = None
         if met is not None:
-            self._skipped = skip
+            self._skipped = (skip[0], met)  # ``skip`` itself: ``met`` is the node it was made with
             # What the recovery was for already holds (a bottle pulled out of the hand as it was being
             # put down, set down upright by the person): nothing to redo, go on from the merge node.
             self.trace.add(self.world.tick, "subgoal_met", edge=binding.candidates[0].edge_id, node=met,
                            waited_ticks=waited)
             return self._arrive(met)
-        refused = []
+        refused: list[dict[str, str]] = []
         for k, candidate in enumerate(binding.candidates):
             problems = self.feasibility.check_program(candidate)
             if not problems:
@@ -167,7 +126,7 @@ class RecoverySwitching:
         """
         edge_id = self.nominal_next.get(node_id)
         monitors = self.monitors.get(edge_id) if edge_id is not None else None
-        if monitors is None or self.modes_unknown(edge_id):
+        if edge_id is None or monitors is None or self.modes_unknown(edge_id):
             return False
         frame = self.frame
         as_started = replace(frame, refs={name: feats.pos.copy() for name, feats in frame.objects.items()})
@@ -177,6 +136,7 @@ class RecoverySwitching:
         """The lost holds came back as they were: the failure cleared, the interrupted edge goes on."""
         self.binding = None
         program = binding.suspended
+        assert program is not None  # a binding's holds come back only where it kept the interrupted edge
         self.program = program
         self._arm_monitors(program)
         self.recovering_from = binding.recovering_from
@@ -208,7 +168,7 @@ class RecoverySwitching:
         failed_nominal = self.recovering_from or detection.edge_id
         candidates = self.strategy.recover(self, detection)
         lost = None
-        if resumable:
+        if interrupted is not None and resumable:
             # A hold lost by the interrupted edge's arms may come back while the recovery waits.
             objects = sorted({g.args.obj for c in candidates for g in first_grasps(c)})
             lost = self.holds.lost(self.frame, {a.arm for a in interrupted.running}, objects) if objects else None
@@ -225,6 +185,8 @@ class RecoverySwitching:
         outcome = self._begin_recovery(candidates)
         if lost is not None:
             # The recovery waits for what fell; if it was never really let go, the edge goes on.
+            # A hold is looked for only when the candidates grasp: _begin_recovery then bound them.
+            assert self.binding is not None
             self.binding.suspended, self.binding.lost = interrupted, lost
             self.binding.failure, self.binding.recovering_from = detection.failure.name, previous_context
             self.binding.window = detection.failure.window
@@ -235,6 +197,7 @@ class RecoverySwitching:
         undone under it), take it as the strategy's detection, bind the next candidate, or end."""
         if self._early_program_failure():
             return None  # its branch has not arrived: the arms hold still until it does
+        assert self.program is not None  # a skill's failure is reported by the running program
         program = self.program
         if program.kind == "recovery" and program.attempt == 1 and program.scene_changed:
             # What it had found done was undone under it (a cup found placed, then knocked over
@@ -316,6 +279,10 @@ class RecoverySwitching:
             repair = validate_repair(self.graph, proposal, failure)
         except (RepairRejectedError, ReasonerError) as error:
             reason = error.reason if isinstance(error, RepairRejectedError) else error.headline
+            if isinstance(error, ReasonerTransportError):
+                # The endpoint is down: the next repair would wait out every retry again for nothing.
+                self.repairer = None
+                reason += " (the endpoint is down: no more repairs are asked in this episode)"
             self.trace.add(self.world.tick, "repair", **record, failure=None, recovery=None, accepted=False,
                            reason=reason, latency_s=time.perf_counter() - started)
             return None

@@ -127,13 +127,21 @@ def recovery_arcs(graph: TaskGraph) -> list[Arc]:
 
 
 # ---------------------------------------------------------------------------------------------- DOT
-def _quote(text: str) -> str:
+#: Characters of one quoted DOT string (a label, a tooltip) a figure keeps: Graphviz refuses a quoted
+#: string over 16,384 characters, and a label that long is unreadable anyway.
+MAX_QUOTED_CHARS = 4000
+
+
+def dot_quote(text: str) -> str:
+    """``text`` as a quoted DOT string, cut to :data:`MAX_QUOTED_CHARS` (the cut says how long it was)."""
+    if len(text) > MAX_QUOTED_CHARS:
+        text = text[:MAX_QUOTED_CHARS - 40] + f"... [{len(text):,} characters in all]"
     return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
 
 
 def _tooltip(lines: list[str]) -> str:
     # Graphviz turns "&#10;" into a line break in SVG titles; the rest is escaped text.
-    return _quote("&#10;".join(html.escape(line, quote=False) for line in lines))
+    return dot_quote("&#10;".join(html.escape(line, quote=False) for line in lines))
 
 
 def _html(lines: list[tuple[str, str]]) -> str:
@@ -180,7 +188,7 @@ def _node_statement(node: Node, graph: TaskGraph) -> str:
         attrs += ['style="rounded,bold"', "penwidth=2"]
     if node.id == graph.goal:
         attrs.append("peripheries=2")
-    return f"  {_quote(node.id)} [{', '.join(attrs)}];"
+    return f"  {dot_quote(node.id)} [{', '.join(attrs)}];"
 
 
 def _nominal_statement(edge: Edge) -> str:
@@ -190,7 +198,7 @@ def _nominal_statement(edge: Edge) -> str:
     tip = [f"{edge.id}: {edge_calls(edge)}", *(failure_line(edge, f) for f in edge.failures)]
     attrs = [f"label={_html(lines)}", f'color="{NOMINAL_COLOR}"', f'fontcolor="{NOMINAL_COLOR}"', "penwidth=2.5",
              "weight=10", f"tooltip={_tooltip(tip)}", f"labeltooltip={_tooltip(tip)}"]
-    return f"  {_quote(edge.source)} -> {_quote(edge.target)} [{', '.join(attrs)}];"
+    return f"  {dot_quote(edge.source)} -> {dot_quote(edge.target)} [{', '.join(attrs)}];"
 
 
 def arc_tooltip(arc: Arc) -> list[str]:
@@ -228,7 +236,7 @@ def _arc_statement(arc: Arc, recovery_nodes: set[str]) -> str:
         # A rank between the recovery node and its merge: its way back runs down to the node, labelled,
         # instead of sideways along the rank, all of its exits on one line.
         attrs.append("minlen=2")
-    return f"  {_quote(edge.source)} -> {_quote(edge.target)} [{', '.join(attrs)}];"
+    return f"  {dot_quote(edge.source)} -> {dot_quote(edge.target)} [{', '.join(attrs)}];"
 
 
 def _retry_statements(node: str, arcs: list[Arc], box: str) -> list[str]:
@@ -241,10 +249,10 @@ def _retry_statements(node: str, arcs: list[Arc], box: str) -> list[str]:
     edge_attrs = f'color="{RECOVERY_COLOR}", style="dashed", tooltip={tip}'
     box_attrs = f'color="{RECOVERY_COLOR}", fontcolor="{RECOVERY_TEXT}", style="rounded,dashed", fontsize=12'
     return [
-        f"  {_quote(box)} [label={_html(lines)}, {box_attrs}, tooltip={tip}];",
-        f"  {{ rank=same; {_quote(node)}; {_quote(box)}; }}",
-        f"  {_quote(node)} -> {_quote(box)} [{edge_attrs}];",
-        f"  {_quote(box)} -> {_quote(node)} [{edge_attrs}];",
+        f"  {dot_quote(box)} [label={_html(lines)}, {box_attrs}, tooltip={tip}];",
+        f"  {{ rank=same; {dot_quote(node)}; {dot_quote(box)}; }}",
+        f"  {dot_quote(node)} -> {dot_quote(box)} [{edge_attrs}];",
+        f"  {dot_quote(box)} -> {dot_quote(node)} [{edge_attrs}];",
     ]
 
 
@@ -263,9 +271,9 @@ def _split_retries(graph: TaskGraph) -> tuple[list[Arc], dict[str, list[Arc]]]:
 def to_figure_dot(graph: TaskGraph) -> str:
     """The readable figure as Graphviz DOT (see the module's docstring)."""
     out = [
-        f"digraph {_quote(graph.task)} {{",
+        f"digraph {dot_quote(graph.task)} {{",
         "  rankdir=TB; nodesep=0.25; ranksep=0.35;",
-        f"  label={_quote(f'{graph.task}: {TITLE}')};",
+        f"  label={dot_quote(f'{graph.task}: {TITLE}')};",
         '  labelloc=t; fontname="Helvetica"; fontsize=16;',
         '  node [shape=box, style="rounded", fontname="Helvetica", fontsize=13, margin="0.15,0.06"];',
         '  edge [fontname="Helvetica", fontsize=12, arrowsize=0.8];',

@@ -16,11 +16,12 @@ from __future__ import annotations
 
 import re
 import shutil
+import subprocess
 import textwrap
 from pathlib import Path
 
 from agentchord.graph.exceptions import RenderError
-from agentchord.graph.figure import NOMINAL_COLOR, RECOVERY_COLOR, to_figure_dot
+from agentchord.graph.figure import NOMINAL_COLOR, RECOVERY_COLOR, dot_quote, to_figure_dot
 from agentchord.graph.figure import edge_calls as edge_summary
 from agentchord.graph.models import Edge, FailureMode, Node, TaskGraph
 from agentchord.graph.page import to_html
@@ -32,6 +33,8 @@ STYLES = ("readable", "full")
 #: Largest graph (nodes + edges) laid out by Graphviz: its time grows faster than the size
 #: (3,000 nodes take ~10 s, 10,000 never end); text formats have no limit.
 MAX_LAYOUT_SIZE = 2500
+#: Seconds Graphviz may take to lay a graph out before the render gives up with a RenderError.
+LAYOUT_TIMEOUT_S = 60.0
 
 __all__ = ["FORMATS", "STYLES", "edge_summary", "render", "to_dot", "to_mermaid"]
 
@@ -67,19 +70,15 @@ def _node_lines(node: Node, graph: TaskGraph) -> list[str]:
     return [title, *textwrap.wrap(node.semantic, 32)]
 
 
-def _dot_quote(text: str) -> str:
-    return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
-
-
 def _dot_label(lines: list[str]) -> str:
     # "\l" would left-align; centred lines read better in small boxes.
-    return _dot_quote("\n".join(lines)).replace("\n", "\\n")
+    return dot_quote("\n".join(lines)).replace("\n", "\\n")
 
 
 def to_dot(graph: TaskGraph) -> str:
     """The graph as Graphviz DOT source."""
     out = [
-        f"digraph {_dot_quote(graph.task)} {{",
+        f"digraph {dot_quote(graph.task)} {{",
         "  rankdir=LR;",
         '  node [shape=box, style="rounded", fontname="Helvetica", fontsize=10];',
         '  edge [fontname="Helvetica", fontsize=9];',
@@ -92,7 +91,7 @@ def to_dot(graph: TaskGraph) -> str:
             attrs.append('style="rounded,bold", penwidth=2')
         if node.id == graph.goal:
             attrs.append("peripheries=2")
-        out.append(f"  {_dot_quote(node.id)} [{', '.join(attrs)}];")
+        out.append(f"  {dot_quote(node.id)} [{', '.join(attrs)}];")
     triggers = _entry_failures(graph)
     for edge in graph.edges:
         color = RECOVERY_COLOR if edge.is_recovery else NOMINAL_COLOR
@@ -105,7 +104,7 @@ def to_dot(graph: TaskGraph) -> str:
             attrs.append('style="dashed"')
         elif edge.alternative_to is not None:
             attrs.append('style="dotted"')
-        out.append(f"  {_dot_quote(edge.source)} -> {_dot_quote(edge.target)} [{', '.join(attrs)}];")
+        out.append(f"  {dot_quote(edge.source)} -> {dot_quote(edge.target)} [{', '.join(attrs)}];")
     out.append("}")
     return "\n".join(out) + "\n"
 
@@ -210,10 +209,15 @@ def _graphviz_pipe(source: str, fmt: str) -> bytes:
             "or render to .dot or .mmd instead"
         )
     try:
-        import graphviz
-    except ImportError:
-        raise RenderError(f"rendering {fmt} needs the graphviz Python package: `pip install graphviz`") from None
-    try:
-        return graphviz.Source(source).pipe(format=fmt)
-    except (graphviz.ExecutableNotFound, graphviz.CalledProcessError) as error:
+        # The binary run as the package would run it, with a time limit the package does not offer.
+        done = subprocess.run(["dot", f"-T{fmt}"], input=source.encode("utf-8"), capture_output=True,
+                              timeout=LAYOUT_TIMEOUT_S, check=False)
+    except subprocess.TimeoutExpired:
+        raise RenderError(f"Graphviz did not lay the graph out within {LAYOUT_TIMEOUT_S:g} s (a graph this dense takes "
+                          "longer than a figure is worth): render to .dot or .mmd instead") from None
+    except OSError as error:
         raise RenderError(f"Graphviz failed to render {fmt}: {error}") from None
+    if done.returncode != 0:
+        message = done.stderr.decode("utf-8", "replace").strip()[:500]
+        raise RenderError(f"Graphviz failed to render {fmt}: {message or f'exit status {done.returncode}'}")
+    return done.stdout

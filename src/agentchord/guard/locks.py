@@ -47,7 +47,7 @@ def lock_folder(folder: str | Path, name: str, what: str) -> int:
     except OSError:
         holder = os.read(fd, 200).decode("utf-8", "replace").strip() or "another process"
         os.close(fd)
-        raise FolderBusyError(str(folder), f"another {what} is running on this folder ({holder}); "
+        raise FolderBusyError(str(folder), f"another {what} is running on this directory ({holder}); "
                               "wait for it to end, or use another --out") from None
     os.ftruncate(fd, 0)
     stamp = datetime.datetime.now().isoformat(timespec="seconds")

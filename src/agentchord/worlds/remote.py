@@ -20,7 +20,7 @@ import ipaddress
 import math
 import os
 import socket as sockets
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 import zmq
@@ -28,6 +28,10 @@ import zmq
 from agentchord.robot.aloha import ARMS
 from agentchord.worlds.protocol import ArmCommand, CameraFrame, ObjectInfo
 from agentchord.worlds.wire import PROTOCOL_VERSION, WireError, pack, unpack
+
+Vec2 = tuple[float, float]
+Vec3 = tuple[float, float, float]
+Vec4 = tuple[float, float, float, float]
 
 #: Seconds a reply may take before the server counts as gone (a camera frame or a trial's set-up included).
 DEFAULT_TIMEOUT_S = 120.0
@@ -38,6 +42,9 @@ MAX_TIMEOUT_S = 86_400.0
 #: Protocol versions this client speaks (1: without trial tokens).
 PROTOCOLS = (1, PROTOCOL_VERSION)
 
+
+#: Milliseconds a closing client waits for the server to take its close.
+CLOSE_WAIT_MS = 1000
 
 class RemoteWorldError(RuntimeError):
     """The remote world did not answer, refused a request, or speaks another protocol version."""
@@ -248,7 +255,7 @@ class RemoteWorld:
         self.address = resolve_address(address)
         self.timeout_s = timeout_from_env() if timeout_s is None else check_timeout(timeout_s)
         self.timeout_ms = int(self.timeout_s * 1000)
-        self._context = zmq.Context.instance()
+        self._context: zmq.Context[zmq.Socket] = zmq.Context.instance()
         self._socket: zmq.Socket | None = None
         #: The open trial's token (protocol 2): every request of the trial carries it.
         self.trial: str | None = None
@@ -286,12 +293,13 @@ class RemoteWorld:
                 self._objects[name] = ObjectInfo(
                     name=name, shape=read.field(o, "shape", str, f"{at}.shape"),
                     size=tuple(float(x) for x in read.array(o, "size", (-1,), f"{at}.size")),
-                    rgba=tuple(float(x) for x in read.array(o, "rgba", (4,), f"{at}.rgba")),
+                    # The casts give the tuples the lengths the protocol sends (rgba's is checked, parts' and pos' are not).
+                    rgba=cast(Vec4, tuple(float(x) for x in read.array(o, "rgba", (4,), f"{at}.rgba"))),
                     mass=float(read.number(o, "mass", f"{at}.mass", low=0.0)),
                     friction=float(read.number(o, "friction", f"{at}.friction", low=0.0)),
-                    parts=tuple((tuple(float(x) for x in h), tuple(float(x) for x in c))
+                    parts=tuple((cast(Vec3, tuple(float(x) for x in h)), cast(Vec3, tuple(float(x) for x in c)))
                                 for h, c in read.field(o, "parts", list, f"{at}.parts")),
-                    pos=tuple(float(x) for x in read.array(o, "pos", (-1,), f"{at}.pos")),
+                    pos=cast(Vec2, tuple(float(x) for x in read.array(o, "pos", (-1,), f"{at}.pos"))),
                     yaw=float(read.number(o, "yaw", f"{at}.yaw")),
                 )
             self._object_index = {name: k for k, name in enumerate(self._objects)}
@@ -369,19 +377,33 @@ class RemoteWorld:
         return reply
 
     def close(self) -> None:
-        """Close the trial (when the server still answers) and the connection."""
+        """Close the trial (when the server still answers, within a second) and the connection.
+
+        The close goes on a connection of its own: the request socket may still be waiting for a
+        reply (a client interrupted by Ctrl-C or SIGTERM in the middle of a step), and a REQ socket
+        in that state cannot send, which left the trial open and every other client refused until
+        the server released it.
+        """
         if self._socket is None:
             return
         socket, self._socket = self._socket, None
-        try:
-            if self.trial is not None:  # a refused open has no trial to close (and must not close another's)
-                socket.send(pack({"op": "close", "trial": self.trial}), zmq.NOBLOCK)
-                if socket.poll(1000):
-                    socket.recv()
-        except zmq.ZMQError:
-            pass
-        self.trial = None
         socket.close(0)
+        trial, self.trial = self.trial, None
+        if trial is None:  # a refused open has no trial to close (and must not close another's)
+            return
+        closer = self._context.socket(zmq.REQ)
+        try:
+            closer.setsockopt(zmq.LINGER, 0)
+            closer.setsockopt(zmq.SNDTIMEO, CLOSE_WAIT_MS)
+            closer.setsockopt(zmq.IPV6, 1)
+            closer.connect(self.address)
+            closer.send(pack({"op": "close", "trial": trial}))
+            if closer.poll(CLOSE_WAIT_MS):
+                closer.recv()
+        except zmq.ZMQError:
+            pass  # the server is gone: it released the trial with itself
+        finally:
+            closer.close(0)
 
     def __enter__(self) -> RemoteWorld:
         return self

@@ -5,9 +5,10 @@ from __future__ import annotations
 import copy
 import time
 from collections.abc import Callable, Mapping
-from typing import Any
+from typing import Any, cast
 
 import openai
+from openai.types.chat import ChatCompletionMessageParam
 
 from agentchord.agents.exceptions import InvalidReplyError, ReasonerError, ReasonerTransportError
 from agentchord.agents.llm.config import ENV_DEADLINE, STRUCTURED_OUTPUT_MODES, LlmConfig
@@ -188,13 +189,14 @@ class LlmReasoner:
                     problems=attempt.transport_errors or ["the deadline passed before a request could be sent"],
                 )
             limit = min(config.timeout_s, left)
+
+            def send(limit: float = limit, mode: str = mode) -> Any:
+                # The conversation's plain dicts are the role/content messages the chat API takes.
+                chat = cast("list[ChatCompletionMessageParam]", messages)
+                return self._client.chat.completions.create(model=config.model, messages=chat, timeout=limit, **self._params(mode))
+
             try:
-                completion = within(
-                    limit,
-                    lambda limit=limit, mode=mode: self._client.chat.completions.create(
-                        model=config.model, messages=messages, timeout=limit, **self._params(mode)
-                    ),
-                )
+                completion = within(limit, send)
             except openai.APIStatusError as error:
                 status = error.status_code
                 line = f"HTTP {status}: {error_text(error)}"

@@ -57,6 +57,10 @@ def parse_reply(
         check_shape(data)  # a validator must not recurse into a 10,000-level list
     except DocumentError as error:
         return None, [f"{error.where}: {error}" if error.where else str(error)]
+    surrogate = lone_surrogate(data)
+    if surrogate is not None:
+        where, char = surrogate
+        return None, [f"{where}: the text holds a lone surrogate (\\u{ord(char):04x}), which is not Unicode text: write plain characters"]
     data = _fill_from_request(data, request)
     try:
         graph = TaskGraph.model_validate(data)
@@ -66,6 +70,25 @@ def parse_reply(
     if isinstance(request, ComposeRequest):
         problems += stated_goal_problems(graph, request.scene)
     return graph, [str(problem) for problem in problems]
+
+
+def lone_surrogate(value: Any, where: str = "reply") -> tuple[str, str] | None:
+    """The first lone surrogate (``"\\ud800"`` in JSON: no character, cannot be written as UTF-8) in a
+    parsed reply's keys or strings, with where it is; None when every string is text."""
+    if isinstance(value, str):
+        bad = next((c for c in value if "\ud800" <= c <= "\udfff"), None)
+        return (where, bad) if bad is not None else None
+    if isinstance(value, dict):
+        for key, item in value.items():
+            found = lone_surrogate(key, where) or lone_surrogate(item, f"{where}.{key}" if where != "reply" else str(key))
+            if found is not None:
+                return found
+    if isinstance(value, list):
+        for k, item in enumerate(value):
+            found = lone_surrogate(item, f"{where}[{k}]")
+            if found is not None:
+                return found
+    return None
 
 
 _FENCE = re.compile(r"```(?:json|JSON)?[ \t]*\n(.*?)```", re.DOTALL)
@@ -159,6 +182,11 @@ def read_completion(
         choice = choices[0]
         message = getattr(choice, "message", None)
         content = getattr(message, "content", None)
+        if isinstance(content, str):
+            # A lone surrogate sent raw (JSON "\ud800" in the response body) is no character: kept as its
+            # escape text, so that the reply can be sent back for repair and written to a trace; the
+            # reply's own JSON then reads it as a lone surrogate, a problem it is told.
+            content = content.encode("utf-8", "backslashreplace").decode("utf-8")
         raw_refusal = getattr(message, "refusal", None)
         refusal = raw_refusal if isinstance(raw_refusal, str) else None
         finish = getattr(choice, "finish_reason", None)

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 from importlib import resources
 
 from agentchord.agents.reasoner import AgentRequest, ComposeRequest
-from agentchord.agents.scene import Scene, SceneObject
+from agentchord.agents.scene import Region, Scene, SceneObject
 from agentchord.graph.models import TaskGraph
 from agentchord.graph.progress import nominal_path
 
@@ -139,7 +139,8 @@ def request_words(request: AgentRequest) -> str:
 def scene_words(scene: Scene) -> list[str]:
     """Names and descriptions of a scene's objects and regions."""
     words = []
-    for item in [*scene.objects, *scene.regions]:
+    items: list[SceneObject | Region] = [*scene.objects, *scene.regions]
+    for item in items:
         words += [item.name, item.description]
     return words
 

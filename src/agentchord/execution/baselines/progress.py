@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from agentchord.agents.rules import knowledge as kb
 from agentchord.agents.rules.goals import GoalSpec, HandedOver, Poured
-from agentchord.expr import Vocabulary, compile_expr
+from agentchord.expr import CompiledExpr, Vocabulary, compile_expr
 from agentchord.features.frame import FeatureFrame
 
 
@@ -30,9 +30,9 @@ class GoalEvents:
         vocabulary = Vocabulary(frozenset(objects))
         self.achieved: set[int] = set()
         # Per event goal: alternatives, each a list of expressions that all hold (<= 0) when it happens.
-        self._tests: dict[int, list[list]] = {}
+        self._tests: dict[int, list[list[CompiledExpr]]] = {}
         # A handover needs its giver to have held the object first.
-        self._given: dict[int, str] = {}
+        self._given: dict[int, CompiledExpr] = {}
         self._held_by_giver: set[int] = set()
         for index, g in enumerate(goal.goals):
             if isinstance(g, Poured):

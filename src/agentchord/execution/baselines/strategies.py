@@ -31,7 +31,7 @@ from agentchord.monitor import Detection
 
 if TYPE_CHECKING:
     from agentchord.agents.pipeline import Replanner
-    from agentchord.execution.executor import Executor
+    from agentchord.execution.context import ExecutionContext as Executor
     from agentchord.features.frame import FeatureFrame
 
 #: ReKep's ``constraint_tolerance``: a path constraint's cost above it is a violation.
@@ -39,7 +39,8 @@ REKEP_TOLERANCE = 0.10
 
 
 def _failure(name: str, intent: str) -> FailureMode:
-    return FailureMode(name=name, monitor="1", intent=intent, recovery=intent)
+    # model_validate, not FailureMode(...): mypy takes the positional Field defaults (margin, window) for required.
+    return FailureMode.model_validate({"name": name, "monitor": "1", "intent": intent, "recovery": intent})
 
 
 VQA_NO = _failure("vqa_failure", "replan")
@@ -76,6 +77,8 @@ class BaselineStrategy(RecoveryStrategy):
         reasoning: Latencies, VQA error rates, DoReMi's period.
         context: Per-episode re-planner, progress and seed.
     """
+
+    reasoning: ReasoningConfig  # never None here (the default config when none is given)
 
     def __init__(self, reasoning: ReasoningConfig | None = None, context: BaselineContext | None = None) -> None:
         self.reasoning = reasoning or ReasoningConfig()
