@@ -57,6 +57,27 @@ def load(path: Path) -> list[dict]:
     return yaml.safe_load(path.read_text(encoding="utf-8"))["entries"]
 
 
+def load_blind(folder: Path, writers: Iterable[str]) -> list[dict]:
+    """The blind evaluation set's entries of ``writers`` (``A`` ...), as corpus entries: each writer's
+    instructions (``writer_X.yaml``) with the goal ``labels.yaml`` says it means (or ``expect: refused``),
+    and its classes: the kinds of phrasing ``kinds.yaml`` tags it with, if any, else ``plain``."""
+    labels = yaml.safe_load((folder / "labels.yaml").read_text(encoding="utf-8"))["labels"]
+    kinds_path = folder / "kinds.yaml"
+    kinds = yaml.safe_load(kinds_path.read_text(encoding="utf-8"))["kinds"] if kinds_path.exists() else {}
+    out = []
+    for writer in writers:
+        for item in yaml.safe_load((folder / f"writer_{writer}.yaml").read_text(encoding="utf-8"))["entries"]:
+            label = labels[item["id"]]
+            entry = {"id": item["id"], "task": label["scene"], "instruction": item["instruction"],
+                     "classes": list(kinds.get(item["id"]) or ["plain"])}
+            if "goal" in label:
+                entry["goal"] = label["goal"]
+            else:
+                entry["expect"] = "refused"
+            out.append(entry)
+    return out
+
+
 def _key(goal) -> tuple:
     fields = goal.model_dump()
     return tuple(sorted((k, round(v, 2) if isinstance(v, float) else tuple(round(x, 2) for x in v) if isinstance(v, (tuple, list)) else v)
@@ -120,5 +141,5 @@ def table(outcomes: Iterable[Outcome]) -> dict[str, dict[str, int]]:
     rows: dict[str, dict[str, int]] = {c: {"right": 0, "refused": 0, "wrong": 0} for c in (*CLASSES, "all")}
     for outcome in outcomes:
         for name in (*outcome.entry["classes"], "all"):
-            rows[name][outcome.verdict] += 1
+            rows.setdefault(name, {"right": 0, "refused": 0, "wrong": 0})[outcome.verdict] += 1
     return {k: v for k, v in rows.items() if sum(v.values())}

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from agentchord.agents.exceptions import ReasonerError
 from agentchord.agents.scene import Scene
+from agentchord.agents.rules.discourse import NotAGoalError
 from agentchord.agents.rules.composer import compose
 from agentchord.agents.rules.goals import GoalSpec
 from agentchord.agents.rules.instructions import Reading, read_instruction, vocabulary
@@ -78,7 +79,11 @@ def explain_plan(instruction: str, scene: Scene, goal: GoalSpec | None = None) -
         lines.append(f"instruction: {instruction!r}")
         lines.append(f"normalised:  {normalise(instruction)!r}")
         known, objects = vocabulary(scene)
-        prepared = prepare(instruction, known, objects)
+        try:
+            prepared = prepare(instruction, known, objects)
+        except NotAGoalError as error:
+            lines.append(f"refused: {error}")
+            return "\n".join(lines)
         if prepared.text != normalise(instruction):
             lines.append(f"rewritten:   {prepared.text!r}" + (f" (typos: {prepared.corrected})" if prepared.corrected else ""))
         try:

@@ -42,6 +42,7 @@ from agentchord.agents.rules.references import (
     Context,
 )
 from agentchord.robot.aloha import other_arm
+from agentchord.agents.rules.discourse import NotAGoalError
 
 @dataclass
 class Reading:
@@ -63,7 +64,9 @@ class Reading:
 
     @property
     def goal(self) -> GoalSpec:
-        return GoalSpec(goals=[g for part in self.goals for g in part])
+        # A goal said twice ("fold the towel in half, near edge onto far edge") is one goal.
+        goals = [g for part in self.goals for g in part]
+        return GoalSpec(goals=[g for k, g in enumerate(goals) if g not in goals[:k]])
 
 
 def _pour(c: Clause, ctx: Context) -> list[Goal]:
@@ -79,11 +82,15 @@ def _pour(c: Clause, ctx: Context) -> list[Goal]:
             raise ctx.error(c.text, "does not say what to pour from (say 'from the bottle')")
         source = ctx.mention(vessels[0])
         ctx.mention(target)
-    hold_target = c.arm == "both" or target in ctx.held_by
+    hold_target = c.arm == "both" or target in ctx.held_by or target in ctx.in_hand  # a cup picked up is poured into in hand
     arm = ctx.arm_of(c.arm, source)
     if hold_target and target not in ctx.in_hand:
         ctx.take(target)  # the other arm holds it: it is put down too
     ctx.take(source)
+    if arm in ("left", "right"):  # who holds what, for "both of you set them down"
+        ctx.pour_arms[source] = arm
+        if hold_target and target not in ctx.held_by:
+            ctx.pour_arms[target] = other_arm(arm)
     return [Poured(source=source, target=target, arm=arm, hold_target=hold_target)]
 
 
@@ -286,7 +293,10 @@ def read_instruction(instruction: str, scene: Scene) -> Reading:
             instructions understood in this scene, and the goal-spec alternative.
     """
     known, objects = vocabulary(scene)
-    prepared = prepare(instruction, known, objects)
+    try:
+        prepared = prepare(instruction, known, objects)
+    except NotAGoalError as exc:
+        raise InstructionNotGroundedError(instruction, str(exc)) from None
     try:
         clauses = parse_prepared(prepared.text)
     except ParseError as exc:

@@ -26,6 +26,9 @@ import re
 from dataclasses import dataclass, field
 from functools import lru_cache
 
+from agentchord.agents.rules.discourse import read_sentence
+from agentchord.agents.rules.english import is_word
+
 #: Verbs people use -> the verb the grammar reads (only where a clause starts with them).
 VERB_SYNONYMS = {
     "decant": "pour", "dump": "pour", "tilt": "pour", "pour out": "pour", "spill": "pour",
@@ -119,6 +122,12 @@ def _lemmas() -> dict[str, str]:
     return table
 
 
+def _verb(word: str) -> str | None:
+    """The verb the rules read that ``word`` is a form of (``picks`` -> ``pick``), else None."""
+    verb = lemma(word)
+    return verb if verb in _VERB_WORDS and verb not in ("up", "down", "end", "go", "have", "leave") else None
+
+
 def lemma(word: str) -> str:
     """The verb an inflected form is of (``pouring`` -> ``pour``), or the word itself."""
     return _lemmas().get(word, word)
@@ -150,19 +159,33 @@ def _subsequence(short: str, long: str) -> bool:
 def correct(word: str, vocabulary: frozenset[str]) -> str | None:
     """The one known word ``word`` is a typo of, or ``None``.
 
-    One edit, on words of four letters or more (three for a transposition: ``cpu``); where two
+    Never an English word (:func:`~agentchord.agents.rules.english.is_word`: "handles" is not a typo
+    of "handes"), and never towards a verb form English lacks. One edit, on words of four letters or
+    more (three for a transposition: ``cpu``); where two
     known words are one edit away, a letter dropped from one of them wins (``pur`` -> ``pour``,
     not ``put``), and otherwise the word is left alone.
     """
-    if word in vocabulary or not word.isalpha() or len(word) < 3 or lemma(word) != word:
-        return None
-    close = [w for w in vocabulary if abs(len(w) - len(word)) <= 1 and w[0] in (word[0], word[1]) and _distance(word, w) == 1]
+    if word in vocabulary or not word.isalpha() or len(word) < 3 or lemma(word) != word or is_word(word):
+        return None  # known, not a word, an inflection, or English: a word people write is not a typo
+    generated = _lemmas()
+    close = [w for w in vocabulary if abs(len(w) - len(word)) <= 1 and w[0] in (word[0], word[1]) and _distance(word, w) == 1
+             and not (w in generated and generated[w] != w and not is_word(w))]  # not an ending English lacks ("handes")
     if len(word) == 3:  # short words: a transposition or a letter dropped only ("cpu", "pur")
         close = [w for w in close if sorted(w) == sorted(word) or (len(w) == 4 and _subsequence(word, w))]
     # Several one edit away: a transposition first, then a letter dropped, then one added.
     for prefer in (lambda w: sorted(w) == sorted(word), lambda w: len(w) > len(word), lambda w: len(w) < len(word)):
         if len(close) > 1:
             close = [w for w in close if prefer(w)] or close
+    return close[0] if len(close) == 1 else None
+
+
+#: Nouns of the table itself, the place noun an English word after "the" may be a slip for.
+_PLACE_NOUNS = ("table", "tabletop")
+
+
+def correct_place(word: str) -> str | None:
+    """The table noun ``word`` is one edit from ("tale" -> table), or ``None``."""
+    close = [w for w in _PLACE_NOUNS if w != word and len(word) >= 4 and _distance(word, w) == 1]
     return close[0] if len(close) == 1 else None
 
 
@@ -254,11 +277,16 @@ def rewrite(text: str, vocabulary: frozenset[str] = frozenset(), objects: frozen
         words = text.split(" ")
         for i, word in enumerate(words):
             fixed = correct(word, vocabulary)
+            if fixed is None and i > 0 and words[i - 1] == "the" and is_word(word):
+                # An English word heading a noun phrase may still be a slip for the one place noun it is
+                # an edit from ("of the tale" -> table): places are not objects, whose names stay exact.
+                fixed = correct_place(word)
             if fixed is not None:
                 out.corrected[word] = fixed
                 words[i] = fixed
         text = " ".join(words)
-    sentences = [_sentence(sentence, steps, objects) for sentence in text.split(" ; ")]
+    read = [read_sentence(sentence, objects, steps.append, _verb) for sentence in text.split(" ; ")]
+    sentences = [_sentence(sentence, steps, objects) for sentence in read if sentence]
     out.text = _ellipsis(" ; ".join(s for s in sentences if s).replace(" , ; ", " , "), steps, objects)
     return out
 

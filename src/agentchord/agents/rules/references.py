@@ -67,6 +67,8 @@ class Context:
         self.corners = {f"{c}_{k}" for c in self.cloths for k in kb.CLOTH_CORNERS}
         self.mentioned: list[str] = []
         self.held_by: dict[str, str] = {}
+        # The arm a pour said holds each vessel: only "both of you put them down" reads it.
+        self.pour_arms: dict[str, str] = {}
         #: Objects picked up, poured from or handed over and not yet put down, last taken last:
         #: what ``put it down`` puts down.
         self.in_hand: list[str] = []
@@ -219,6 +221,8 @@ class Context:
             return said
         if said == "other" and obj in self.held_by:
             return other_arm(self.held_by[obj])
+        if said == "both" and obj:  # "both of you set them down": each arm what it holds
+            return self.held_by.get(obj) or self.pour_arms.get(obj)
         return self.held_by.get(obj) if obj else None
 
 

@@ -1,0 +1,251 @@
+"""What each sentence and clause of an instruction contributes, read before the phrasing rewrites.
+
+People wrap what they ask in talk the grammar has no rule for, and name the doer of a step where the
+grammar expects an imperative. On the normalised text (sentences split by ``;``, clauses by ``,``),
+a sentence at a time:
+
+- **talk**: greetings, thanks, hesitations and remarks ("hi robot", "thanks so much", "um", "is
+  it possible", "just a splash is fine"): a clause that names nothing the scene or the rules know
+  (no object, colour, arm, place, direction or action verb) states no goal and is dropped;
+- **things left as they are**: "leave the cup alone", "the red one stays where it is", "don't touch
+  the fork", "you don't need to move the tray": no goal (what is not moved stays);
+- **arms as subjects**: "left arm picks up the block", "the right hand pours", "have the right one
+  put it in the tray", "left arm, grab ..." -> the imperative with ``with the left arm``;
+- **ordinal steps**: "first ..., second ..., third ...", "after that", "afterwards", "finally" ->
+  steps in order; "... first" at a clause's end is dropped (the order is the order said);
+- **how, not what**: "at the same time", "one in each hand", "use both hands for that": the
+  planner chooses the arms' timing; dropped;
+- **direction words**: "further away from you", "farther back", "away from me" -> ``forward``;
+  a flat utensil "pointing away from you" / "facing forward" beside a plate is how it is laid
+  anyway (dropped).
+
+Every change is recorded as a step (``talk``, ``left as is``, ``arm``, ``order``, ``how``,
+``direction``) for ``plan --explain``.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Callable
+
+from agentchord.agents.rules import knowledge as kb
+
+#: Words that make a clause say something about the task (else it is talk).
+_CONTENT = frozenset("""
+left right both arm arms hand hands gripper grippers one ones it them they it's its
+table corner corners edge edges half halves side sides top bottom near far front back forward forwards behind
+center middle target region spot area place there here beside next on onto in into inside under over between
+water upright down up away closer nearer
+once done when while after before until then and so
+""".split())
+#: Verbs of the actions the rules know, in any form people write (a clause with one is not talk).
+_ACTION_STEMS = ("pour", "empt", "fill", "pick", "grab", "grasp", "take", "took", "hold", "held", "lift", "put", "place",
+                 "set", "lay", "laid", "stand", "stood", "drop", "insert", "hand", "pass", "transfer", "give", "gave", "fold",
+                 "move", "push", "slide", "shift", "carry", "bring", "brought", "stack", "arrange", "swap", "switch",
+                 "return", "get", "go", "went", "leave", "left", "keep", "sit", "lie", "rest", "tip", "decant", "load",
+                 "pop", "stick", "nudge", "drag", "turn", "rotate", "spread", "line", "pile", "collect", "fetch",
+                 "deposit", "toss", "plop", "release", "let", "pinch", "clean", "tidy", "clear", "end")
+#: Interjections and courtesies that open or close a sentence.
+_OPENERS = re.compile(r"^(?:(?:hi|hello|hey|hiya|yo|ok|okay|alright|so|um+|uh+|hmm+|oh|ah|well|sorry|excuse me|"
+                      r"good (?:morning|afternoon|evening)|dear robot|robot|hey robot|hi robot|hello robot)(?: ,)? )+")
+_CLOSERS = re.compile(r"(?: ,)? (?:thanks|thank you|thx|ty|cheers)(?: (?:so|very) much| a lot| in advance)?(?: ,)?"
+                      r"(?: (?:robot|buddy|friend))?$")
+#: A clause that leaves an object as it is: no goal.
+_LEFT_AS_IS = [
+    re.compile(r"^(?:and )?(?:but )?(?:please )?(?:leave|keep) (?:the |that |this )?[a-z ]+? "
+               r"(?:alone|where it is|where they are|as it is|as they are|in place|untouched|where it was|there)$"),
+    re.compile(r"^(?:and )?(?:but )?(?:do not|don't|dont|no need to|you don't need to|you do not need to|you dont need to)"
+               r" (?:touch|move|bother with|worry about) [a-z ' ]+$"),
+    re.compile(r"^(?:and )?(?:the |that )?[a-z ]+? (?:stays|stay|remains|should stay|can stay) (?:where it is|put|as it is|there)$"),
+    re.compile(r"^(?:just |only )?(?:the \w+ )?(?:and )?(?:don't|do not|dont) (?:just )?(?:slide|drag|push) it$"),
+]
+#: The same inside a clause, after "and" or "but".
+_LEFT_AS_IS_INSIDE = re.compile(
+    r"(?: ,)? (?:and|but) (?:(?:please )?(?:leave|keep) (?:the |that |this )?[a-z ]+? (?:alone|where it is|where they are|as it is|"
+    r"in place|untouched)|(?:do not|don't|dont) (?:touch|move) (?:the |that |this )?[a-z ]+?)(?= ,|$)")
+#: How the arms share the work, when the goal says what: the planner chooses it.
+_HOW = [
+    re.compile(r"\b(?:at the same time|simultaneously|together|in one go|in parallel)\b"),
+    re.compile(r"(?: ,)? (?:one (?:in|with|per) (?:each|every) (?:hand|arm|gripper)|one per (?:hand|arm|gripper)|"
+               r"one (?:for|with) each (?:hand|arm))\b"),
+    re.compile(r"(?: ,)? (?:you'll|you will|you'd|you) (?:probably )?need (?:both|two) (?:hands|arms)(?: for (?:that|this|it))?$"),
+]
+#: Arm words a subject may be.
+_ARM_SUBJECT = re.compile(
+    r"^(?:and )?(?:(?:can|could|will|would|should|let|have|make) )?(?:the |your )?(left|right)(?: (?:arm|hand|gripper|one|side))?"
+    r"(?: ,| :)? (?!(?:arm|hand|gripper)\b)(\w+)\b(.*)$")
+_BOTH_SUBJECT = re.compile(r"^(?:and )?(?:then )?(?:both (?:of you|arms|hands|grippers)|both|the two arms|the arms) (\w+)\b(.*)$")
+#: Ordinal words that open a step.
+_ORDINAL = re.compile(r"^(?:first(?:ly)?|second(?:ly)?|third(?:ly)?|fourth|next|after that|afterwards|after this|"
+                      r"then after that|finally|lastly|last|to finish|and finally|and then|and after that)(?: ,)? ")
+_TRAILING_ORDER = re.compile(r" (?:first|afterwards|after that|at the end|in the end|when (?:you(?:'re| are)?|ur) done|"
+                             r"when finished|after|last|this time|for me)$")
+#: Direction phrases that mean "away from the robot".
+_AWAY = re.compile(r"\b(?:(?:a )?(?:little |tiny )?(?:bit )?(?:further|farther|more) (?:away )?(?:back )?(?:from (?:me|you|the robot))?"
+                   r"(?: than (?:it is|it does) now)?|away from (?:me|you|the robot)|farther back|further back|"
+                   r"towards? the (?:back|far side|far end)|to the back)\b")
+_POINTING = re.compile(r"(?: ,)? (?:and )?(?:both |each )?(?:of them )?(?:pointing|facing|oriented|aimed|tips?|handles?)"
+                       r" (?:away from (?:me|you|the robot)|forwards?|ahead|straight ahead|to the far side|away|up|north)"
+                       r"(?: \( ?tips away from (?:me|you) ?\))?\b")
+
+
+#: Shorthand people type -> the word.
+_SHORTHAND = [(re.compile(r"\b(?:pls|plz|plse)\b"), ""), (re.compile(r"\bw/ ?|\bw (?=the |your |my |both |left |right )"), "with "),
+              (re.compile(r"\bur\b"), "your"), (re.compile(r"\bu\b"), "you"), (re.compile(r"\bthx\b"), "thanks")]
+#: Vague amounts and distances: the goal has none (a pour is a pour; a nudge is the rules' nudge).
+_AMOUNT = re.compile(r"(?: ,)? (?:just |only |maybe )?(?:like )?(?:a (?:little|tiny|small|wee) (?:bit )?(?:of )?|a bit(?: more)?(?: of)? |"
+                     r"some |a splash of |a drop of |a little more |a few centimet(?:er|re)s |about \w+ (?:cm|centimet(?:er|re)s|mm)(?: or so)? |"
+                     r"(?:roughly |about |around )?\d+ ?(?:cm|centimet(?:er|re)s)(?: or so)? )(?=water\b|$| ,| then\b| and\b)")
+_AMOUNT_TAIL = re.compile(r"(?: ,)? (?:just |only |maybe )?(?:like )?(?:a (?:little|tiny|small) bit|a bit|a little|slightly|somewhat|"
+                          r"(?:roughly |about |around )?(?:\d+|ten|five|a few) ?(?:cm|centimet(?:er|re)s)(?: or so)?)(?= ,|$| then\b| and\b)")
+#: Particles of phrasal verbs that add nothing to the goal.
+_PARTICLES = [
+    (re.compile(r"\b(pick|lift|take|hold|raise|stand|set|get) (it|them|the [a-z]+(?: [a-z]+)?) (?:back )?up\b"), r"\1 \2"),
+    (re.compile(r"\b(hold|lift|raise|pick|take) up (?=the |it\b|them\b)"), r"\1 "),
+    (re.compile(r"\b(move|slide|bring|shift|carry|push|put|set) (it|them|the [a-z]+(?: [a-z]+)?) over "
+                r"(?=to |next |beside |onto |on |into |in |,|$)"), r"\1 \2 "),
+    (re.compile(r"\b(hand|pass|give) (it|them|the [a-z]+(?: [a-z]+)?) (?:off|across|over) (?=to )"), r"\1 \2 "),
+    (re.compile(r"\b(stand|set|put) (it|them|the [a-z]+(?: [a-z]+)?) back up\b"), r"\1 \2 back"),
+]
+#: An arm named by its side alone, after a hand-over or "with": "to your right", "with the other".
+_ARM_ELLIPSIS = [
+    (re.compile(r"\b((?:hand|pass|give|transfer)\w* (?:it|them|the [a-z]+(?: [a-z]+)?) (?:over |across |off )?to) (?:the|your|my) "
+                r"(left|right)(?: one)?\b(?! (?:arm|hand|gripper|of|side)\b)"), r"\1 the \2 arm"),
+    (re.compile(r"\b(with|in|using) (?:the|your|my) (left|right)(?: one)?\b(?! (?:arm|hand|gripper|of|side)\b)"), r"\1 the \2 arm"),
+    (re.compile(r"\b(to|with|in|by|from) (?:the )?(left|right) one\b"), r"\1 the \2 arm"),
+    (re.compile(r"\bthe (left|right) one\b(?= (?:put|place|set|pour|take|grab|hold|drop|fill|pick)\b)"), r"the \1 arm"),
+    (re.compile(r"\b(left|right) arm (hand|arm|gripper)\b"), r"\1 \2"),
+]
+#: A fold across the cloth (left onto right), which no rule makes.
+_ACROSS = re.compile(r"\b(?:from )?(?:the )?(?:left|right)(?: half| side| edge| corners?)?(?: of it)? (?:to|onto|over|over to|on top of|towards?) "
+                     r"(?:the )?(?:right|left)(?: half| side| edge| corners?)?\b|\bside to side\b|\blengthwise\b|\bsideways\b|\bleft-right\b")
+#: Where a pour happens, said beside it: the goal is the pour (holding the cup is said by "hold").
+_IN_THE_AIR = re.compile(r"(?: ,)? (?:in (?:the )?(?:mid-? ?air|air)|up in the air|off the table|above the table|over the table)\b")
+
+
+class NotAGoalError(ValueError):
+    """A sentence asks for something the rules recognise but cannot do (the reason is the message)."""
+
+
+def _lemma_like(word: str) -> bool:
+    return any(word.startswith(stem) for stem in _ACTION_STEMS)
+
+
+def is_talk(clause: str, objects: frozenset[str]) -> bool:
+    """Whether a clause names nothing the task is about (no object, colour, arm, place or action verb)."""
+    words = clause.replace("'", " ").split()
+    if not words:
+        return True
+    for word in words:
+        if word in objects or word in _CONTENT or word in kb.DIRECTION_WORDS or word in kb.TABLE_WORDS:
+            return False
+        if word.rstrip("s") in objects or _lemma_like(word):
+            return False
+        if word in _COLOUR_WORDS:
+            return False
+    return True
+
+
+_COLOUR_WORDS = frozenset({"red", "blue", "green", "yellow", "orange", "white", "black", "grey", "gray", "brown", "purple", "pink"})
+
+
+def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], None], verb: Callable[[str], str | None]) -> str:
+    """The sentence with its talk, things left as they are and how-clauses dropped, arms as subjects moved
+    into ``with the ... arm`` and ordinal steps as ``then``.
+
+    Args:
+        sentence: One normalised sentence (clauses separated by `` , ``).
+        objects: The words naming scene objects.
+        note: Records a step's name (for ``--explain``).
+        verb: The verb a word is a form of (``picks`` -> ``pick``), or None when it is not one the rules read.
+
+    Raises:
+        NotAGoalError: A fold across the cloth (left onto right), which no rule makes.
+    """
+    s = sentence
+    for pattern, repl in _SHORTHAND:
+        s = _sub(pattern, repl, s, note, "shorthand")
+    heading = re.match(r"^armheading (left|right|both) , ", s)
+    if heading is not None:
+        s = s[heading.end():]
+    # The rules fold a cloth near edge onto far edge only: a fold across (left onto right) is refused,
+    # not read as the fold they know.
+    if re.search(r"\bfold", s) and (across := _ACROSS.search(s)) is not None:
+        raise NotAGoalError(f"'{across[0].strip()}': the rules fold a cloth in half near edge onto far edge only, "
+                            "not across it (left onto right)")
+    s = _drop(_OPENERS, s, note, "talk")
+    s = _drop(_CLOSERS, s, note, "talk")
+    s = _drop(_LEFT_AS_IS_INSIDE, s, note, "left as is")
+    # An arm called by name before its step: "left hand, put ..." -> "put ... with the left arm".
+    called = re.match(r"^(?:the |your )?(left|right) (?:arm|hand|gripper) , (.+)$", s)
+    if called is not None:
+        first, sep, rest = called[2].partition(" , ")
+        s = f"{first} with the {called[1]} arm{sep}{rest}"
+        note("arm")
+    for how in _HOW:
+        s = _drop(how, s, note, "how")
+    s = _sub(_POINTING, "", s, note, "how")
+    s = _sub(_AWAY, "forward", s, note, "direction")
+    s = _sub(_AMOUNT, " ", s, note, "amount")
+    s = _sub(_AMOUNT_TAIL, "", s, note, "amount")
+    s = _sub(_IN_THE_AIR, "", s, note, "how")
+    for pattern, repl in _PARTICLES:
+        s = _sub(pattern, repl, s, note, "particle")
+    for pattern, repl in _ARM_ELLIPSIS:
+        s = _sub(pattern, repl, s, note, "arm")
+    clauses: list[str] = []
+    for clause in s.split(" , "):
+        clause = clause.strip()
+        if not clause:
+            continue
+        if any(p.fullmatch(clause) for p in _LEFT_AS_IS):
+            note("left as is")
+            continue
+        ordinal = _ORDINAL.match(clause)
+        if ordinal and clauses:
+            note("order")
+            clause = "then " + clause[ordinal.end():]
+        elif ordinal:
+            note("order")
+            clause = clause[ordinal.end():]
+        clause = _drop(_TRAILING_ORDER, clause, note, "order")
+        clause = _arm_subject(clause, note, verb)
+        if is_talk(clause.removeprefix("then "), objects):
+            note("talk")
+            continue
+        if heading is not None and not re.search(r"\b(?:left|right|both|other)\b", clause):
+            # A heading ("Right arm: grab ..., pour ..., set it down") names the arm of every step under it.
+            side = heading[1]
+            clause = " then ".join(f"{step} with {'both arms' if side == 'both' else f'the {side} arm'}"
+                                   for step in clause.split(" then "))
+        clauses.append(clause)
+    return " , ".join(clauses)
+
+
+def _arm_subject(clause: str, note: Callable[[str], None], verb: Callable[[str], str | None]) -> str:
+    """``left arm picks up the block`` -> ``pick up the block with the left arm``."""
+    then = clause.startswith("then ")
+    body = clause.removeprefix("then ")
+    match = _ARM_SUBJECT.match(body)
+    if match is not None and verb(match[2]) is not None and not re.search(r"\b(?:left|right|other|while|as)\b", match[3]):
+        rest = match[3].strip()
+        arm = f"with the {match[1]} arm"
+        body = f"{verb(match[2])} {rest} {arm}".strip() if rest else f"{verb(match[2])} {arm}"
+        note("arm")
+    else:
+        match = _BOTH_SUBJECT.match(body)
+        if match is not None and verb(match[1]) is not None:
+            body = f"{verb(match[1])} {match[2].strip()} with both arms".replace("  ", " ")
+            note("arm")
+    return ("then " + body) if then else body
+
+
+def _drop(pattern: re.Pattern[str], text: str, note: Callable[[str], None], name: str) -> str:
+    return _sub(pattern, "", text, note, name)
+
+
+def _sub(pattern: re.Pattern[str], repl: str, text: str, note: Callable[[str], None], name: str) -> str:
+    new = re.sub(r"\s+", " ", pattern.sub(repl, text)).strip()
+    if new != text.strip():
+        note(name)
+    return new
