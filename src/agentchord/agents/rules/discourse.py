@@ -53,7 +53,7 @@ _CLOSERS = re.compile(r"(?: ,)? (?:thanks|thank you|thx|ty|cheers)(?: (?:so|very
 #: A clause that leaves an object as it is: no goal.
 _LEFT_AS_IS = [
     re.compile(r"^(?:and )?(?:but )?(?:please )?(?:leave|keep) (?:the |that |this )?[a-z ]+? "
-               r"(?:alone|where it is|where they are|as it is|as they are|in place|untouched|where it was|there)$"),
+               r"(?:alone|where it is|where they are|as it is|as they are|in place|untouched|where it was|there|on the table)$"),
     re.compile(r"^(?:and )?(?:but )?(?:do not|don't|dont|no need to|you don't need to|you do not need to|you dont need to)"
                r" (?:touch|move|bother with|worry about) [a-z ' ]+$"),
     re.compile(r"^(?:and )?(?:the |that )?[a-z ]+? (?:stays|stay|remains|should stay|can stay) (?:where it is|put|as it is|there)$"),
@@ -123,6 +123,38 @@ _ACROSS = re.compile(r"\b(?:from )?(?:the )?(?:left|right)(?: half| side| edge| 
 _IN_THE_AIR = re.compile(r"(?: ,)? (?:in (?:the )?(?:mid-? ?air|air)|up in the air|off the table|above the table|over the table)\b")
 
 
+#: Frames that say "the end state is": dropped, the state that follows is read as usual.
+_END_STATE = re.compile(r"^(?:(?:the )?end result|result|the goal|goal|in the end|at the end|by the end|when you're done|"
+                        r"what i(?:'d| would) like is|what i want is|i (?:just |really )?(?:want|need|would like|'d like)|"
+                        r"want|i'd like)(?: ,| :)? (?=the |a |an |there |both |my |water )")
+#: "there to be water in the cup", "the cup with water in it", "cup has water in it": a pour into the cup.
+_WATER_IN = [
+    (re.compile(r"^(?:there (?:to be|is|should be) )?(?:some )?water in (?:the |my )?(\w+)(?: (?:at the end|in the end))?$"), r"pour water into the \1"),
+    (re.compile(r"^(?:the |my )?(\w+) (?:with|has|should have|to have|having|ends up with|to end up with) (?:some )?water in it"
+                r"(?: (?:at the end|in the end))?$"), r"pour water into the \1"),
+]
+#: How an arm is asked for: "use your left hand (this time) to pick ...", "use right arm only".
+_USE_ARM = re.compile(r"^(?:please )?(?:use|using) (?:your |the )?(left|right|both) (?:arm|hand|gripper)s?(?: (?:only|this time))*"
+                      r"(?: (?:to|for|and) (.+))?$")
+#: The tray's handles are how it is carried: "by both handles", "using the two handles", "grab both handles" (the tray).
+_HANDLES = [
+    (re.compile(r"(?: ,)? (?:by|using|with|at) (?:both|its|the two|the|its two|both of its|the) handles?\b"), ""),
+    (re.compile(r"\b(grab|take|hold|grasp|pick up) (?:both|the two|the|its) handles?\b"), r"\1 the tray"),
+]
+#: A cloth's parts, as the rules name them (bottom = near the robot, top = far).
+_CLOTH_PARTS = [
+    (re.compile(r"\b(?:the )?(?:two )?corners? (?:closest|nearest|nearer|closer) to (?:you|me|the robot)\b"), "the bottom corners"),
+    (re.compile(r"\b(?:the )?(?:two )?(?:far|farthest|furthest) ones\b"), "the top corners"),
+    (re.compile(r"\b(?:near|front|bottom)[- ](left|right) corner\b"), r"bottom \1 corner"),
+    (re.compile(r"\b(?:far|back|top)[- ](left|right) corner\b"), r"top \1 corner"),
+    (re.compile(r"\b(?:front|near|nearer|closer) (corners|edge|side|half|end)\b"), r"bottom \1"),
+    (re.compile(r"\b(?:back|far|farther|further) (corners|edge|side|half|end)\b"), r"top \1"),
+]
+#: A whole fold said by its parts: the bottom (near) corners, edge or half brought onto the top ones.
+_FOLD_BY_PARTS = re.compile(r"\bbottom (?:corners|edge|side|half|end)\b.*\b(?:top (?:corners|edge|side|half|end)|them)\b|"
+                            r"\bthem\b.*\btop (?:corners|edge|side|half)\b")
+
+
 class NotAGoalError(ValueError):
     """A sentence asks for something the rules recognise but cannot do (the reason is the message)."""
 
@@ -147,6 +179,31 @@ def is_talk(clause: str, objects: frozenset[str]) -> bool:
 
 
 _COLOUR_WORDS = frozenset({"red", "blue", "green", "yellow", "orange", "white", "black", "grey", "gray", "brown", "purple", "pink"})
+
+
+def read_sentences(sentences: list[str], objects: frozenset[str], note: Callable[[str], None],
+                   verb: Callable[[str], str | None]) -> list[str]:
+    """Each sentence read (:func:`read_sentence`); a sentence that only names an arm ("use the right arm only")
+    names the arm of every step after it."""
+    out = []
+    arm: str | None = None
+    for sentence in sentences:
+        alone = _ARM_ALONE.fullmatch(sentence.strip())
+        if alone is not None:
+            arm = alone[1]
+            note("arm")
+            continue
+        if arm is not None and not re.match(r"^armheading ", sentence) and not re.search(r"\b(?:left|right|both) (?:arm|hand|gripper)", sentence):
+            sentence = f"armheading {arm} , {sentence}"
+        out.append(read_sentence(sentence, objects, note, verb))
+    return out
+
+
+#: Verbs that start a step joined by "and" ("pick up the bottle and pour ...").
+_VERB_STARTS = ("pick", "take", "grab", "grasp", "hold", "lift", "put", "place", "set", "lay", "stand", "drop", "pour", "fill",
+                "empty", "hand", "pass", "give", "move", "carry", "bring", "push", "slide", "fold", "stack", "insert")
+#: A sentence that only says which arm does the work.
+_ARM_ALONE = re.compile(r"(?:please )?(?:(?:use|using|with) )?(?:only )?(?:your |the )?(left|right) (?:arm|hand|gripper)(?: only)?(?: please)?")
 
 
 def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], None], verb: Callable[[str], str | None]) -> str:
@@ -176,6 +233,26 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
     s = _drop(_OPENERS, s, note, "talk")
     s = _drop(_CLOSERS, s, note, "talk")
     s = _drop(_LEFT_AS_IS_INSIDE, s, note, "left as is")
+    s = _drop(_END_STATE, s, note, "end state")
+    s = _sub(re.compile(r"\bthe whole thing\b"), "it", s, note, "pronoun")
+    s = _drop(re.compile(r"(?: ,)? (?:and )?(?:let go|release it|release them|go)$"), s, note, "talk")
+    for pattern, repl in _HANDLES:
+        s = _sub(pattern, repl, s, note, "handles")
+    if re.search(r"\b(?:towel|cloth|corners?|fold)", s):
+        for pattern, repl in _CLOTH_PARTS:
+            s = _sub(pattern, repl, s, note, "cloth part")
+        if _FOLD_BY_PARTS.search(s) and not re.search(r"\b(?:left|right) (?:corner|half|side|edge)\b(?!s)", s.replace("bottom left corner", "")
+                                                       .replace("bottom right corner", "").replace("top left corner", "").replace("top right corner", "")):
+            note("cloth part")
+            return "fold the towel"  # the bottom corners (or edge, or half) onto the top ones: the fold
+    used = _USE_ARM.match(s)
+    if used is not None and used[2] and heading is None:
+        heading_arm: str | None = used[1]  # "use your left hand to pick up ... and pour ...": every step's arm
+        s = used[2]
+        note("arm")
+    else:
+        heading_arm = heading[1] if heading is not None else None
+    s = _sub(re.compile(r"\bthe (\w+) (?:spot|area|zone|circle|mark|position)\b"), r"the \1 region", s, note, "place")
     # An arm called by name before its step: "left hand, put ..." -> "put ... with the left arm".
     called = re.match(r"^(?:the |your )?(left|right) (?:arm|hand|gripper) , (.+)$", s)
     if called is not None:
@@ -210,14 +287,16 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
             clause = clause[ordinal.end():]
         clause = _drop(_TRAILING_ORDER, clause, note, "order")
         clause = _arm_subject(clause, note, verb)
+        for pattern, repl in _WATER_IN:
+            clause = _sub(pattern, repl, clause, note, "end state")
         if is_talk(clause.removeprefix("then "), objects):
             note("talk")
             continue
-        if heading is not None and not re.search(r"\b(?:left|right|both|other)\b", clause):
+        if heading_arm is not None and not re.search(r"\b(?:left|right|both|other) (?:arm|hand|gripper|one)s?\b", clause):
             # A heading ("Right arm: grab ..., pour ..., set it down") names the arm of every step under it.
-            side = heading[1]
-            clause = " then ".join(f"{step} with {'both arms' if side == 'both' else f'the {side} arm'}"
-                                   for step in clause.split(" then "))
+            with_arm = "with both arms" if heading_arm == "both" else f"with the {heading_arm} arm"
+            steps = re.split(r" (then|and then|and(?= (?:" + "|".join(_VERB_STARTS) + r")\b)) ", clause)
+            clause = "".join(f"{part} {with_arm}" if k % 2 == 0 else f" {part} " for k, part in enumerate(steps))
         clauses.append(clause)
     return " , ".join(clauses)
 

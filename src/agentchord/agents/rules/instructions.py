@@ -66,7 +66,18 @@ class Reading:
     def goal(self) -> GoalSpec:
         # A goal said twice ("fold the towel in half, near edge onto far edge") is one goal.
         goals = [g for part in self.goals for g in part]
-        return GoalSpec(goals=[g for k, g in enumerate(goals) if g not in goals[:k]])
+        placed = {g.obj for g in goals if isinstance(g, Placed) and not _put_down(g)}
+
+        def said(k: int, g: Goal) -> bool:
+            # "carry the tray forward, then put it down": the put-down is the placement already said.
+            return g in goals[:k] or (_put_down(g) and g.obj in placed)
+
+        return GoalSpec(goals=[g for k, g in enumerate(goals) if not said(k, g)])
+
+
+def _put_down(goal: Goal) -> bool:
+    """A placement with no place: the object put down where it was."""
+    return isinstance(goal, Placed) and goal.at is None and goal.region is None and goal.relative_to is None
 
 
 def _pour(c: Clause, ctx: Context) -> list[Goal]:
@@ -216,6 +227,9 @@ def _place_at(names: list[str], where: Where | None, c: Clause, ctx: Context) ->
             np = np.of
         support = ctx.resolve(np, exclude=tuple(names))
         return [On(obj=n, support=support, arm=arms[n]) for n in names]
+    named = ctx.region(np) if set(np.words) & {"region", "area", "zone", "spot", "position"} else None
+    if named is not None:  # "the forward position": the scene's region of that name, not a part of the table
+        return [Placed(obj=n, region=named, arm=arms[n]) for n in names]
     table = ctx.table_place(np)
     if table is None:
         return [Placed(obj=n, arm=arms[n]) for n in names]

@@ -26,7 +26,7 @@ import re
 from dataclasses import dataclass, field
 from functools import lru_cache
 
-from agentchord.agents.rules.discourse import read_sentence
+from agentchord.agents.rules.discourse import read_sentences
 from agentchord.agents.rules.english import is_word
 
 #: Verbs people use -> the verb the grammar reads (only where a clause starts with them).
@@ -285,7 +285,7 @@ def rewrite(text: str, vocabulary: frozenset[str] = frozenset(), objects: frozen
                 out.corrected[word] = fixed
                 words[i] = fixed
         text = " ".join(words)
-    read = [read_sentence(sentence, objects, steps.append, _verb) for sentence in text.split(" ; ")]
+    read = read_sentences(text.split(" ; "), objects, steps.append, _verb)
     sentences = [_sentence(sentence, steps, objects) for sentence in read if sentence]
     out.text = _ellipsis(" ; ".join(s for s in sentences if s).replace(" , ; ", " , "), steps, objects)
     return out
