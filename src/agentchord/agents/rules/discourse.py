@@ -36,7 +36,7 @@ left right both arm arms hand hands gripper grippers one ones it them they it's 
 table corner corners edge edges half halves side sides top bottom near far front back forward forwards behind
 center middle target region spot area place there here beside next on onto in into inside under over between
 water upright down up away closer nearer
-once done when while after before until then and so
+once done when while after before until then and
 """.split())
 #: Verbs of the actions the rules know, in any form people write (a clause with one is not talk).
 _ACTION_STEMS = ("pour", "empt", "fill", "pick", "grab", "grasp", "take", "took", "hold", "held", "lift", "put", "place",
@@ -44,11 +44,11 @@ _ACTION_STEMS = ("pour", "empt", "fill", "pick", "grab", "grasp", "take", "took"
                  "move", "push", "slide", "shift", "carry", "bring", "brought", "stack", "arrange", "swap", "switch",
                  "return", "get", "go", "went", "leave", "left", "keep", "sit", "lie", "rest", "tip", "decant", "load",
                  "pop", "stick", "nudge", "drag", "turn", "rotate", "spread", "line", "pile", "collect", "fetch",
-                 "deposit", "toss", "plop", "release", "let", "pinch", "clean", "tidy", "clear", "end")
+                 "deposit", "toss", "plop", "release", "let", "pinch", "clean", "tidy", "clear")
 #: Interjections and courtesies that open or close a sentence.
 _OPENERS = re.compile(r"^(?:(?:hi|hello|hey|hiya|yo|ok|okay|alright|so|um+|uh+|hmm+|oh|ah|well|sorry|excuse me|"
                       r"good (?:morning|afternoon|evening)|dear robot|robot|hey robot|hi robot|hello robot)(?: ,)? )+")
-_CLOSERS = re.compile(r"(?: ,)? (?:thanks|thank you|thx|ty|cheers)(?: (?:so|very) much| a lot| in advance)?(?: ,)?"
+_CLOSERS = re.compile(r"(?:^|(?: ,)? )(?:thanks|thank you|thx|ty|cheers)(?: (?:so|very) much| a lot| in advance)?(?: ,)?"
                       r"(?: (?:robot|buddy|friend))?$")
 #: A clause that leaves an object as it is: no goal.
 _LEFT_AS_IS = [
@@ -81,9 +81,11 @@ _ORDINAL = re.compile(r"^(?:first(?:ly)?|second(?:ly)?|third(?:ly)?|fourth|next|
 _TRAILING_ORDER = re.compile(r" (?:first|afterwards|after that|at the end|in the end|when (?:you(?:'re| are)?|ur) done|"
                              r"when finished|after|last|this time|for me)$")
 #: Direction phrases that mean "away from the robot".
-_AWAY = re.compile(r"\b(?:(?:a )?(?:little |tiny )?(?:bit )?(?:further|farther|more) (?:away )?(?:back )?(?:from (?:me|you|the robot))?"
-                   r"(?: than (?:it is|it does) now)?|away from (?:me|you|the robot)|farther back|further back|"
-                   r"towards? the (?:back|far side|far end)|to the back)\b")
+_AWAY = re.compile(r"\b(?:a (?:little |tiny )?bit |a little |slightly )?(?:further|farther)(?: away)?(?: back)?(?: from (?:me|you|the robot))?"
+                   r"(?: than (?:it is|it does|it was)(?: now)?)?\b|\baway from (?:me|you|the robot)\b|\btowards? the (?:back|far side|far end)\b|"
+                   r"\bto the back\b")
+#: "a bit closer to the bottle": next to it.
+_CLOSER = re.compile(r"\b(?:a (?:little |tiny )?bit |a little |slightly )?(?:closer|nearer) to\b")
 _POINTING = re.compile(r"(?: ,)? (?:and )?(?:both |each )?(?:of them )?(?:pointing|facing|oriented|aimed|tips?|handles?)"
                        r" (?:away from (?:me|you|the robot)|forwards?|ahead|straight ahead|to the far side|away|up|north)"
                        r"(?: \( ?tips away from (?:me|you) ?\))?\b")
@@ -133,6 +135,13 @@ _WATER_IN = [
     (re.compile(r"^(?:the |my )?(\w+) (?:with|has|should have|to have|having|ends up with|to end up with) (?:some )?water in it"
                 r"(?: (?:at the end|in the end))?$"), r"pour water into the \1"),
 ]
+#: "bottle standing back where it was", "the cup back in the same spot": put back.
+_BACK_AS_IT_WAS = re.compile(r"^(?:and )?(?:the )?(\w+)(?: is| should be| to be)?(?: standing| sitting| upright)*(?: back)?(?: upright)?"
+                             r" (?:where it was|where it started|in the same spot|in its (?:old )?place|back where it (?:was|started))$")
+#: "both back on table (after)": the two put back.
+_BOTH_BACK = re.compile(r"^(?:and )?(?:then )?both (?:of them )?(?:back )?(?:down )?(?:on (?:the )?table)?(?: after(?:wards)?)?$")
+#: A sentence that only names what follows ("end result", "the goal").
+_TITLE = re.compile(r"(?:the )?(?:end result|result|goal|final state|end state|target state|plan|steps?)")
 #: How an arm is asked for: "use your left hand (this time) to pick ...", "use right arm only".
 _USE_ARM = re.compile(r"^(?:please )?(?:use|using) (?:your |the )?(left|right|both) (?:arm|hand|gripper)s?(?: (?:only|this time))*"
                       r"(?: (?:to|for|and) (.+))?$")
@@ -238,7 +247,7 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
     s = _drop(re.compile(r"(?: ,)? (?:and )?(?:let go|release it|release them|go)$"), s, note, "talk")
     for pattern, repl in _HANDLES:
         s = _sub(pattern, repl, s, note, "handles")
-    if re.search(r"\b(?:towel|cloth|corners?|fold)", s):
+    if re.search(r"\b(?:towel|cloth|corners?|fold)", s) or ("towel" in objects or "cloth" in objects) and re.search(r"\b(?:edge|side|half)\b", s):
         for pattern, repl in _CLOTH_PARTS:
             s = _sub(pattern, repl, s, note, "cloth part")
         if _FOLD_BY_PARTS.search(s) and not re.search(r"\b(?:left|right) (?:corner|half|side|edge)\b(?!s)", s.replace("bottom left corner", "")
@@ -263,6 +272,10 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
         s = _drop(how, s, note, "how")
     s = _sub(_POINTING, "", s, note, "how")
     s = _sub(_AWAY, "forward", s, note, "direction")
+    s = _sub(_CLOSER, "next to", s, note, "direction")
+    s = _sub(re.compile(r" ?-> ?"), " ", s, note, "shorthand")
+    s = _sub(re.compile(r"\bwith the other(?: one| hand| arm| gripper)?\b"), "with the other arm", s, note, "arm")
+    s = _drop(re.compile(r"(?: ,)? while (?:you(?:'re| are)? (?:holding|pour)\w*|it(?:'s| is) (?:up|held|in the air))[a-z' ]*?(?= ,|$)"), s, note, "how")
     s = _sub(_AMOUNT, " ", s, note, "amount")
     s = _sub(_AMOUNT_TAIL, "", s, note, "amount")
     s = _sub(_IN_THE_AIR, "", s, note, "how")
@@ -289,6 +302,11 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
         clause = _arm_subject(clause, note, verb)
         for pattern, repl in _WATER_IN:
             clause = _sub(pattern, repl, clause, note, "end state")
+        clause = _sub(_BACK_AS_IT_WAS, r"put the \1 back", clause, note, "end state")
+        clause = _sub(_BOTH_BACK, "put them back", clause, note, "end state")
+        if _TITLE.fullmatch(clause):
+            note("talk")
+            continue
         if is_talk(clause.removeprefix("then "), objects):
             note("talk")
             continue

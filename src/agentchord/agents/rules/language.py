@@ -123,7 +123,9 @@ def normalise(instruction: str) -> str:
     text = re.sub(r"\bhand-?over\b", "handover", text)
     text = re.sub(r"\bleft-hand\b|\bleft hand side\b", "left", text)
     text = re.sub(r"\bright-hand\b|\bright hand side\b", "right", text)
-    text = re.sub(r"[!?\"()]", " ", text)
+    text = re.sub(r"[!?]+", " ; ", text)  # a question or an exclamation ends a sentence
+    text = re.sub(r"[\"()]", " ", text)
+    text = re.sub(r"\s+-+\s+", " , ", text)  # "set the table - fork on the left"
     text = _PUNCT.sub(r" \1 ", text)
     text = re.sub(r"(?:\s*[;.:]\s*)(?:[;.:,]\s*)*", " ; ", text)  # sentence ends: one separator
     text = re.sub(r"(?:\s*,\s*)+", " , ", text)
