@@ -103,7 +103,8 @@ _AMOUNT_TAIL = re.compile(r"(?: ,)? (?:just |only |maybe )?(?:like )?(?:a (?:lit
 #: Particles of phrasal verbs that add nothing to the goal.
 _PARTICLES = [
     (re.compile(r"\b(pick|lift|take|hold|raise|stand|set|get) (it|them|the [a-z]+(?: [a-z]+)?) (?:back )?up\b"), r"\1 \2"),
-    (re.compile(r"\b(hold|lift|raise|pick|take) up (?=the |it\b|them\b)"), r"\1 "),
+    (re.compile(r"\b(hold|lift|raise|pick|take|fill) up (?=the |it\b|them\b|my )"), r"\1 "),
+    (re.compile(r"\bmy (?=\w+\b)"), "the "),
     (re.compile(r"\b(move|slide|bring|shift|carry|push|put|set) (it|them|the [a-z]+(?: [a-z]+)?) over "
                 r"(?=to |next |beside |onto |on |into |in |,|$)"), r"\1 \2 "),
     (re.compile(r"\b(hand|pass|give) (it|them|the [a-z]+(?: [a-z]+)?) (?:off|across|over) (?=to )"), r"\1 \2 "),
@@ -115,6 +116,12 @@ _ARM_ELLIPSIS = [
                 r"(left|right)(?: one)?\b(?! (?:arm|hand|gripper|of|side)\b)"), r"\1 the \2 arm"),
     (re.compile(r"\b(with|in|using) (?:the|your|my) (left|right)(?: one)?\b(?! (?:arm|hand|gripper|of|side)\b)"), r"\1 the \2 arm"),
     (re.compile(r"\b(to|with|in|by|from) (?:the )?(left|right) one\b"), r"\1 the \2 arm"),
+    (re.compile(r"\bwith (?:the )?(\w+) in (?:your|the) (left|right)(?: hand| arm| gripper| one)?\b"), r"from the \1 with the \2 arm"),
+    (re.compile(r"\bin (?:your|the) (left|right)(?: hand| arm| gripper| one)?\b(?! (?:side|of|corner|half|edge)\b)"), r"with the \1 arm"),
+    (re.compile(r"\b(hand|pass|give|transfer)(\w*(?: (?:it|them|the [a-z]+))?(?: over| across)?) from (?:the )?(left|right)(?: arm| hand| gripper)?"
+                r" to (?:the )?(right|left)(?: arm| hand| gripper| one)?\b"), r"\1\2 from the \3 arm to the \4 arm"),
+    (re.compile(r"\b(?:with|via|using|by) (?:a )?handover(?: ,)? (?:from )?(?:the )?(left|right)(?: arm| hand)? to (?:the )?(right|left)(?: arm| hand)?\b"),
+     r", hand it over from the \1 arm to the \2 arm ,"),
     (re.compile(r"\bthe (left|right) one\b(?= (?:put|place|set|pour|take|grab|hold|drop|fill|pick)\b)"), r"the \1 arm"),
     (re.compile(r"\b(left|right) arm (hand|arm|gripper)\b"), r"\1 \2"),
 ]
@@ -283,6 +290,12 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
         s = _sub(pattern, repl, s, note, "particle")
     for pattern, repl in _ARM_ELLIPSIS:
         s = _sub(pattern, repl, s, note, "arm")
+    # "... while the right one pours into it": a step of its own, by that arm.
+    # (A hold said so is left to the phrasing's temporal rewrite: "pour ... while the left arm holds the cup".)
+    s = _sub(re.compile(r" while (?:the |your )?(left|right)(?: one| arm| hand| gripper) (?!hold|keep|grip|steady)(\w+)\b([^,]*)"),
+             lambda m: f" , {verb(m[2]) or m[2]}{m[3]} with the {m[1]} arm", s, note, "arm")
+    s = _sub(re.compile(r"\bso (?:that )?it(?:'s| is)? (?:only )?half (?:as \w+|the size)\b"), "", s, note, "how")
+    s = _sub(re.compile(r"\bmake (the \w+) (?:smaller|half as big|half the size) by folding it\b"), r"fold \1", s, note, "verb")
     clauses: list[str] = []
     for clause in s.split(" , "):
         clause = clause.strip()

@@ -115,7 +115,7 @@ def normalise(instruction: str) -> str:
     text = re.sub(r"^(?:could|can|would|will) you\s+|^(?:i want|i'd like|i would like) you to\s+|^(?:please\s+)", "", text.strip())
     # A heading names the arm of every step under it (read by agents.rules.discourse).
     text = re.sub(r"(?:^|(?<=[;.]\s))(?:the\s+)?(left|right|both)\s+(arm|hand|gripper)s?\s*:", r"armheading \1 ,", text)
-    text = re.sub(r"\b(on|to|at) its (left|right)\b", r"\1 the \2 of it", text)
+    text = re.sub(r"\b(on|to|at) its (left|right)(?: hand)?(?: side)?\b", r"\1 the \2 of it", text)
     text = re.sub(r"\b(upright|steady|steadily|firmly|securely|safely|upside up)\b", " ", text)
     text = re.sub(r"\b(please|carefully|gently|slowly|now|just|again)\b", " ", text)
     text = re.sub(r"\b(?:pick|take|lift) up\b", "pick up", text)
