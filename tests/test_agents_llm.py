@@ -495,3 +495,18 @@ def test_credentials_in_the_base_url_are_never_printed_nor_recorded(scene, nomin
         llm.compose(compose_request(nominal, scene))
     assert "s3cret" not in str(caught.value) and "***@127.0.0.1:9" in str(caught.value)
     assert "s3cret" not in json.dumps(llm.calls[-1].to_trace_event())
+
+
+@pytest.mark.parametrize(("url", "model", "message"), [
+    ("http://[::1", "m", "base_url: not a URL (Invalid IPv6 URL)"),
+    ("http://127.0.0.1:8000/v1\udcff", "m", "base_url: expected ASCII text"),
+    ("http://127.0.0.1:8000/v1", "\udcff\udcfe", "model: expected ASCII text"),
+    ("http://127.0.0.1:99999/v1", "m", "Port out of range"),
+])
+def test_llm_settings_that_no_request_can_carry_are_refused_up_front(url, model, message):
+    """An adversarial pass (issue 58): these were internal errors (exit 3) at the first request."""
+    from agentchord.agents.exceptions import ReasonerConfigError
+    from agentchord.agents.llm.config import LlmConfig
+
+    with pytest.raises(ReasonerConfigError, match=re.escape(message)):
+        LlmConfig(base_url=url, model=model, api_key="k")

@@ -161,3 +161,24 @@ def test_after_a_failed_plan_every_nominal_edge_keeps_its_derived_monitors():
     assert failed["tick"] == 25 and not failed["outage"]  # taken at the tick it arrives, not when polled
     armed = [e for e in result.trace.of("monitors_armed") if e["tick"] >= failed["tick"]]
     assert armed and all(all(m.startswith("keeps: ") for m in e["monitors"]) for e in armed)
+
+
+def test_run_says_when_the_offline_arranger_stood_in_or_the_plan_failed():
+    """An adversarial pass (issue 58): the trace said the LLM's plan failed and the rules wrote the branches,
+    but ``run``'s output said nothing of it."""
+    import io
+
+    from rich.console import Console
+
+    from agentchord.agents.prompts import nominal_part
+    from agentchord.cli.episode import _print_episode
+
+    graph = load_task_graph(TASK)
+    for plan, words in ((ScriptedPlan(0.5, graph, error="ReasonerTransportError: HTTP 500", outage=True, fallback="rules"),
+                         "the rules arranger and conductor wrote the recovery branches instead"),
+                        (ScriptedPlan(0.5, None, error="ReasonerTransportError: HTTP 500", outage=True),
+                         "each edge keeps the monitors derived from its constraints")):
+        result = run_episode(EpisodeSpec(TASK, seed=0, graph=nominal_part(graph), reasoning=ReasoningConfig(), background=plan))
+        out = io.StringIO()
+        _print_episode(Console(file=out, width=300), result)
+        assert "the LLM's plan failed (ReasonerTransportError: HTTP 500)" in out.getvalue() and words in out.getvalue()

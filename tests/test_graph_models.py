@@ -107,3 +107,22 @@ def test_json_schema_shows_both_action_forms() -> None:
     actions = schema["$defs"]["Edge"]["properties"]["actions"]
     assert {option["type"] for option in actions["anyOf"]} == {"object", "array"}
     assert schema["$defs"]["FailureMode"]["properties"]["window"]["minimum"] == 1
+
+
+@pytest.mark.parametrize(("node_id", "message"), [("v\ud800", "a lone surrogate"), ("a\x00b", r"a control character \(U\+0000\)"),
+                                                  ("a\nb", r"a control character \(U\+000A\)"), ("v" * 100_000, "more than 128")])
+def test_an_id_is_one_short_line_of_text(node_id, message):
+    """An adversarial pass (issue 58): `graph check` accepted these ids, which `graph render` then could not
+    write (exit 3), wrote as DOT that Graphviz rejects, or broke a Mermaid label."""
+    from agentchord.graph.models import Node
+
+    with pytest.raises(ValueError, match=message):
+        Node(id=node_id, semantic="s")
+
+
+def test_a_semantic_keeps_its_lines_but_no_nul():
+    from agentchord.graph.models import Node
+
+    assert Node(id="v0", semantic="two\\nlines").semantic == "two\\nlines"
+    with pytest.raises(ValueError, match="U\\+0000"):
+        Node(id="v0", semantic="a\x00b")

@@ -140,3 +140,15 @@ def test_human_rendering_without_pygame_is_refused_at_make(monkeypatch):
     monkeypatch.setitem(sys.modules, "pygame", None)  # as if not installed: importing it raises ImportError
     with pytest.raises(gymnasium.error.DependencyNotInstalled, match="render_mode='rgb_array'"):
         gymnasium.make("agentchord/BlocksAndCup-v0", render_mode="human")
+
+
+@pytest.mark.parametrize(("kwargs", "message"), [({"cameras": "top"}, "cameras: expected a tuple"),
+                                                 ({"image_size": (100_000, 100_000)}, "each from 1 to 4096"),
+                                                 ({"disturb": ""}, "disturb: expected")])
+def test_more_careless_arguments_are_refused_at_construction(kwargs, message):
+    """An adversarial pass (issue 58): a camera name as a string was read letter by letter, a huge image was a
+    MemoryError, and an empty disturb was taken as none."""
+    from agentchord.gym.env import AgentChordEnv
+
+    with pytest.raises(ValueError, match=message):
+        AgentChordEnv("single_arm_pour_water", **kwargs)

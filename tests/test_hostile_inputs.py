@@ -720,3 +720,33 @@ def test_a_reply_holding_a_lone_surrogate_is_refused_and_its_trace_kept(tmp_path
     assert not (tmp_path / "g.yaml").exists()
     events = [json.loads(line) for line in trace.read_text().splitlines()]
     assert events[0]["event"] == "reasoner_call" and not events[0]["ok"]
+
+
+@pytest.mark.parametrize("body", [b'{"choices": [ {"mess', b'{"choices": [], "x": "\xff"}', b"[" * 100_000 + b"]" * 100_000],
+                         ids=["cut short", "not UTF-8", "nested past the parser"])
+def test_an_unreadable_response_body_is_retried_then_a_transport_error_with_the_trace_kept(tmp_path, body):
+    """Issue 58 (an adversarial pass): an HTTP 200 whose body the client cannot read was an internal error
+    (exit 3: JSONDecodeError, UnicodeDecodeError, RecursionError) with no trace written."""
+    trace = tmp_path / "calls.jsonl"
+    with HostileServer(lambda request: Reply(body)) as server:
+        invoke(["plan", "put the red block into the cup", "--task", "blocks_and_cup", "--reasoner", "llm",
+                "-o", tmp_path / "g.yaml", "--trace", trace], 2, "an unreadable response body",
+               env=_llm(server, AGENTCHORD_LLM_DEADLINE_S="2"))
+    assert trace.exists() and not (tmp_path / "g.yaml").exists()
+
+
+LONG = "a" * 300
+
+
+@pytest.mark.parametrize("args", [
+    ["run", "single_arm_pour_water", "--json", "{t}/" + LONG + ".json"],
+    ["plan", "pour water from the bottle into the cup", "--task", "single_arm_pour_water", "-o", "{t}/" + LONG + ".json"],
+    ["bench", "--tasks", "single_arm_pour_water", "--methods", "agentchord", "--trials", "1", "--p", "0", "--out", "{t}/" + LONG],
+    ["record", "single_arm_pour_water", "--episodes", "1", "--camera", "none", "--out", "{t}/" + LONG],
+    ["bench", "--tasks", "single_arm_pour_water", "--methods", "agentchord", "--trials", "1", "--p", "0", "--out", ""],
+], ids=["run --json", "plan -o", "bench --out", "record --out", "bench --out ''"])
+def test_an_output_name_no_file_system_takes_is_refused_before_the_work(tmp_path, args):
+    """An adversarial pass (issue 58): a name over 255 bytes was an internal error (exit 3) after the work, and
+    `bench --out ''` wrote its sweep into the current folder."""
+    invoke([a.replace("{t}", str(tmp_path)) for a in args], 2, "--out" if "bench" in args or "record" in args else "bytes long")
+    assert list(tmp_path.iterdir()) == []

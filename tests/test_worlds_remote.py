@@ -418,3 +418,18 @@ def test_a_client_interrupted_while_waiting_for_a_reply_still_closes_its_trial()
     finally:
         stop.set()
         thread.join(5)
+
+
+def test_a_pull_on_a_served_world_is_the_same_episode_as_on_the_local_one():
+    """Issue 58 (an adversarial pass): every pull over ``--world`` ended in an internal error, exit 3
+    (the pull read ``half_extent_along`` of the object's model, which only the simulator's had)."""
+    setting = DisturbanceSetting.from_options(protocol="real")
+    address, stop, thread = serve_in_thread(TASK)
+    try:
+        remote = run_episode(EpisodeSpec(task=TASK, seed=1, disturbances=setting, world=address))
+    finally:
+        stop.set()
+        thread.join(5)
+    local = run_episode(EpisodeSpec(task=TASK, seed=1, disturbances=setting))
+    assert "pull" in remote.disturbances and remote.success, remote.reason
+    assert _comparable(remote) == _comparable(local)

@@ -11,7 +11,7 @@ from rich.console import Console
 from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
-from agentchord.cli.support import EXIT_INTERNAL, BadInput
+from agentchord.cli.support import EXIT_INTERNAL, BadInput, catches_sigterm
 
 TABLE_I_TASKS = "single_arm_pour_water,dual_arm_pour_water,rearrange_table"
 
@@ -92,6 +92,7 @@ def _latency(ctx, param, value: str | None):
 @click.option("--reasoner", type=click.Choice(("rules", "llm")), default="rules", show_default=True,
               help="rules: the library graphs, planning calls charged the modelled latency; llm: every method plans "
                    "from the instruction with the LLM of AGENTCHORD_LLM_* and is charged what its calls measured.")
+@catches_sigterm
 def bench_command(tasks, methods, ps, protocol, trials, first_seed, out_dir, backend, ray_address, workers, latency, vqa_miss,
                   vqa_false_alarm, doremi_every, reasoner) -> None:
     """Every method on the same seeded episodes; records as they finish, then tables and figures.
@@ -109,6 +110,13 @@ def bench_command(tasks, methods, ps, protocol, trials, first_seed, out_dir, bac
     from agentchord.sim.tasks import SIM_TASKS
 
     from agentchord.bench.tables import TASK_TITLES
+    from agentchord.guard import OutputPathError
+    from agentchord.guard.outputs import check_output_folder
+
+    try:
+        check_output_folder(out_dir, "--out")
+    except OutputPathError as error:
+        raise BadInput(str(error)) from None
 
     from agentchord.library import library_tasks
 

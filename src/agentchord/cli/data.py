@@ -66,6 +66,13 @@ def record_command(task, episodes, out, p, disturb, protocol, only_recovered, ke
     if task not in library_tasks():
         raise click.BadParameter(f"{task!r} has no library graph to record", param_hint="TASK")
     check_rendered(task, "a recorded dataset")
+    from agentchord.guard import OutputPathError
+    from agentchord.guard.outputs import check_output_folder
+
+    try:
+        check_output_folder(out, "--out")
+    except OutputPathError as error:
+        raise BadInput(str(error)) from None
     cameras = () if tuple(cameras) == ("none",) else tuple(cameras)
     from agentchord.data.record import ResumeError, record_settings, recorded_state
 

@@ -346,6 +346,12 @@ def _print_episode(console: Console, result) -> None:
             console.print(f"{tick}  {event['agent']} ({event['reasoner']}): {status}, {1000 * event['latency_s']:.0f} ms")
         elif kind == "branch_removed":
             console.print(f"{tick}  forward-moving filter removed {event['failure']} on {event['edge']}: {event['reason']}")
+        elif kind == "plan_arrived" and event.get("written_by"):
+            console.print(f"{tick}  [yellow]the LLM's plan failed[/yellow] ({plain(str(event['llm_error'])[:200])}): "
+                          f"the {event['written_by']} arranger and conductor wrote the recovery branches instead")
+        elif kind == "plan_failed":
+            console.print(f"{tick}  [red]the LLM's plan failed[/red] ({plain(str(event['reason'])[:200])}): each edge keeps "
+                          "the monitors derived from its constraints; a failure that needs a branch ends the episode")
     verdict = "[green]SUCCESS[/green]" if result.success else "[red]FAILURE[/red]"
     console.print(f"{verdict}: {plain(result.reason)}")
     console.print(f"steps {result.steps}  robot time {result.time_s:.2f} s  wall {result.wall_s:.2f} s  "

@@ -9,6 +9,8 @@ by :func:`agentchord.graph.validation.check_graph`.
 
 from __future__ import annotations
 
+import unicodedata
+
 from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, SerializerFunctionWrapHandler, field_serializer, field_validator
@@ -68,6 +70,30 @@ class FailureMode(_Model):
     recovery: str
 
 
+#: The longest id a graph may give a node or an edge (a figure's label, a trace's field, a log line).
+MAX_ID_CHARS = 128
+
+
+def _printable_id(value: str) -> str:
+    """An id is a short line of text: no control character (newline, NUL), no lone surrogate."""
+    if len(value) > MAX_ID_CHARS:
+        raise ValueError(f"an id of {len(value):,} characters, more than {MAX_ID_CHARS}")
+    bad = next((c for c in value if unicodedata.category(c) in ("Cc", "Cs")), None)
+    if bad is not None:
+        raise ValueError(f"the id holds {'a lone surrogate' if unicodedata.category(bad) == 'Cs' else 'a control character'} "
+                         f"(U+{ord(bad):04X}); an id is one line of text")
+    return value
+
+
+def _plain_text(value: str) -> str:
+    """Free text (a semantic): any line breaks, but no NUL or other control character and no lone surrogate."""
+    bad = next((c for c in value if unicodedata.category(c) in ("Cc", "Cs") and c not in "\n\t"), None)
+    if bad is not None:
+        raise ValueError(f"the text holds {'a lone surrogate' if unicodedata.category(bad) == 'Cs' else 'a control character'} "
+                         f"(U+{ord(bad):04X})")
+    return value
+
+
 class Node(_Model):
     """A sub-goal (nominal) or a recovery state.
 
@@ -82,6 +108,16 @@ class Node(_Model):
     semantic: str
     kind: Kind = "nominal"
     constraints: list[str] = Field(default_factory=list)
+
+    @field_validator("id")
+    @classmethod
+    def _check_id(cls, value: str) -> str:
+        return _printable_id(value)
+
+    @field_validator("semantic")
+    @classmethod
+    def _check_semantic(cls, value: str) -> str:
+        return _plain_text(value)
 
     @property
     def is_recovery(self) -> bool:
@@ -123,6 +159,11 @@ class Edge(_Model):
     failures: list[FailureMode] = Field(default_factory=list)
     cost: float | None = Field(None, ge=0.0, allow_inf_nan=False)
     alternative_to: str | None = None
+
+    @field_validator("id", "source", "target")
+    @classmethod
+    def _check_ids(cls, value: str) -> str:
+        return _printable_id(value)
 
     @field_validator("actions", mode="before", json_schema_input_type=Step | list[Step])
     @classmethod

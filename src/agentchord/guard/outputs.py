@@ -21,6 +21,36 @@ from typing import Any
 from agentchord.guard.exceptions import OutputPathError
 
 
+#: The longest file or folder name (bytes) of common file systems (ext4, XFS, APFS, NTFS).
+NAME_MAX = 255
+#: Bytes an atomic write adds to a file's name for its temporary file.
+TEMP_SUFFIX_BYTES = 24
+
+
+def _check_names(given: str, option: str | None, file: bool) -> None:
+    """An empty path, or a file or folder name longer than a file system allows, is refused before any work."""
+    if not given.strip():
+        raise OutputPathError(given, f"an empty path; give a {'file' if file else 'folder'} name", option)
+    path = Path(given)
+    for part in path.parts:
+        size = len(part.encode("utf-8", "surrogateescape"))
+        # NAME_MAX on every common file system; an atomic write adds a temporary suffix to a file's own name.
+        last = file and part == path.name
+        if size > NAME_MAX - (TEMP_SUFFIX_BYTES if last else 0):
+            raise OutputPathError(given, f"the name {part[:40]!r}... is {size} bytes long, more than a file system allows "
+                                         f"({NAME_MAX} bytes{', less room for a temporary suffix' if last else ''})", option)
+
+
+def check_output_folder(path: str | Path, option: str | None = None) -> Path:
+    """An output folder's path, checked as :func:`check_output_path` checks a file's names (not yet created).
+
+    Raises:
+        OutputPathError: An empty path, or a name longer than a file system allows.
+    """
+    _check_names(str(path), option, file=False)
+    return Path(path)
+
+
 def check_output_path(path: str | Path, suffixes: Iterable[str] = (), option: str | None = None) -> Path:
     """Make sure ``path`` can be written: its folder exists (created if missing) and accepts a new file.
 
@@ -41,6 +71,7 @@ def check_output_path(path: str | Path, suffixes: Iterable[str] = (), option: st
     given = str(path)
     path = Path(path)
     suffixes = tuple(suffixes)
+    _check_names(given, option, file=True)
     if suffixes and path.suffix.lower() not in suffixes:
         raise OutputPathError(given, f"unsupported file type {path.suffix or '(none)'!r}; use {', '.join(suffixes)}", option)
     if path.is_dir():

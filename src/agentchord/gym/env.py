@@ -41,6 +41,10 @@ def disturbance_setting(disturb, window: tuple[int, int] = PROTOCOL_WINDOW) -> D
     return DisturbanceSetting.from_options(disturb=disturb, protocol="custom", window=window)
 
 
+#: The largest image side (pixels) the environments render: a bigger frame is a mistake, not a camera.
+MAX_IMAGE_SIDE = 4096
+
+
 class AgentChordEnv(gym.Env):
     """One simulated task as a Gymnasium environment.
 
@@ -78,9 +82,11 @@ class AgentChordEnv(gym.Env):
         if isinstance(max_steps, bool) or not isinstance(max_steps, int) or max_steps < 1:
             raise ValueError(f"max_steps: expected a whole number of ticks >= 1, got {max_steps!r}")
         if (not isinstance(image_size, (tuple, list)) or len(image_size) != 2
-                or not all(isinstance(v, int) and not isinstance(v, bool) and v >= 1 for v in image_size)):
-            raise ValueError(f"image_size: expected (height, width) in pixels, each >= 1, got {image_size!r}")
-        if disturb is not None and not isinstance(disturb, str):
+                or not all(isinstance(v, int) and not isinstance(v, bool) and 1 <= v <= MAX_IMAGE_SIDE for v in image_size)):
+            raise ValueError(f"image_size: expected (height, width) in pixels, each from 1 to {MAX_IMAGE_SIDE}, got {image_size!r}")
+        if isinstance(cameras, str) or not isinstance(cameras, (tuple, list)) or not all(isinstance(c, str) for c in cameras):
+            raise ValueError(f"cameras: expected a tuple of camera names, e.g. ('top',), got {cameras!r}")
+        if disturb is not None and (not isinstance(disturb, str) or not disturb.strip()):
             raise ValueError(f"disturb: expected None, a protocol ('real', 'stress') or kinds ('drop,pull'), got {disturb!r}")
         self.task = task
         self.disturbances = disturbance_setting(disturb, window)

@@ -25,7 +25,7 @@ from agentchord.robot.aloha import (  # noqa: F401  (the robot's numbers, re-exp
 )
 from agentchord.robot.exceptions import RobotModelError
 from agentchord.robot.model import add_collision_proxies, edit_robot, robot_xml
-from agentchord.worlds.protocol import grip_width, upright_height
+from agentchord.worlds.protocol import grip_width, half_extent_along, upright_height
 from agentchord.sim.exceptions import SceneError
 
 #: Sliding friction of the table top (MuJoCo takes the larger of two touching geoms' coefficients).
@@ -75,11 +75,7 @@ class ObjectSpec:
 
     def half_extent_along(self, matrix: np.ndarray, direction: np.ndarray) -> float:
         """Half the object's extent (m) along a world direction, in its pose ``matrix`` (3 x 3)."""
-        local = np.abs(matrix.T @ direction)
-        if self.shape == "cylinder":
-            radius, half_height = self.size[0], self.size[1]
-            return float(local[2] * half_height + np.sqrt(max(1.0 - local[2] ** 2, 0.0)) * radius)
-        return float(local @ np.asarray(self.size[:3], dtype=float))
+        return half_extent_along(self.shape, self.size, matrix, direction)
 
 
 @dataclass

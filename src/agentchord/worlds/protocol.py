@@ -103,6 +103,20 @@ class ObjectInfo:
         """Smallest horizontal width (m): what a gripper closes on."""
         return grip_width(self.shape, self.size)
 
+    def half_extent_along(self, matrix: np.ndarray, direction: np.ndarray) -> float:
+        """Half the object's extent (m) along a world direction, in its pose ``matrix`` (3 x 3)."""
+        return half_extent_along(self.shape, self.size, matrix, direction)
+
+
+def half_extent_along(shape: str, size: tuple[float, ...], matrix: np.ndarray, direction: np.ndarray) -> float:
+    """Half the extent (m) along a world direction of a ``cylinder`` (radius, half-height) or ``box`` (half-sizes)
+    in its pose ``matrix`` (3 x 3): what a disturbance pulling or loading it reads, for a local or a remote world."""
+    local = np.abs(matrix.T @ direction)
+    if shape == "cylinder":
+        radius, half_height = size[0], size[1]
+        return float(local[2] * half_height + np.sqrt(max(1.0 - local[2] ** 2, 0.0)) * radius)
+    return float(local @ np.asarray(size[:3], dtype=float))
+
 
 def upright_height(shape: str, size: tuple[float, ...]) -> float:
     """Full height (m) of a ``cylinder`` (radius, half-height) or ``box`` (half-sizes) standing upright."""

@@ -111,10 +111,23 @@ class LlmConfig:
         for name in ("timeout_s", "deadline_s", "backoff_base_s", "backoff_max_s"):
             if _finite_number(getattr(self, name)) and getattr(self, name) > MAX_WAIT_S:
                 problems.append(f"{name}: at most {MAX_WAIT_S:g} s (a day), got {getattr(self, name)!r}")
-        if isinstance(self.base_url, str) and self.base_url.strip():
-            url = urllib.parse.urlsplit(self.base_url.strip())
-            if url.scheme not in ("http", "https") or not url.netloc:
-                problems.append(f"base_url: expected an http:// or https:// URL with a host, got {redact_url(self.base_url)!r}")
+        for name, _, _ in _REQUIRED:
+            value = getattr(self, name)
+            if isinstance(value, str) and not value.isascii():
+                # A header or a URL must be ASCII: a byte the shell passed undecoded, or a stray non-ASCII letter.
+                shown = value.encode("utf-8", "surrogateescape").decode("ascii", "backslashreplace")
+                problems.append(f"{name}: expected ASCII text, got {redact_url(shown) if name == 'base_url' else shown!r}"[:300])
+        if isinstance(self.base_url, str) and self.base_url.strip() and self.base_url.isascii():
+            try:
+                url = urllib.parse.urlsplit(self.base_url.strip())
+                url.port  # noqa: B018 -- read for its check: a port out of range raises here
+                ok = url.scheme in ("http", "https") and bool(url.hostname)
+            except ValueError as error:  # "http://[::1": an invalid IPv6 address; a port out of range
+                ok = False
+                problems.append(f"base_url: not a URL ({error}): {redact_url(self.base_url)!r}")
+            else:
+                if not ok:
+                    problems.append(f"base_url: expected an http:// or https:// URL with a host, got {redact_url(self.base_url)!r}")
         if self.temperature is not None and not (_finite_number(self.temperature) and 0 <= self.temperature <= 2):
             problems.append(f"temperature: expected a number from 0 to 2 or None, got {self.temperature!r}")
         if self.max_tokens is not None and self.max_tokens < 1:

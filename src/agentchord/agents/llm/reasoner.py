@@ -213,9 +213,13 @@ class LlmReasoner:
                 delay = retry_after(error.response, config.backoff_max_s)
                 if delay is None:
                     delay = backoff_delay(retries, config.backoff_base_s, config.backoff_max_s)
-            except (openai.APIConnectionError, WallClockTimeout) as error:  # also a timeout
+            except (openai.APIConnectionError, WallClockTimeout, ValueError, RecursionError) as error:  # also a timeout
                 if isinstance(error, (openai.APITimeoutError, WallClockTimeout)):
                     line = f"timed out after {limit:g} s"
+                elif isinstance(error, (ValueError, RecursionError)):
+                    # An HTTP 200 whose body the client cannot read (cut short, not UTF-8, nested past the parser's
+                    # depth): as a dropped connection, retried, then a transport error (issue 58).
+                    line = f"an unreadable response body ({type(error).__name__}: {str(error)[:120]})"
                 else:
                     cause = error.__cause__
                     line = f"connection error: {cause or error}"

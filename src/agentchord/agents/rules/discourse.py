@@ -354,7 +354,7 @@ def _drop(pattern: re.Pattern[str], text: str, note: Callable[[str], None], name
     return _sub(pattern, "", text, note, name)
 
 
-def _sub(pattern: re.Pattern[str], repl: str, text: str, note: Callable[[str], None], name: str) -> str:
+def _sub(pattern: re.Pattern[str], repl: str | Callable[[re.Match[str]], str], text: str, note: Callable[[str], None], name: str) -> str:
     new = re.sub(r"\s+", " ", pattern.sub(repl, text)).strip()
     if new != text.strip():
         note(name)
