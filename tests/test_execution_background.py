@@ -182,3 +182,34 @@ def test_run_says_when_the_offline_arranger_stood_in_or_the_plan_failed():
         out = io.StringIO()
         _print_episode(Console(file=out, width=300), result)
         assert "the LLM's plan failed (ReasonerTransportError: HTTP 500)" in out.getvalue() and words in out.getvalue()
+
+
+def test_a_late_reply_that_is_refused_is_written_by_the_offline_arranger(monkeypatch):
+    """Issue 58: a background reply refused before it runs (an object the scene lacks) left the robot with no
+    monitor. Now the offline arranger writes the branches (the trace names the refusal)."""
+    import agentchord.episode as episode_module
+    from agentchord.execution.background import FallbackPlan
+    from agentchord.graph.exceptions import GraphNotRunnableError
+
+    scene = observe(open_world(TASK, 0), task_regions(SIM_TASKS[TASK]))
+    from agentchord.agents.prompts import nominal_part
+
+    composed = nominal_part(load_task_graph(TASK))
+    real = episode_module.require_runnable
+    refused = []
+
+    def refuse_the_llms(graph, names, task, source):
+        if not refused:  # the LLM's reply: it names a ghost
+            refused.append(graph)
+            raise GraphNotRunnableError(source, ["edge 'e3': names 'ghost', which the scene lacks"])
+        return real(graph, names, task, source)
+
+    monkeypatch.setattr(episode_module, "require_runnable", refuse_the_llms)
+    work = episode_module._augmenting(composed, scene, RulesReasoner(), open_world(TASK, 0), TASK)
+    with pytest.raises(FallbackPlan) as raised:
+        work()
+    assert "ghost" in str(raised.value.cause) and raised.value.by == "rules" and raised.value.graph.failures()
+    without = episode_module._augmenting(composed, scene, RulesReasoner(), open_world(TASK, 0), TASK, fallback=False)
+    refused.clear()
+    with pytest.raises(GraphNotRunnableError):
+        without()
