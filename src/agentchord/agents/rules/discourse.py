@@ -68,7 +68,7 @@ _HOW = [
     re.compile(r"\b(?:at the same time|simultaneously|together|in one go|in parallel)\b"),
     re.compile(r"(?: ,)? (?:one (?:in|with|per) (?:each|every) (?:hand|arm|gripper)|one per (?:hand|arm|gripper)|"
                r"one (?:for|with) each (?:hand|arm))\b"),
-    re.compile(r"(?: ,)? (?:you'll|you will|you'd|you) (?:probably )?need (?:both|two) (?:hands|arms)(?: for (?:that|this|it))?$"),
+    re.compile(r"(?:^|(?: ,)? )(?:you'll|you will|you'd|you) (?:probably )?need (?:both|two) (?:hands|arms)(?: for (?:that|this|it))?$"),
 ]
 #: Arm words a subject may be.
 _ARM_SUBJECT = re.compile(
@@ -109,6 +109,7 @@ _PARTICLES = [
                 r"(?=to |next |beside |onto |on |into |in |,|$)"), r"\1 \2 "),
     (re.compile(r"\b(hand|pass|give) (it|them|the [a-z]+(?: [a-z]+)?) (?:off|across|over) (?=to )"), r"\1 \2 "),
     (re.compile(r"\b(stand|set|put) (it|them|the [a-z]+(?: [a-z]+)?) back up\b"), r"\1 \2 back"),
+    (re.compile(r"\b(?:standing|sitting|stood) up\b"), ""),
 ]
 #: An arm named by its side alone, after a hand-over or "with": "to your right", "with the other".
 _ARM_ELLIPSIS = [
@@ -176,7 +177,11 @@ class NotAGoalError(ValueError):
 
 
 def _lemma_like(word: str) -> bool:
-    return any(word.startswith(stem) for stem in _ACTION_STEMS)
+    """Whether ``word`` is a form of an action verb: the stem and an ending (``pours``, ``poured``, ``pouring``)."""
+    return any(word == stem or (word.startswith(stem) and word[len(stem):] in _ENDINGS) for stem in _ACTION_STEMS)
+
+
+_ENDINGS = frozenset({"s", "es", "ed", "d", "ing", "ping", "ped", "ting", "ted", "ling", "led", "ies", "ied", "y", "e", "en", "t"})
 
 
 def is_talk(clause: str, objects: frozenset[str]) -> bool:
@@ -219,7 +224,7 @@ def read_sentences(sentences: list[str], objects: frozenset[str], note: Callable
 _VERB_STARTS = ("pick", "take", "grab", "grasp", "hold", "lift", "put", "place", "set", "lay", "stand", "drop", "pour", "fill",
                 "empty", "hand", "pass", "give", "move", "carry", "bring", "push", "slide", "fold", "stack", "insert")
 #: A sentence that only says which arm does the work.
-_ARM_ALONE = re.compile(r"(?:please )?(?:(?:use|using|with) )?(?:only )?(?:your |the )?(left|right) (?:arm|hand|gripper)(?: only)?(?: please)?")
+_ARM_ALONE = re.compile(r"(?:please )?(?:(?:use|using|with) )?(?:only )?(?:your |the )?(left|right|both) (?:arm|hand|gripper)s?(?: only)?(?: please)?")
 
 
 def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], None], verb: Callable[[str], str | None]) -> str:
@@ -248,6 +253,14 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
                             "not across it (left onto right)")
     s = _drop(_OPENERS, s, note, "talk")
     s = _drop(_CLOSERS, s, note, "talk")
+    s = _drop(re.compile(r"\b(?:for me|for you|if you can|if possible|if that's ok|if that's easier(?: for you)?|though)\b"), s, note, "talk")
+    s = _drop(re.compile(r"(?: ,)? (?:is|would be|'s|will be) (?:fine|good|ok|okay|enough|great|perfect|all)$"), s, note, "talk")
+    if re.fullmatch(r"(?:go|do it|start|begin|go ahead|that's all|that is all|done)", s):
+        note("talk")
+        return ""
+    if not re.search(r"\b(?:pour|fill|empt)", s):  # for a pour, both arms say who holds the cup; else how it is carried
+        s = _drop(re.compile(r"(?:^|(?: ,)? )(?:use|using|with) (?:both|two|the two) (?:of your )?(?:hands?|arms?|grippers?)"
+                             r"(?: for (?:that|this|it))?(?: at the same time)?$"), s, note, "how")
     s = _drop(_LEFT_AS_IS_INSIDE, s, note, "left as is")
     s = _drop(_END_STATE, s, note, "end state")
     s = _sub(re.compile(r"\bthe whole thing\b"), "it", s, note, "pronoun")
