@@ -76,7 +76,8 @@ _ARM_SUBJECT = re.compile(
     r"(?: ,| :)? (?!(?:arm|hand|gripper)\b)(\w+)\b(.*)$")
 _BOTH_SUBJECT = re.compile(r"^(?:and )?(?:then )?(?:both (?:of you|arms|hands|grippers)|both|the two arms|the arms) (\w+)\b(.*)$")
 #: Ordinal words that open a step.
-_ORDINAL = re.compile(r"^(?:first(?:ly)?|second(?:ly)?|third(?:ly)?|fourth|next|after that|afterwards|after this|"
+_ORDINAL = re.compile(r"^(?:and )?(?:first(?:ly)?|second(?:ly)?|third(?:ly)?|fourth|next|after that|afterwards|after this|"
+                      r"after(?= (?:put|set|place|lay|stand|move|give|hand|pour|take|grab|pick|carry|bring|fold)\b)|"
                       r"then after that|finally|lastly|last|to finish|and finally|and then|and after that)(?: ,)? ")
 _TRAILING_ORDER = re.compile(r" (?:first|afterwards|after that|at the end|in the end|when (?:you(?:'re| are)?|ur) done|"
                              r"when finished|after|last|this time|for me)$")
@@ -143,9 +144,24 @@ _WATER_IN = [
     (re.compile(r"^(?:the |my )?(\w+) (?:with|has|should have|to have|having|ends up with|to end up with) (?:some )?water in it"
                 r"(?: (?:at the end|in the end))?$"), r"pour water into the \1"),
 ]
+#: Whole sentences or clauses that are talk though they name things: permission, questions about the ask, remarks.
+_TALK_SENTENCES = [re.compile(p) for p in (
+    r"(?:is it|is that|would that be) (?:possible|ok|okay|alright)",
+    r"how you do it is up to you", r"(?:it's|it is) up to you",
+    r"i(?:'m| am) (?:done|finished|thirsty|hungry|not sure)\b.*",
+    r"(?:and )?(?:i|we) (?:don't|do not|dont) want (?:to|you to|it to)\b.*",
+    r"(?:and )?you (?:can|may|could) (?:hold|do|use|take)\b.*(?: if .*)?",
+    r"(?:and )?(?:don't|do not|dont) (?:overflow|spill|drop|break)\b.*",
+    r"(?:both|all)(?: of them)?(?: (?:vertical|horizontal|straight|too|aligned))?",
+    r"(?:just )?once", r"in half",
+)]
 #: "bottle standing back where it was", "the cup back in the same spot": put back.
 _BACK_AS_IT_WAS = re.compile(r"^(?:and )?(?:the )?(\w+)(?: is| should be| to be)?(?: standing| sitting| upright)*(?: back)?(?: upright)?"
                              r" (?:where it was|where it started|in the same spot|in its (?:old )?place|back where it (?:was|started))$")
+#: "the capsule should end up in the tray", "the blue one goes in the cup", "the block to end up inside the target".
+_SHOULD_BE = re.compile(r"^(?:and )?((?:the |my )?[a-z]+(?: [a-z]+)?) (?:should|must|needs? to|has to|is to|will|to|shall)? ?"
+                        r"(?:end up|be|go|goes|sit|sits|stay|get|gets|belong|belongs|land|lands)(?: back)? "
+                        r"(in|inside|into|on|onto|at|next to|beside|on top of) ")
 #: "both back on table (after)": the two put back.
 _BOTH_BACK = re.compile(r"^(?:and )?(?:then )?both (?:of them )?(?:back )?(?:down )?(?:on (?:the )?table)?(?: after(?:wards)?)?$")
 #: A sentence that only names what follows ("end result", "the goal").
@@ -255,7 +271,7 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
     s = _drop(_CLOSERS, s, note, "talk")
     s = _drop(re.compile(r"\b(?:for me|for you|if you can|if possible|if that's ok|if that's easier(?: for you)?|though)\b"), s, note, "talk")
     s = _drop(re.compile(r"(?: ,)? (?:is|would be|'s|will be) (?:fine|good|ok|okay|enough|great|perfect|all)$"), s, note, "talk")
-    if re.fullmatch(r"(?:go|do it|start|begin|go ahead|that's all|that is all|done)", s):
+    if re.fullmatch(r"(?:go|do it|start|begin|go ahead|that's all|that is all|done)", s) or any(t.fullmatch(s) for t in _TALK_SENTENCES):
         note("talk")
         return ""
     if not re.search(r"\b(?:pour|fill|empt)", s):  # for a pour, both arms say who holds the cup; else how it is carried
@@ -274,6 +290,9 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
                                                        .replace("bottom right corner", "").replace("top left corner", "").replace("top right corner", "")):
             note("cloth part")
             return "fold the towel"  # the bottom corners (or edge, or half) onto the top ones: the fold
+        if re.search(r"\bfold", s):  # "fold it in half, towards the far side": the only way the rules fold
+            s = _drop(re.compile(r"(?: ,)? (?:towards? |to )(?:the )?(?:top|far|back) (?:side|edge|end|half)(?= ,|$)|(?: ,)? forward(?= ,|$)"),
+                      s, note, "cloth part")
     used = _USE_ARM.match(s)
     if used is not None and used[2] and heading is None:
         heading_arm: str | None = used[1]  # "use your left hand to pick up ... and pour ...": every step's arm
@@ -293,9 +312,13 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
     s = _sub(_POINTING, "", s, note, "how")
     s = _sub(_AWAY, "forward", s, note, "direction")
     s = _sub(_CLOSER, "next to", s, note, "direction")
+    s = _sub(re.compile(r"\bforward(?: ,)? (to the \w+ region)\b"), r"\1", s, note, "direction")
+    s = _sub(re.compile(r"\bto (inside|into|onto)\b"), r"\1", s, note, "place")
+    s = _drop(re.compile(r" (?:standing|sitting|lying|upright|up)(?= ,|$)"), s, note, "how")
+    s = _sub(re.compile(r"\b(hand|pass|give) (it|them) (?:across|over)$"), r"\1 \2 over", s, note, "particle")
     s = _sub(re.compile(r" ?-> ?"), " ", s, note, "shorthand")
     s = _sub(re.compile(r"\bwith the other(?: one| hand| arm| gripper)?\b"), "with the other arm", s, note, "arm")
-    s = _drop(re.compile(r"(?: ,)? while (?:you(?:'re| are)? (?:holding|pour)\w*|it(?:'s| is) (?:up|held|in the air))[a-z' ]*?(?= ,|$)"), s, note, "how")
+    s = _drop(re.compile(r"(?: ,)? while (?:you(?:'re| are)? holding it|it(?:'s| is)? (?:up|held|in the air))(?= ,|$)"), s, note, "how")
     s = _sub(_AMOUNT, " ", s, note, "amount")
     s = _sub(_AMOUNT_TAIL, "", s, note, "amount")
     s = _sub(_IN_THE_AIR, "", s, note, "how")
@@ -314,7 +337,7 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
         clause = clause.strip()
         if not clause:
             continue
-        if any(p.fullmatch(clause) for p in _LEFT_AS_IS):
+        if any(p.fullmatch(clause) for p in _LEFT_AS_IS) or any(t.fullmatch(clause) for t in _TALK_SENTENCES):
             note("left as is")
             continue
         ordinal = _ORDINAL.match(clause)
@@ -329,6 +352,7 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
         for pattern, repl in _WATER_IN:
             clause = _sub(pattern, repl, clause, note, "end state")
         clause = _sub(_BACK_AS_IT_WAS, r"put the \1 back", clause, note, "end state")
+        clause = _sub(_SHOULD_BE, r"put \1 \2 ", clause, note, "end state")
         clause = _sub(_BOTH_BACK, "put them back", clause, note, "end state")
         if _TITLE.fullmatch(clause):
             note("talk")
@@ -342,7 +366,7 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
             steps = re.split(r" (then|and then|and(?= (?:" + "|".join(_VERB_STARTS) + r")\b)) ", clause)
             clause = "".join(f"{part} {with_arm}" if k % 2 == 0 else f" {part} " for k, part in enumerate(steps))
         clauses.append(clause)
-    return " , ".join(clauses)
+    return " , ".join(clauses).strip(" ,")
 
 
 def _arm_subject(clause: str, note: Callable[[str], None], verb: Callable[[str], str | None]) -> str:

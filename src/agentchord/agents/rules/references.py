@@ -150,7 +150,13 @@ class Context:
         words = [kb.SYNONYMS.get(w, w) for w in np.words if w not in FILLER_WORDS] or list(np.words)
         if words[-1] == "one":
             if self.last_kind is None:
-                raise self.error(np.text, "has nothing to refer to (name the object)")
+                # "the blue one" said first: the one object its other words (a colour) name, if just one.
+                rest = [w for w in words[:-1] if w not in ("the", "a", "an")]
+                named = [o for o in self.scene.objects if o.name not in self.corners and rest and all(w in kb.words(o) for w in rest)]
+                if len(named) != 1:
+                    raise self.error(np.text, "has nothing to refer to (name the object)")
+                self.note(np.text, "object", named[0].name)
+                return self.mention(named[0].name)
             words[-1] = self.last_kind
         if np.of is not None and not words:
             return self.resolve(np.of)
