@@ -98,7 +98,7 @@ _SHORTHAND = [(re.compile(r"\b(?:pls|plz|plse)\b"), ""), (re.compile(r"\bw/ ?|\b
 #: Vague amounts and distances: the goal has none (a pour is a pour; a nudge is the rules' nudge).
 _AMOUNT = re.compile(r"(?: ,)? (?:just |only |maybe )?(?:like )?(?:a (?:little|tiny|small|wee) (?:bit )?(?:of )?|a bit(?: more)?(?: of)? |"
                      r"some |a splash of |a drop of |a little more |a few centimet(?:er|re)s |about \w+ (?:cm|centimet(?:er|re)s|mm)(?: or so)? |"
-                     r"(?:roughly |about |around )?\d+ ?(?:cm|centimet(?:er|re)s)(?: or so)? )(?=water\b|$| ,| then\b| and\b)")
+                     r"(?:roughly |about |around )?\d+ ?(?:cm|centimet(?:er|re)s)(?: or so)? )(?=water\b|with\b|$| ,| then\b| and\b)")
 _AMOUNT_TAIL = re.compile(r"(?: ,)? (?:just |only |maybe )?(?:like )?(?:a (?:little|tiny|small) bit|a bit|a little|slightly|somewhat|"
                           r"(?:roughly |about |around )?(?:\d+|ten|five|a few) ?(?:cm|centimet(?:er|re)s)(?: or so)?)(?= ,|$| then\b| and\b)")
 #: Particles of phrasal verbs that add nothing to the goal.
@@ -158,8 +158,17 @@ _TALK_SENTENCES = [re.compile(p) for p in (
 #: "bottle standing back where it was", "the cup back in the same spot": put back.
 _BACK_AS_IT_WAS = re.compile(r"^(?:and )?(?:the )?(\w+)(?: is| should be| to be)?(?: standing| sitting| upright)*(?: back)?(?: upright)?"
                              r" (?:where it was|where it started|in the same spot|in its (?:old )?place|back where it (?:was|started))$")
+#: Cleanups once a sentence's clauses are read: states and particles left at a clause's end.
+_LAST = [
+    (re.compile(r" (?:standing up|sitting up|standing|sitting|lying|upright)(?= ,|$)"), "", "how"),
+    (re.compile(r" while it(?:'s| is)?(?= ,|$)"), "", "how"),
+    (re.compile(r"\b(fill|lift|hold|pick|take) (the \w+|it|them) up\b"), r"\1 \2", "particle"),
+]
+#: Which way a fold goes, said of the only fold the rules make (near edge onto far edge).
+_FOLD_WAY = re.compile(r"(?:^|(?: ,)? )(?:towards? |to )(?:the )?(?:top|far|back) (?:side|edge|end|half)(?= ,|$)|(?: ,)? forward(?= ,|$)")
 #: "the capsule should end up in the tray", "the blue one goes in the cup", "the block to end up inside the target".
-_SHOULD_BE = re.compile(r"^(?:and )?((?:the |my )?[a-z]+(?: [a-z]+)?) (?:should|must|needs? to|has to|is to|will|to|shall)? ?"
+_SHOULD_BE = re.compile(r"^(?:and )?((?:the |my )?[a-z]+(?: (?!should|must|needs?|has|is|will|to|shall)[a-z]+)?) "
+                        r"(?:should|must|needs? to|has to|is to|will|to|shall)? ?"
                         r"(?:end up|be|go|goes|sit|sits|stay|get|gets|belong|belongs|land|lands)(?: back)? "
                         r"(in|inside|into|on|onto|at|next to|beside|on top of) ")
 #: "both back on table (after)": the two put back.
@@ -290,9 +299,7 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
                                                        .replace("bottom right corner", "").replace("top left corner", "").replace("top right corner", "")):
             note("cloth part")
             return "fold the towel"  # the bottom corners (or edge, or half) onto the top ones: the fold
-        if re.search(r"\bfold", s):  # "fold it in half, towards the far side": the only way the rules fold
-            s = _drop(re.compile(r"(?: ,)? (?:towards? |to )(?:the )?(?:top|far|back) (?:side|edge|end|half)(?= ,|$)|(?: ,)? forward(?= ,|$)"),
-                      s, note, "cloth part")
+
     used = _USE_ARM.match(s)
     if used is not None and used[2] and heading is None:
         heading_arm: str | None = used[1]  # "use your left hand to pick up ... and pour ...": every step's arm
@@ -315,7 +322,7 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
     s = _sub(re.compile(r"\bforward(?: ,)? (to the \w+ region)\b"), r"\1", s, note, "direction")
     s = _sub(re.compile(r"\bto (inside|into|onto)\b"), r"\1", s, note, "place")
     s = _drop(re.compile(r" (?:standing|sitting|lying|upright|up)(?= ,|$)"), s, note, "how")
-    s = _sub(re.compile(r"\b(hand|pass|give) (it|them) (?:across|over)$"), r"\1 \2 over", s, note, "particle")
+
     s = _sub(re.compile(r" ?-> ?"), " ", s, note, "shorthand")
     s = _sub(re.compile(r"\bwith the other(?: one| hand| arm| gripper)?\b"), "with the other arm", s, note, "arm")
     s = _drop(re.compile(r"(?: ,)? while (?:you(?:'re| are)? holding it|it(?:'s| is)? (?:up|held|in the air))(?= ,|$)"), s, note, "how")
@@ -366,7 +373,12 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
             steps = re.split(r" (then|and then|and(?= (?:" + "|".join(_VERB_STARTS) + r")\b)) ", clause)
             clause = "".join(f"{part} {with_arm}" if k % 2 == 0 else f" {part} " for k, part in enumerate(steps))
         clauses.append(clause)
-    return " , ".join(clauses).strip(" ,")
+    out = " , ".join(clauses).strip(" ,")
+    for pattern, repl, name in _LAST:
+        out = _sub(pattern, repl, out, note, name)
+    if re.search(r"\bfold", out) or "towel" in objects:  # "fold it in half, towards the far side": the only fold the rules make
+        out = _drop(_FOLD_WAY, out, note, "cloth part")
+    return out.strip(" ,")
 
 
 def _arm_subject(clause: str, note: Callable[[str], None], verb: Callable[[str], str | None]) -> str:
