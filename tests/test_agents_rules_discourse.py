@@ -42,7 +42,8 @@ SAME = [
     ("single_arm_pour_water", "pour water from the bottle into the cup",
      ["pour a little water from the bottle into the cup", "pour some water from the bottle into the cup, just a splash is fine"]),
     ("blocks_and_cup", "put the red block into the cup then put the blue block into the cup",
-     ["first put the red block into the cup, second put the blue block into the cup"]),
+     ["first put the red block into the cup, second put the blue block into the cup",
+      "put the two blocks into the cup, the red one first and then the blue one"]),
     ("handover_block", "pick up the block with the left arm, hand it over to the right arm, put it on the target",
      ["pick the block up with your left hand, hand it off to your right, put it on the target"]),
 ]

@@ -158,6 +158,15 @@ _TALK_SENTENCES = [re.compile(p) for p in (
 #: "bottle standing back where it was", "the cup back in the same spot": put back.
 _BACK_AS_IT_WAS = re.compile(r"^(?:and )?(?:the )?(\w+)(?: is| should be| to be)?(?: standing| sitting| upright)*(?: back)?(?: upright)?"
                              r" (?:where it was|where it started|in the same spot|in its (?:old )?place|back where it (?:was|started))$")
+#: "(pick up both blocks and) put them in the cup, red first then blue": each, in the order said.
+_EACH_IN_ORDER = re.compile(r"^(?:(?:pick up|take|grab|lift) (?:both|the two|the) (\w+?)s and (put|place|drop|set|move) them|"
+                            r"(put|place|drop|set|move) (?:both|the two|the) (\w+?)s) (.+?) , (?:the )?(\w+)(?: one)? first"
+                            r"(?: ,)?(?: and)?(?: then)? (?:the )?(\w+)(?: one)?$")
+
+
+def _each_in_order(m: re.Match[str]) -> str:
+    noun, verb, where = m[1] or m[4], m[2] or m[3], m[5]
+    return f"{verb} the {m[6]} {noun} {where} then {verb} the {m[7]} {noun} {where}"
 #: Cleanups once a sentence's clauses are read: states and particles left at a clause's end.
 _LAST = [
     (re.compile(r" (?:standing up|sitting up|standing|sitting|lying|upright)(?= ,|$)"), "", "how"),
@@ -374,6 +383,7 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
             clause = "".join(f"{part} {with_arm}" if k % 2 == 0 else f" {part} " for k, part in enumerate(steps))
         clauses.append(clause)
     out = " , ".join(clauses).strip(" ,")
+    out = _sub(_EACH_IN_ORDER, _each_in_order, out, note, "order")
     for pattern, repl, name in _LAST:
         out = _sub(pattern, repl, out, note, name)
     if re.search(r"\bfold", out) or "towel" in objects:  # "fold it in half, towards the far side": the only fold the rules make
