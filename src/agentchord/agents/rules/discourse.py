@@ -65,10 +65,10 @@ _LEFT_AS_IS_INSIDE = re.compile(
     r"in place|untouched)|(?:do not|don't|dont) (?:touch|move) (?:the |that |this )?[a-z ]+?)(?= ,|$)")
 #: How the arms share the work, when the goal says what: the planner chooses it.
 _HOW = [
-    re.compile(r"\b(?:at the same time|simultaneously|together|in one go|in parallel)\b"),
+    re.compile(r"\b(?:at (?:the )?same time|simultaneously|together|in one go|in parallel)\b"),
     re.compile(r"(?: ,)? (?:one (?:in|with|per) (?:each|every) (?:hand|arm|gripper)|one per (?:hand|arm|gripper)|"
                r"one (?:for|with) each (?:hand|arm))\b"),
-    re.compile(r"(?:^|(?: ,)? )(?:you'll|you will|you'd|you) (?:probably )?need (?:both|two) (?:hands|arms)(?: for (?:that|this|it))?$"),
+    re.compile(r"(?:^|(?: ,)? )(?:you'll|you will|you'd|you) (?:probably )?need (?:both|two) (?:hands?|arms?)(?: for (?:that|this|it))?$"),
 ]
 #: Arm words a subject may be.
 _ARM_SUBJECT = re.compile(
@@ -79,7 +79,7 @@ _BOTH_SUBJECT = re.compile(r"^(?:and )?(?:then )?(?:both (?:of you|arms|hands|gr
 _ORDINAL = re.compile(r"^(?:and )?(?:first(?:ly)?|second(?:ly)?|third(?:ly)?|fourth|next|after that|afterwards|after this|"
                       r"after(?= (?:put|set|place|lay|stand|move|give|hand|pour|take|grab|pick|carry|bring|fold)\b)|"
                       r"then after that|finally|lastly|last|to finish|and finally|and then|and after that)(?: ,)? ")
-_TRAILING_ORDER = re.compile(r" (?:first|afterwards|after that|at the end|in the end|when (?:you(?:'re| are)?|ur) done|"
+_TRAILING_ORDER = re.compile(r" (?:first|afterwards|after that|after it|after them|at the end|in the end|when (?:you(?:'re| are)?|ur|your) done|"
                              r"when finished|after|last|this time|for me)$")
 #: Direction phrases that mean "away from the robot".
 _AWAY = re.compile(r"\b(?:a (?:little |tiny )?bit |a little |slightly )?(?:further|farther)(?: away)?(?: back)?(?: from (?:me|you|the robot))?"
@@ -154,10 +154,14 @@ _TALK_SENTENCES = [re.compile(p) for p in (
     r"(?:and )?(?:don't|do not|dont) (?:overflow|spill|drop|break)\b.*",
     r"(?:both|all)(?: of them)?(?: (?:vertical|horizontal|straight|too|aligned))?",
     r"(?:just )?once", r"in half",
+    r"it(?:'s| is)? (?:quite |very |rather |a bit |so )?(?:long|heavy|big|wide|light|small|wobbly)",
+    r"(?:then )?(?:pull|move|bring|take) (?:the |your )?(?:left|right|both) arms? (?:back|away|home)(?: out of the way)?",
+    r"(?:the |my )?[a-z ]+ (?:is|are) (?:kind of |sort of |a bit |rather |quite )?(?:in the way|far away|too far(?: away)?|too close)",
+    r"(?:just )?(?:next |close )?to it",
 )]
 #: "bottle standing back where it was", "the cup back in the same spot": put back.
 _BACK_AS_IT_WAS = re.compile(r"^(?:and )?(?:the )?(\w+)(?: is| should be| to be)?(?: standing| sitting| upright)*(?: back)?(?: upright)?"
-                             r" (?:where it was|where it started|in the same spot|in its (?:old )?place|back where it (?:was|started))$")
+                             r" (?:where it was|where it started|where you found it|in the same (?:spot|place|position)|in its (?:old )?place|back where it (?:was|started))$")
 #: "(pick up both blocks and) put them in the cup, red first then blue": each, in the order said.
 _EACH_IN_ORDER = re.compile(r"^(?:(?:pick up|take|grab|lift) (?:both|the two|the) (\w+?)s and (put|place|drop|set|move) them|"
                             r"(put|place|drop|set|move) (?:both|the two|the) (\w+?)s) (.+?) , (?:the )?(\w+)(?: one)? first"
@@ -169,6 +173,12 @@ def _each_in_order(m: re.Match[str]) -> str:
     return f"{verb} the {m[6]} {noun} {where} then {verb} the {m[7]} {noun} {where}"
 #: Cleanups once a sentence's clauses are read: states and particles left at a clause's end.
 _LAST = [
+    (re.compile(r"(?: ,)+ ,"), " ,", "shorthand"),
+    (re.compile(r"\bgive (?:some )?water (?:from (?:the )?(\w+) )?(?=into|in|to)\b"), r"pour water from the \1 ", "verb"),
+    (re.compile(r"\b(hold|lift|take|pick) ([^,]+?) , (?:then )?pour(?= with| ,|$)"), r"\1 \2 , pour into it", "ellipsis"),
+    (re.compile(r"^(?:set|lay) (?:up )?the table(?: properly)?(?: for me)? , "), "", "talk"),
+    (re.compile(r"(?: ,)? with the folded edge (?:nearest|closest|near|towards?)(?: to)? (?:me|you)"), "", "cloth part"),
+    (re.compile(r"(?: ,)? lying on the (?:top|far) half(?: of where it is(?: now)?)?"), "", "cloth part"),
     (re.compile(r" (?:standing up|sitting up|standing|sitting|lying|upright)(?= ,|$)"), "", "how"),
     (re.compile(r" while it(?:'s| is)?(?= ,|$)"), "", "how"),
     (re.compile(r"\b(fill|lift|hold|pick|take) (the \w+|it|them) up\b"), r"\1 \2", "particle"),
@@ -316,7 +326,7 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
         note("arm")
     else:
         heading_arm = heading[1] if heading is not None else None
-    s = _sub(re.compile(r"\bthe (\w+) (?:spot|area|zone|circle|mark|position)\b"), r"the \1 region", s, note, "place")
+    s = _sub(re.compile(r"\bthe (?!same\b|other\b|original\b|old\b)(\w+) (?:spot|area|zone|circle|mark|position)\b"), r"the \1 region", s, note, "place")
     # An arm called by name before its step: "left hand, put ..." -> "put ... with the left arm".
     called = re.match(r"^(?:the |your )?(left|right) (?:arm|hand|gripper) , (.+)$", s)
     if called is not None:
@@ -367,7 +377,8 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
         clause = _arm_subject(clause, note, verb)
         for pattern, repl in _WATER_IN:
             clause = _sub(pattern, repl, clause, note, "end state")
-        clause = _sub(_BACK_AS_IT_WAS, r"put the \1 back", clause, note, "end state")
+        clause = _sub(_BACK_AS_IT_WAS, lambda m: "put it back" if m[1] in ("it", "they", "them") else f"put the {m[1]} back",
+                      clause, note, "end state")
         clause = _sub(_SHOULD_BE, r"put \1 \2 ", clause, note, "end state")
         clause = _sub(_BOTH_BACK, "put them back", clause, note, "end state")
         if _TITLE.fullmatch(clause):
