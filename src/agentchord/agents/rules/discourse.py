@@ -122,8 +122,10 @@ _ARM_ELLIPSIS = [
     (re.compile(r"\bin (?:your|the) (left|right)(?: hand| arm| gripper| one)?\b(?! (?:side|of|corner|half|edge)\b)"), r"with the \1 arm"),
     (re.compile(r"\b(hand|pass|give|transfer)(\w*(?: (?:it|them|the [a-z]+))?(?: over| across)?) from (?:the )?(left|right)(?: arm| hand| gripper)?"
                 r" to (?:the )?(right|left)(?: arm| hand| gripper| one)?\b"), r"\1\2 from the \3 arm to the \4 arm"),
-    (re.compile(r"\b(?:with|via|using|by) (?:a )?handover(?: ,)? (?:from )?(?:the )?(left|right)(?: arm| hand)? to (?:the )?(right|left)(?: arm| hand)?\b"),
-     r", hand it over from the \1 arm to the \2 arm ,"),
+    # "move the block to the target with a handover, left to right": the hand-over first, then the move.
+    (re.compile(r"^(?:move|put|place|bring|get|take) (the [a-z]+(?: [a-z]+)?) (to|onto|on|in|into) ([a-z ]+?) (?:with|via|using|by) (?:a )?handover"
+                r"(?: ,)? (?:from )?(?:the )?(left|right)(?: arm| hand)? to (?:the )?(right|left)(?: arm| hand)?\b"),
+     r"hand \1 over from the \4 arm to the \5 arm , then put \1 \2 \3"),
     (re.compile(r"\bthe (left|right) one\b(?= (?:put|place|set|pour|take|grab|hold|drop|fill|pick)\b)"), r"the \1 arm"),
     (re.compile(r"\b(left|right) arm (hand|arm|gripper)\b"), r"\1 \2"),
 ]
@@ -161,11 +163,16 @@ _TALK_SENTENCES = [re.compile(p) for p in (
 )]
 #: "bottle standing back where it was", "the cup back in the same spot": put back.
 _BACK_AS_IT_WAS = re.compile(r"^(?:and )?(?:the )?(\w+)(?: is| should be| to be)?(?: standing| sitting| upright)*(?: back)?(?: upright)?"
-                             r" (?:where it was|where it started|where you found it|in the same (?:spot|place|position)|in its (?:old )?place|back where it (?:was|started))$")
+                             r" (?:where it was|where it started|where you found it|in the same (?:spot|place|position)|in its (?:old )?place|"
+                             r"back where it (?:was|started))$")
 #: "(pick up both blocks and) put them in the cup, red first then blue": each, in the order said.
 _EACH_IN_ORDER = re.compile(r"^(?:(?:pick up|take|grab|lift) (?:both|the two|the) (\w+?)s and (put|place|drop|set|move) them|"
                             r"(put|place|drop|set|move) (?:both|the two|the) (\w+?)s) (.+?) , (?:the )?(\w+)(?: one)? first"
                             r"(?: ,)?(?: and)?(?: then)? (?:the )?(\w+)(?: one)?$")
+
+
+def _put_back(m: re.Match[str]) -> str:
+    return "put it back" if m[1] in ("it", "they", "them") else f"put the {m[1]} back"
 
 
 def _each_in_order(m: re.Match[str]) -> str:
@@ -173,6 +180,9 @@ def _each_in_order(m: re.Match[str]) -> str:
     return f"{verb} the {m[6]} {noun} {where} then {verb} the {m[7]} {noun} {where}"
 #: Cleanups once a sentence's clauses are read: states and particles left at a clause's end.
 _LAST = [
+    (re.compile(r" after (?:it|them|that)(?= with| ,|$)"), "", "order"),
+    (re.compile(r"(?:^|(?: ;| ,) )(?:you'll|you will|you'd|you) (?:probably )?need (?:both|two) (?:hands?|arms?)(?: for (?:that|this|it))?(?= ,|$)"),
+     "", "how"),
     (re.compile(r"(?: ,)+ ,"), " ,", "shorthand"),
     (re.compile(r"\bgive (?:some )?water (?:from (?:the )?(\w+) )?(?=into|in|to)\b"), r"pour water from the \1 ", "verb"),
     (re.compile(r"\b(hold|lift|take|pick) ([^,]+?) , (?:then )?pour(?= with| ,|$)"), r"\1 \2 , pour into it", "ellipsis"),
@@ -359,8 +369,9 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
     s = _sub(re.compile(r"\bso (?:that )?it(?:'s| is)? (?:only )?half (?:as \w+|the size)\b"), "", s, note, "how")
     s = _sub(re.compile(r"\bmake (the \w+) (?:smaller|half as big|half the size) by folding it\b"), r"fold \1", s, note, "verb")
     clauses: list[str] = []
+    s = re.sub(r"\s*,(?:\s*,)+", " ,", s)  # a clause dropped inside left two commas
     for clause in s.split(" , "):
-        clause = clause.strip()
+        clause = clause.strip(" ,")
         if not clause:
             continue
         if any(p.fullmatch(clause) for p in _LEFT_AS_IS) or any(t.fullmatch(clause) for t in _TALK_SENTENCES):
@@ -377,8 +388,7 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
         clause = _arm_subject(clause, note, verb)
         for pattern, repl in _WATER_IN:
             clause = _sub(pattern, repl, clause, note, "end state")
-        clause = _sub(_BACK_AS_IT_WAS, lambda m: "put it back" if m[1] in ("it", "they", "them") else f"put the {m[1]} back",
-                      clause, note, "end state")
+        clause = _sub(_BACK_AS_IT_WAS, _put_back, clause, note, "end state")
         clause = _sub(_SHOULD_BE, r"put \1 \2 ", clause, note, "end state")
         clause = _sub(_BOTH_BACK, "put them back", clause, note, "end state")
         if _TITLE.fullmatch(clause):
