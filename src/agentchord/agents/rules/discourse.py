@@ -37,6 +37,7 @@ table corner corners edge edges half halves side sides top bottom near far front
 center middle target region spot area place there here beside next on onto in into inside under over between
 water upright down up away closer nearer
 once done when while after before until then and
+handover hand-over transfer pour fold swap
 """.split())
 #: Verbs of the actions the rules know, in any form people write (a clause with one is not talk).
 _ACTION_STEMS = ("pour", "empt", "fill", "pick", "grab", "grasp", "take", "took", "hold", "held", "lift", "put", "place",
@@ -336,7 +337,7 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
         note("arm")
     else:
         heading_arm = heading[1] if heading is not None else None
-    s = _sub(re.compile(r"\bthe (?!same\b|other\b|original\b|old\b)(\w+) (?:spot|area|zone|circle|mark|position)\b"), r"the \1 region", s, note, "place")
+
     # An arm called by name before its step: "left hand, put ..." -> "put ... with the left arm".
     called = re.match(r"^(?:the |your )?(left|right) (?:arm|hand|gripper) , (.+)$", s)
     if called is not None:

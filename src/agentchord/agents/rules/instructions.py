@@ -22,6 +22,8 @@ and the goal-spec alternative.
 
 from __future__ import annotations
 
+import re
+
 import difflib
 from dataclasses import dataclass, field
 
@@ -317,6 +319,10 @@ def read_instruction(instruction: str, scene: Scene) -> Reading:
         raise InstructionNotGroundedError(instruction, _not_understood(exc, scene)) from None
     ctx = Context(scene, instruction)
     reading = Reading(instruction, clauses, prepared=prepared, words=ctx.read)
+    for text in dict.fromkeys(c.text for c in clauses):
+        unread = _unread_words(text, [c for c in clauses if c.text == text], known)
+        if unread is not None:
+            raise InstructionNotGroundedError(instruction, f"no rule reads {unread!r} in the clause {text!r} (what it names would be lost)")
     for clause in clauses:
         reading.goals.append([_into_socket(goal, ctx) for goal in _BUILD[clause.verb](clause, ctx)])
         if clause.arm or clause.giver or clause.receiver:
@@ -331,6 +337,20 @@ def read_instruction(instruction: str, scene: Scene) -> Reading:
         reading.clauses.append(Clause(verb="place", text="(still in hand: put back where it was)", objects=[NounPhrase(words=(g.obj,)) for g in rest]))
         reading.goals.append(rest)
     return reading
+
+
+def _unread_words(text: str, clauses: list[Clause], known: frozenset[str]) -> str | None:
+    """A word of a clause's text that no rule knows and no part of its parse holds ("the marked circle on the
+    right": the grammar kept "on the right" and passed over the circle), so the goal would silently lose it."""
+    parsed: set[str] = set()
+    for clause in clauses:
+        phrases = [*clause.objects, *(clause.where.phrases if clause.where is not None else ()), clause.source, clause.target]
+        for np in phrases:
+            while np is not None:
+                parsed.update(np.words)
+                np = np.of
+    unread = [w for w in re.findall(r"[a-z]+", text) if w not in known and w not in parsed and w not in FILLER_WORDS]
+    return " ".join(dict.fromkeys(unread)) or None
 
 
 def _into_socket(goal: Goal, ctx: Context) -> Goal:

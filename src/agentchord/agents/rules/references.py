@@ -207,6 +207,8 @@ class Context:
         if set(np.words) <= kb.TABLE_WORDS and np.words and np.of is None:
             return None
         region_words = set(words) & (kb.PART_WORDS | set(kb.DIRECTION_WORDS))
+        if not of_table and not set(words) & (set(kb.DIRECTION_WORDS) | kb.TABLE_WORDS | {"center", "middle"}):
+            return False  # "the spot", "the area": a part of nothing said; not the table
         if of_table or (np.of is None and np.words and set(np.words) <= kb.PART_WORDS | set(kb.DIRECTION_WORDS) | kb.TABLE_WORDS and region_words):
             return kb.table_point(words) or (kb.TABLE_CENTER if set(words) & {"center", "middle"} else None)
         return False

@@ -1,0 +1,46 @@
+"""The blind evaluation set (issue 59, tests/data/language/blind/): rates that must not fall, and never a wrong goal.
+
+Written by four helpers who saw only the scenes' descriptions, labelled by a fifth. Writers A-C were read for
+their kinds of failure while the rules grew (73 % planned to the goal they mean); writer D was held out and
+measured once (29 of 60, 48 %, with 3 wrong goals; the mechanisms behind the wrong ones were then fixed, so D
+is no longer blind: the next round needs a new held-out writer). Grounding only (the goal), a few seconds.
+"""
+
+from __future__ import annotations
+
+from functools import cache
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from agentchord.agents.observe import observe, task_regions
+from agentchord.agents.rules import corpus
+from agentchord.agents.scene import Scene
+from agentchord.sim.tasks import SIM_TASKS
+from agentchord.sim.world import SimWorld
+
+BLIND = Path(__file__).parent / "data" / "language" / "blind"
+#: Measured floors (right / all).
+FLOOR = {"ABC": 0.72, "D": 0.48}
+
+
+@cache
+def scene(task: str) -> Scene:
+    sim = SIM_TASKS[task]
+    return observe(SimWorld(sim.sample_scene(np.random.default_rng([0, 0x5CE7E]))), task_regions(sim))
+
+
+def test_the_blind_set_is_large_and_labelled():
+    entries = corpus.load_blind(BLIND, "ABCD")
+    assert len(entries) >= 150 and len({e["id"] for e in entries}) == len(entries)
+    assert all("goal" in e or e.get("expect") == "refused" for e in entries)
+
+
+@pytest.mark.parametrize("writers", list(FLOOR))
+def test_the_blind_set_keeps_its_rate_and_never_reads_a_wrong_goal(writers):
+    outcomes = [corpus.evaluate(e, scene(e["task"]), plan=False) for e in corpus.load_blind(BLIND, writers)]
+    wrong = [f"{o.entry['id']} {o.entry['instruction']!r}: {o.detail}" for o in outcomes if o.verdict == "wrong"]
+    assert not wrong, "\n".join(wrong)
+    right = sum(o.verdict == "right" for o in outcomes) / len(outcomes)
+    assert right >= FLOOR[writers], f"{right:.1%} planned to the labelled goal, floor {FLOOR[writers]:.0%}"
