@@ -133,3 +133,14 @@ def test_a_re_plan_hands_over_what_the_other_arm_is_to_put_down():
     steps = fns(compose(goal, _mid_handover(0.85)).graph)
     grasp = next(i for i, step in enumerate(steps) if ("right", "grasp") in step)
     assert grasp < next(i for i, step in enumerate(steps) if ("right", "place") in step)
+
+
+def test_two_placements_into_one_container_are_made_in_the_goals_order_not_at_once():
+    """Issue 61: "the red block inside the cup, then the blue block on top of the cup" was planned as one two-arm
+    step: both arms reached into the cup at once and the run ended "failure budget exhausted"."""
+    goal = GoalSpec.model_validate({"goals": [{"kind": "inside", "obj": "red_block", "container": "cup"},
+                                              {"kind": "on_top_of", "obj": "blue_block", "support": "cup"}]})
+    graph = compose(goal, scene_of("blocks_and_cup", 0), "blocks_and_cup").graph
+    placing = [[call.args.get("obj") for _, call in edge.calls if call.fn == "place"] for edge in graph.nominal_edges()]
+    placing = [objs for objs in placing if objs]
+    assert placing == [["red_block"], ["blue_block"]]

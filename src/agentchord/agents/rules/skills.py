@@ -139,9 +139,14 @@ def _one_arm_ops(
         if arm not in reachers:
             continue  # the place is beyond this arm's reach: the other arm's, after a hand-off
         pre = {("holding", arm, name)} | extra_pre | ({("lifted", arm)} if kb.is_flat(obj) else set())
+        # The object placed into or onto (not beside): two placements there are one after the other, in the
+        # goal's order, not both arms reaching into the same cup at once.
+        anchor = args.get("relative_to")
+        target = args.get("target") or (1.0, 1.0)
+        into = isinstance(anchor, str) and max(abs(float(t)) for t in target[:2]) < INTO_RADIUS
         ops.append(
             Operator(
-                name=f"place({arm}, {name}, {key})", arms=(arm,), objects=(name,),
+                name=f"place({arm}, {name}, {key})", arms=(arm,), objects=(name, anchor) if into else (name,),
                 # A container is not moved from under a vessel still tilted over it.
                 pre=frozenset(pre), pre_not=frozenset({("tilted", arm), ("under_pour", name)}),
                 add=frozenset({("free", arm), ("on_table", name), ("at", name, key)} | {("reach", a, name) for a in reachers}),
@@ -154,6 +159,8 @@ def _one_arm_ops(
     return ops
 
 
+#: Offset (m) from an anchor within which a placement is into or onto it (beside one is farther).
+INTO_RADIUS = 0.06
 #: Cost (ticks) of setting an object down for the other arm, on top of the places it saves.
 HANDOFF_COST = 260
 
