@@ -213,3 +213,26 @@ def _completion_body(item: Completion, request: Any) -> dict[str, Any]:
             "total_tokens": item.prompt_tokens + item.completion_tokens,
         }
     return body
+
+
+def composer_first(task: str, later: Completion | HttpError, first: bool = True) -> tuple[str, ReplayServer]:
+    """The task's library instruction and a server whose first answer is the rules composer's reply for it
+    (unless ``first`` is False) and every later one ``later``: an LLM whose arranger misbehaves."""
+    from agentchord.agents.observe import observe, task_regions
+    from agentchord.agents.pipeline import plan_task
+    from agentchord.agents.rules import RulesReasoner
+    from agentchord.library import load_task_graph
+    from agentchord.sim.tasks import SIM_TASKS
+    from agentchord.sim.trial import open_world
+
+    instruction = load_task_graph(task).instruction
+    rules = RulesReasoner()
+    plan_task(instruction, observe(open_world(task, 0), task_regions(SIM_TASKS[task])), rules, task)
+    composed = json.dumps(rules.calls[0].reply)
+    answered: list[Any] = []
+
+    def respond(body: Any) -> Completion | HttpError:
+        answered.append(body)
+        return Completion(composed) if first and len(answered) == 1 else later
+
+    return instruction, ReplayServer(respond)

@@ -8,7 +8,6 @@ replay server (127.0.0.1) plays the LLM.
 
 from __future__ import annotations
 
-import json
 import os
 import signal
 import subprocess
@@ -16,32 +15,15 @@ import sys
 import time
 
 import pytest
-from replay_server import Completion, ReplayServer
+from replay_server import Completion, ReplayServer, composer_first
 
-from agentchord.agents.observe import observe, task_regions
-from agentchord.agents.pipeline import plan_task
-from agentchord.agents.rules import RulesReasoner
-from agentchord.library import load_task_graph
-from agentchord.sim.tasks import SIM_TASKS
-from agentchord.sim.trial import open_world
 
 TASK = "single_arm_pour_water"
 NEVER_S = 120.0  # a reply that never comes within the test
 
 
 def _server(composer_hangs: bool) -> tuple[str, ReplayServer]:
-    instruction = load_task_graph(TASK).instruction
-    rules = RulesReasoner()
-    plan_task(instruction, observe(open_world(TASK, 0), task_regions(SIM_TASKS[TASK])), rules, TASK)
-    composed = json.dumps(rules.calls[0].reply)
-    answered = []
-
-    def respond(body):
-        answered.append(body)
-        first = len(answered) == 1 and not composer_hangs
-        return Completion(composed) if first else Completion("{}", delay_s=NEVER_S)
-
-    return instruction, ReplayServer(respond)
+    return composer_first(TASK, Completion("{}", delay_s=NEVER_S), first=not composer_hangs)
 
 
 def _run(server: ReplayServer, instruction: str, *extra: str) -> subprocess.Popen:

@@ -92,22 +92,11 @@ def test_the_control_loop_does_not_run_ahead_of_a_pending_reply():
 
 def _composer_then(server_reply, monkeypatch):
     """A replay server whose first answer is the rules composer's reply for TASK, every later one ``server_reply``."""
-    from replay_server import HttpError  # noqa: F401 -- re-exported for the callers' replies
+    from replay_server import composer_first
 
-    instruction = load_task_graph(TASK).instruction
-    rules = RulesReasoner()
-    plan_task(instruction, observe(open_world(TASK, 0), task_regions(SIM_TASKS[TASK])), rules, TASK)
-    composed = json.dumps(rules.calls[0].reply)
-    answered = []
-
-    def respond(body):
-        answered.append(body)
-        return Completion(composed) if len(answered) == 1 else server_reply
-
-    server = ReplayServer(respond)
     monkeypatch.setenv("AGENTCHORD_LLM_MODEL", "replay-model")
     monkeypatch.setenv("AGENTCHORD_LLM_API_KEY", "test-key")
-    return instruction, server
+    return composer_first(TASK, server_reply)
 
 
 @pytest.mark.parametrize("fallback", [True, False])
