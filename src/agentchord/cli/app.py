@@ -47,19 +47,28 @@ main.add_command(demo)
 
 
 @main.command()
-def tasks() -> None:
-    """List the simulated tasks, with a one-line description each."""
+@click.argument("task", required=False)
+@click.option("--details", "details", metavar="TASK", default=None,
+              help="One task's scene: its objects (sizes, where they lie at seed 0, which arm reaches them), regions, "
+                   "arms, and an example goal file to run.")
+def tasks(task: str | None, details: str | None) -> None:
+    """List the simulated tasks, with a one-line description each; with TASK (or --details TASK), that task's scene."""
     from agentchord.library import library_tasks
     from agentchord.sim.tasks import SIM_TASKS
 
+    chosen = details or task
+    if chosen is not None:
+        check_task_name(chosen, "TASK")
+        click.echo(describe_task(chosen))
+        return
     graphs = set(library_tasks())
     width = max(len(name) for name in SIM_TASKS)
-    for name, task in sorted(SIM_TASKS.items()):
-        if getattr(task, "goal_defined", False):
+    for name, sim in sorted(SIM_TASKS.items()):
+        if getattr(sim, "goal_defined", False):
             mark = "  (no library graph: plan it with --instruction)"
         else:
             mark = "" if name in graphs else "  (no library graph yet)"
-        click.echo(f"{name:<{width}}  {task.description}{mark}")
+        click.echo(f"{name:<{width}}  {sim.description}{mark}")
 
 
 @main.command()
@@ -170,3 +179,64 @@ def _check_plan_outputs(output, render_path, trace_path, goal_path=None) -> None
 
     check_outputs(("-o", output, YAML_SUFFIXES + JSON_SUFFIXES), ("--render", render_path, FORMATS), ("--trace", trace_path, ()),
                   inputs=(("--goal", goal_path),))
+
+
+def describe_task(name: str) -> str:
+    """A task's scene as text for ``tasks --details``: what a newcomer needs to write a goal or an instruction."""
+    from agentchord.agents.observe import observe, task_regions
+    from agentchord.agents.rules.goals import GoalSpec
+    from agentchord.library import library_tasks
+    from agentchord.sim.tasks import SIM_TASKS
+    from agentchord.sim.trial import open_world
+
+    task = SIM_TASKS[name]
+    scene = observe(open_world(name, 0), task_regions(task))
+    lines = [f"{name}: {task.description}", "",
+             "objects (at seed 0; x + is the robot's right, y + away from it; sizes are full extents):"]
+    for o in scene.objects:
+        size = " x ".join(f"{100 * v:.1f}" for v in o.extent)
+        reach = ", ".join(o.reachable_by) if o.reachable_by else "no arm"
+        lines.append(f"  {o.name:<12} {o.description:<22} size {size} cm at ({o.pos[0]:+.2f}, {o.pos[1]:+.2f}) m, reached by: {reach}")
+    lines.append("regions:" if scene.regions else "regions: none")
+    for r in scene.regions:
+        lines.append(f"  {r.name:<12} {r.description} (centre ({r.center[0]:+.2f}, {r.center[1]:+.2f}) m, radius {100 * r.radius:.0f} cm)")
+    lines.append("arms:")
+    for a in scene.arms:
+        base = f"base ({a.base[0]:+.2f}, {a.base[1]:+.2f}) m, " if a.base is not None else ""
+        lines.append(f"  {a.name:<6} {base}reaches {a.reach_top:.2f} m from above, {a.reach_side:.2f} m from the side")
+    lines.append(f"library graph: {'yes' if name in library_tasks() else 'no (plan one: run --instruction or --goal)'}")
+    example = _example_goal(scene)
+    GoalSpec.model_validate(example)  # the example is a goal spec this scene takes
+    lines += ["", f"an example goal file (save it as goal.yaml, then: agentchord run {name} --goal goal.yaml;",
+              "every kind: agentchord schema goal):", "goals:"]
+    lines += [f"  - {{{', '.join(f'{k}: {v}' for k, v in goal.items())}}}" for goal in example["goals"]]
+    return "\n".join(lines)
+
+
+def _example_goal(scene) -> dict:
+    """A goal this scene can be given, the first of a few kinds the offline planner finds feasible here:
+    a fold, a pour, something into a container, into a region, beside another object, or put back."""
+    from agentchord.agents.rules import knowledge as kb
+    from agentchord.agents.rules.feasibility import goal_problems
+    from agentchord.agents.rules.goals import GoalSpec
+
+    corners = [o for o in scene.objects if kb.is_cloth_corner(o.name)]
+    movable = [o for o in scene.objects if not kb.is_cloth_corner(o.name)]
+    small = sorted(movable, key=lambda o: o.extent[0] * o.extent[1])
+    candidates: list[list[dict]] = []
+    if corners:
+        candidates.append([{"kind": "folded", "cloth": corners[0].name.rsplit("_", 1)[0]}])
+    for source in (o for o in movable if kb.is_pourable(o)):
+        candidates += [[{"kind": "poured", "source": source.name, "target": t.name}, {"kind": "placed", "obj": source.name}]
+                       for t in movable if t is not source and kb.is_container(t)]
+    candidates += [[{"kind": "inside", "obj": o.name, "container": c.name}] for o in small for c in movable
+                   if c is not o and kb.is_container(c)]
+    candidates += [[{"kind": "placed", "obj": o.name, "region": r.name}] for o in small for r in scene.regions]
+    candidates += [[{"kind": "placed", "obj": o.name, "relative_to": a.name, "offset": [0.17 if o.pos[0] > a.pos[0] else -0.17, 0.0]}]
+                   for o in small for a in reversed(small) if a is not o]
+    candidates += [[{"kind": "placed", "obj": o.name}] for o in small]
+    for goals in candidates:
+        spec = GoalSpec.model_validate({"goals": goals})
+        if not goal_problems(spec, scene):
+            return {"goals": goals}
+    return {"goals": candidates[-1] if candidates else []}
