@@ -20,7 +20,25 @@ def test_aggregate_counts_rates_and_latencies():
     assert stats["mean_steps_success_with_drop"] == 900.0
     assert stats["drops_injected"] == 2 and stats["drops_recovered"] == 1
     assert stats["reaction_latency_ticks_max"] == 4
-    assert stats["failures"] == ["x"]
+    assert stats["failures"] == ["seed 2: x"]  # which seed failed (issue 61)
+    # As bench's tables: the failed episode, which ended early, does not flatter the mean time (issue 61).
+    assert stats["mean_time_s"] == pytest.approx((700 + 900) / 2 / 50)
+
+
+def test_the_strategies_are_printed_side_by_side():
+    import io
+
+    from rich.console import Console
+
+    from agentchord.bench.report import print_tables
+
+    out = io.StringIO()
+    results = {"agentchord": aggregate([_summary(0, True, 700)]), "agentchord-bt": aggregate([_summary(0, False, 300)])}
+    print_tables(results, Console(file=out, width=200))
+    text = out.getvalue()
+    header = next(line for line in text.splitlines() if "metric" in line)
+    assert "agentchord" in header and "agentchord-bt" in header  # one table, a column per strategy
+    assert "agentchord-bt failed seed 0: x" in text
 
 
 def test_paired_steps_uses_seeds_every_strategy_completed_after_a_drop():

@@ -253,3 +253,16 @@ def test_run_prints_names_from_a_graph_file_as_written(tmp_path):
     path.write_text(yaml.safe_dump(data))
     result = CliRunner().invoke(main, ["run", "single_arm_pour_water", "--graph", str(path), "--seed", "1"])
     assert "[link=file:///etc/passwd]v0" in result.output, result.output
+
+
+def test_demo_json_has_no_p_under_a_protocol_and_names_each_failed_seed(tmp_path):
+    """Issue 61: `demo --protocol real --json` recorded "p": 0.1, which a protocol ignores."""
+    import json
+
+    out = tmp_path / "demo.json"
+    result = CliRunner().invoke(main, ["demo", "--task", "single_arm_pour_water", "--trials", "1", "--protocol", "real",
+                                       "--strategies", "agentchord", "--json", str(out)])
+    assert result.exit_code == 0, result.output
+    data = json.loads(out.read_text())
+    assert data["p"] is None and data["protocol"] == "real"
+    assert all(f.startswith("seed ") for f in data["strategies"]["agentchord"]["failures"])

@@ -31,7 +31,8 @@ def aggregate(summaries: list[dict]) -> dict:
         "episodes": n,
         "success_rate": successes / n if n else 0.0,
         "success_ci95": [round(low, 3), round(high, 3)],
-        "mean_time_s": round(mean(s["time_s"] for s in summaries), 3) if n else 0.0,
+        # As bench's tables: over the successful episodes (a strategy whose failures end early is not faster).
+        "mean_time_s": round(mean(s["time_s"] for s in summaries if s["success"]), 3) if successes else None,
         "mean_steps": round(mean(s["steps"] for s in summaries), 1) if n else 0.0,
         "mean_steps_with_drop": round(mean(s["steps"] for s in with_drop), 1) if with_drop else None,
         # The paper counts steps "to complete a task": failed episodes end early and would flatter a strategy that gives up.
@@ -47,7 +48,7 @@ def aggregate(summaries: list[dict]) -> dict:
         # Counted as failures in the success rate, and separately: objects beyond every arm's reach.
         "unrecoverable": sum(bool(s.get("unrecoverable")) for s in summaries),
         "disturbances": _disturbance_totals(summaries),
-        "failures": sorted({s["reason"] for s in summaries if not s["success"]}),
+        "failures": [f"seed {s['seed']}: {s['reason']}" for s in sorted(summaries, key=lambda s: s["seed"]) if not s["success"]],
     }
 
 
@@ -81,37 +82,55 @@ def paired_steps(by_strategy: dict[str, list[dict]]) -> dict | None:
     return {"seeds": seeds, "mean_steps": {n: round(mean(per_seed[n][s]["steps"] for s in seeds), 1) for n in names}}
 
 
-def strategy_table(name: str, stats: dict) -> Table:
-    """One strategy's aggregates as a rich table."""
-    table = Table(title=name, show_header=True, header_style="bold")
-    table.add_column("metric")
-    table.add_column("value", justify="right")
+def metric_rows(stats: dict) -> list[tuple[str, str]]:
+    """One strategy's aggregates as (metric, value) rows."""
     low, high = stats["success_ci95"]
-    table.add_row("success rate", f"{100 * stats['success_rate']:.0f}%  (95% CI {100 * low:.0f}-{100 * high:.0f}%)")
-    table.add_row("mean execution time (robot s)", f"{stats['mean_time_s']:.2f}")
-    table.add_row("mean steps (control ticks)", f"{stats['mean_steps']:.0f}")
+    time_s = stats["mean_time_s"]
+    rows = [
+        ("success rate", f"{100 * stats['success_rate']:.0f}% ({100 * low:.0f}-{100 * high:.0f}%)"),
+        ("mean execution time, successful episodes (robot s)", "-" if time_s is None else f"{time_s:.2f}"),
+        ("mean steps (control ticks)", f"{stats['mean_steps']:.0f}"),
+    ]
     with_drop = stats["mean_steps_with_drop"]
-    table.add_row(f"mean steps, episodes with a drop ({stats['episodes_with_drop']})", "-" if with_drop is None else f"{with_drop:.0f}")
+    rows.append(("mean steps, episodes with a drop", "-" if with_drop is None else f"{with_drop:.0f} ({stats['episodes_with_drop']})"))
     done = stats["mean_steps_success_with_drop"]
-    table.add_row("mean steps, successful episodes with a drop", "-" if done is None else f"{done:.0f}")
-    table.add_row("drops injected / detected / recovered", f"{stats['drops_injected']} / {stats['drops_detected']} / {stats['drops_recovered']}")
+    rows.append(("mean steps, successful episodes with a drop", "-" if done is None else f"{done:.0f}"))
+    rows.append(("drops injected / detected / recovered", f"{stats['drops_injected']} / {stats['drops_detected']} / {stats['drops_recovered']}"))
     for kind, (injected, detected, recovered) in stats.get("disturbances", {}).items():
         if kind != "drop":
-            table.add_row(f"{kind}: injected / detected / recovered", f"{injected} / {detected} / {recovered}")
-    table.add_row("unrecoverable episodes (counted as failures)", str(stats.get("unrecoverable", 0)))
+            rows.append((f"{kind}: injected / detected / recovered", f"{injected} / {detected} / {recovered}"))
+    rows.append(("unrecoverable episodes (counted as failures)", str(stats.get("unrecoverable", 0))))
     lat_mean, lat_max = stats["reaction_latency_ticks_mean"], stats["reaction_latency_ticks_max"]
-    table.add_row("reaction latency mean / max (ticks)", "-" if lat_mean is None else f"{lat_mean:.1f} / {lat_max}")
-    table.add_row("mean wall time per episode (s)", f"{stats['mean_wall_s']:.2f}")
+    rows.append(("reaction latency mean / max (ticks)", "-" if lat_mean is None else f"{lat_mean:.1f} / {lat_max}"))
+    rows.append(("mean wall time per episode (s)", f"{stats['mean_wall_s']:.2f}"))
+    return rows
+
+
+def strategy_table(name: str, stats: dict) -> Table:
+    """One strategy's aggregates as a rich table."""
+    return strategies_table({name: stats}, title=name)
+
+
+def strategies_table(results: dict[str, dict], title: str | None = None) -> Table:
+    """Every strategy's aggregates side by side: a row per metric, a column per strategy (a metric one lacks: -)."""
+    table = Table(title=title, show_header=True, header_style="bold")
+    table.add_column("metric")
+    rows = {name: dict(metric_rows(stats)) for name, stats in results.items()}
+    for name in results:
+        table.add_column(name if len(results) > 1 else "value", justify="right")
+    labels = list(dict.fromkeys(label for values in rows.values() for label in values))
+    for label in labels:
+        table.add_row(label, *(rows[name].get(label, "-") for name in results))
     return table
 
 
 def print_tables(results: dict[str, dict], console: Console | None = None, paired: dict | None = None) -> None:
-    """Print one table per strategy, the failure reasons and the paired step comparison."""
+    """Print the strategies side by side, each failure with its seed, and the paired step comparison."""
     console = console or Console()
+    console.print(strategies_table(results))
     for name, stats in results.items():
-        console.print(strategy_table(name, stats))
         for reason in stats["failures"]:
-            console.print(f"  [red]failed:[/red] {reason}")
+            console.print(f"  [red]{name} failed[/red] {reason}", markup=True, highlight=False)
     if paired is not None and paired["seeds"]:
         steps = ", ".join(f"{name} {value:.0f}" for name, value in paired["mean_steps"].items())
         console.print(f"paired: over the {len(paired['seeds'])} seeds with a drop that every strategy completed, mean steps: {steps}")

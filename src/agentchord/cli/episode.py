@@ -433,7 +433,7 @@ def demo(task, trials, first_seed, p, disturb, protocol, perception, strategies,
     paired = paired_steps(summaries)
     print_tables(results, console, paired)
     if json_path:
-        payload = {"task": task, "p": p, "trials": trials, "first_seed": first_seed, "disturb": list(setting.kinds), "protocol": protocol,
+        payload = {"task": task, "p": None if protocol else p, "trials": trials, "first_seed": first_seed, "disturb": list(setting.kinds), "protocol": protocol,
                    "perception": perception, "instruction": instruction, "reasoner": reasoner if instruction else None,
                    "strategies": results, "paired_steps": paired,
                    "world": world, "runs": summaries}
