@@ -266,3 +266,11 @@ def test_demo_json_has_no_p_under_a_protocol_and_names_each_failed_seed(tmp_path
     data = json.loads(out.read_text())
     assert data["p"] is None and data["protocol"] == "real"
     assert all(f.startswith("seed ") for f in data["strategies"]["agentchord"]["failures"])
+
+
+def test_a_plan_the_reasoner_refuses_is_not_preceded_by_a_usage_banner():
+    """Issue 61: a refused instruction (exit 2) was printed after click's "Usage: ... Try --help" lines, as if the
+    command line were wrong."""
+    result = CliRunner().invoke(main, ["plan", "fold the towel side to side", "--task", "fold_towel", "-o", "/tmp/unused.yaml"])
+    assert result.exit_code == 2 and "cannot ground the instruction" in result.output
+    assert "Usage:" not in result.output and "--help" not in result.output

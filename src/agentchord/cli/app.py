@@ -148,7 +148,7 @@ def plan(instruction, task, seed, goal_path, reasoner, perception, output, rende
         agent = make_reasoner(reasoner, goal=goal, watch_visibility=perception == "rgbd")
         result = plan_task(instruction or "", scene, agent, task=task)
     except ReasonerError as exc:
-        raise click.UsageError(str(exc) + failed_calls_trace(exc, trace_path)) from exc
+        raise BadInput(str(exc) + failed_calls_trace(exc, trace_path)) from exc
     console = Console()
     graph = planned_success(result.graph, task, goal or getattr(agent, "last_goal", None), scene)
     dump_graph(graph, output)

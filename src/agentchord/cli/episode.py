@@ -172,7 +172,7 @@ def _load_graph_option(graph_path: str | None):
     try:
         graph = load_graph(graph_path)
     except GraphFileError as exc:
-        raise click.UsageError(str(exc)) from exc
+        raise BadInput(str(exc)) from exc
     problems = check_graph(graph)
     if problems:
         lines = "\n".join(f"{graph_path}: {p.path}: {p.message}" for p in problems)
@@ -203,7 +203,7 @@ def _run_or_explain(spec, on_tick=None, trace_path=None, graph_path=None):
     except RemoteWorldError as exc:
         raise BadInput(str(exc)) from exc
     except ReasonerError as exc:
-        raise click.UsageError(str(exc) + failed_calls_trace(exc, trace_path)) from exc
+        raise BadInput(str(exc) + failed_calls_trace(exc, trace_path)) from exc
     except GraphNotRunnableError as exc:
         source = graph_path or exc.source
         raise BadInput("the graph cannot run:\n" + "\n".join(f"{source}: {line}" for line in exc.lines)) from exc

@@ -334,7 +334,7 @@ def load_goal_option(goal_path: str | None):
     try:
         return load_model(goal_path, GoalSpec)
     except GraphFileError as exc:
-        raise click.UsageError(str(exc)) from exc
+        raise BadInput(str(exc)) from exc
 
 
 def failed_calls_trace(error, trace_path) -> str:
