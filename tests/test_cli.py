@@ -274,3 +274,10 @@ def test_a_plan_the_reasoner_refuses_is_not_preceded_by_a_usage_banner():
     result = CliRunner().invoke(main, ["plan", "fold the towel side to side", "--task", "fold_towel", "-o", "/tmp/unused.yaml"])
     assert result.exit_code == 2 and "cannot ground the instruction" in result.output
     assert "Usage:" not in result.output and "--help" not in result.output
+
+
+def test_run_says_what_each_node_means():
+    """Issue 61: `run` printed node ids (`v3`) without their meaning."""
+    result = CliRunner().invoke(main, ["run", "single_arm_pour_water", "--seed", "0"], terminal_width=200)
+    assert result.exit_code == 0, result.output
+    assert "node v1 (Right gripper holds the bottle)" in result.output

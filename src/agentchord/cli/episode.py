@@ -295,6 +295,12 @@ def plain(value):
     return value
 
 
+def _short(text: str, limit: int = 70) -> str:
+    """A node's semantic on one line, cut to ``limit`` characters."""
+    line = " ".join(str(text).split()).rstrip(".")
+    return line if len(line) <= limit else line[: limit - 3] + "..."
+
+
 def _print_episode(console: Console, result) -> None:
     for raw in result.trace.events:
         event = {key: plain(value) for key, value in raw.items()}
@@ -305,7 +311,8 @@ def _print_episode(console: Console, result) -> None:
             console.print(f"{tick}  [{colour}]{event['edge']}[/{colour}] -> {event['target']}  ({event['kind']})")
         elif kind == "node_reached":
             mark = "ok" if event["constraints_hold"] else f"constraints violated: {event.get('violated')}"
-            console.print(f"{tick}  node [bold]{event['node']}[/bold]  {mark}")
+            meaning = f" ({_short(event['semantic'])})" if event.get("semantic") else ""
+            console.print(f"{tick}  node [bold]{event['node']}[/bold]{meaning}  {mark}")
         elif kind == "disturbance":
             by = f" from the {event['arm']} gripper" if event["kind"] in ("drop", "pull") else ""
             during = f" during {event['action']}" if event["action"] else ""

@@ -445,7 +445,7 @@ class Executor(RecoverySwitching, PlanArrivals):
         self.node = node_id
         self.path.append(node_id)
         self.trace.add(self.world.tick, "node_reached", node=node_id, kind=node.kind, constraints_hold=held,
-                       violated=[] if held else self.violated_constraints(node_id))
+                       violated=[] if held else self.violated_constraints(node_id), semantic=node.semantic)
         merging = node.kind == "nominal" and self.recovering_from is not None
         if node.kind == "nominal":
             self.visited_nominal.append(node_id)
