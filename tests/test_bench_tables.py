@@ -58,3 +58,19 @@ def test_figures_are_png():
     assert stress_figure(records).startswith(b"\x89PNG")
     assert steps_figure(records).startswith(b"\x89PNG")
     assert stress_figure(_records()) is None  # one value of p: no curve
+
+
+def test_every_table_of_a_full_sweep_fits_a_terminal_of_120_characters():
+    """Issue 60: Tables I and II were Markdown of 37 columns. Now the paper's own columns (success with its
+    interval, execution time) are the main table, a row per method, and the rest have tables of their own."""
+    from agentchord.execution.methods import METHODS
+
+    records = [{**_record(method, seed, seed != 1, 30.0 + seed, 900, p=p, task=task), "first_motion_s": 1.5,
+                "critical_reasoning_s": 1.2}
+               for task in ("single_arm_pour_water", "dual_arm_pour_water", "rearrange_table", "handover_block",
+                            "setup_coffee_tray", "fold_towel")
+               for method in METHODS for seed in range(3) for p in (0.05, 0.1)]
+    markdown = table_markdown(records, "Table I: random drops", "caption")
+    assert max(len(line) for line in markdown.splitlines()) <= 120
+    assert "| Method | Success % [95% CI] | Exec. time s |" in markdown
+    assert "time to the first motion" in markdown and "steps of the disturbed episodes" in markdown

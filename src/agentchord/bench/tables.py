@@ -193,11 +193,57 @@ def table_layout(records: list[dict], methods: list[str] | None = None, with_ste
     return header, rows
 
 
+#: The widest line a table is meant to take (a terminal of 120 characters).
+MAX_TABLE_WIDTH = 120
+
+
 def table_markdown(records: list[dict], title: str, caption: str, methods: list[str] | None = None,
                    with_steps: bool = True, with_condition: bool = True, with_timing: bool = True) -> str:
-    """A titled Markdown table with its caption (the latency model, the intervals)."""
-    header, rows = table_layout(records, methods, with_steps, with_condition, with_timing)
-    return f"### {title}\n\n{markdown_table(header, rows)}\n{caption}\n"
+    """Titled Markdown tables, each narrow enough for a terminal of 120 characters, with the caption.
+
+    The main table has the paper's own columns, success with its interval and execution time, a row per
+    method of each task (and condition); the time to the first motion with the reasoning on its critical
+    path, and the steps of disturbed successful episodes, have tables of their own.
+    """
+    cells = group(records)
+    methods = ordered({m for _, _, m in cells} if methods is None else methods, METHODS)
+    keys = _row_keys(cells, methods)
+    lead = ["Task"] + (["Condition"] if with_condition else [])
+
+    def lead_of(task: str, condition: str, first: bool) -> list[str]:
+        # The task (and condition) once per block of method rows, as a person reads it.
+        return ([TASK_TITLES.get(task, task)] + ([condition] if with_condition else [])) if first else [""] * len(lead)
+
+    main = []
+    for task, condition in keys:
+        for k, method in enumerate(m for m in methods if (task, condition, m) in cells):
+            c = cells[(task, condition, method)]
+            main.append([*lead_of(task, condition, k == 0), SHORT.get(method, method), _pct(c), _time(c)])
+    for k, method in enumerate(methods):
+        found = [cells[(t, cond, method)] for t, cond in keys if (t, cond, method) in cells]
+        times = [c.time_s for c in found if c.time_s is not None]
+        main.append([*(["Average"] if k == 0 else [""]), *([""] if with_condition else []), SHORT.get(method, method),
+                     f"{mean(100 * c.success_rate for c in found):.1f}" if found else "-", f"{mean(times):.1f}" if times else "-"])
+    parts = [f"### {title}\n\n" + markdown_table([*lead, "Method", "Success % [95% CI]", "Exec. time s"], main)]
+    if with_timing and any(c.first_motion_s is not None for c in cells.values()):
+        timing = [[*lead_of(task, condition, k == 0), SHORT.get(method, method), _seconds(c.first_motion_s), _seconds(c.critical_reasoning_s)]
+                  for task, condition in keys
+                  for k, (method, c) in enumerate((m, cells[(task, condition, m)]) for m in methods if (task, condition, m) in cells)]
+        parts.append(f"#### {title}: time to the first motion\n\n"
+                     + markdown_table([*lead, "Method", "First motion s", "Critical reasoning s"], timing))
+    if with_steps:
+        header = [*lead, *(f"Steps {SHORT.get(m, m)}" for m in methods)]
+        steps = [[TASK_TITLES.get(t, t), *([cond] if with_condition else []), *(_steps(cells.get((t, cond, m))) for m in methods)]
+                 for t, cond in keys]
+        parts.append(f"#### {title}: steps of the disturbed episodes each method completed\n\n" + markdown_table(header, steps))
+    return "\n".join(parts) + f"\n{caption}\n"
+
+
+def _row_keys(cells: dict, methods: list[str]) -> list[tuple[str, str]]:
+    """The (task, condition) rows some method has, tasks in the paper's order, drops before protocols."""
+    tasks = ordered({t for t, _, _ in cells}, list(TASK_TITLES))
+    conditions = sorted({c for _, c, _ in cells}, key=lambda label: (label.startswith("protocol"), label))
+    return [(t, c) for t in tasks for c in conditions if any((t, c, m) in cells for m in methods)]
 
 
 def summary_csv(records: list[dict]) -> str:
