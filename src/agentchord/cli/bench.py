@@ -71,7 +71,9 @@ def _latency(ctx, param, value: str | None):
               help="Comma-separated tasks (`agentchord tasks`), or paper (the paper's six), or all.")
 @click.option("--methods", default=None, help="Comma-separated methods (default: all seven, in the paper's order, "
               "AgentChord with its sequential plan beside it).")
-@click.option("--p", "ps", callback=_probabilities, help="Drop probabilities, comma-separated (Table I: 0.05,0.10; Fig. 4: 0,0.05,0.1,0.2,0.3).")
+@click.option("--p", "ps", callback=_probabilities,
+              help="Drop probabilities, comma-separated; without --p or --protocol: 0.05,0.10, Table I's two "
+                   "(Fig. 4: 0,0.05,0.1,0.2,0.3).")
 @click.option("--protocol", type=click.Choice(("real", "stress")), default=None, help="A disturbance protocol instead of --p (Table II: real).")
 @click.option("--trials", type=click.IntRange(1, 10000), default=20, show_default=True, help="Seeds per task, method and condition.")
 @click.option("--seed", "first_seed", type=click.IntRange(0, 2**31), default=0, show_default=True, help="Seeds run from here.")
