@@ -111,7 +111,7 @@ def latency_rows(records: list[dict], plan_s: float, scales=SCALES) -> tuple[lis
         times = {m: lines[m].at(scale) for m in methods}
         fastest = min(times.values())
         best = [SHORT.get(m, m) for m in methods if math.isclose(times[m], fastest, abs_tol=0.05)]
-        rows.append([f"{scale:g}", f"{scale * plan_s:.2f}"] + [f"{times[m]:.1f}" for m in methods] + [", ".join(best)])
+        rows.append([f"{scale:g}", f"{round(scale * plan_s, 2):g}"] + [f"{times[m]:.1f}" for m in methods] + [", ".join(best)])
     return header, rows
 
 
