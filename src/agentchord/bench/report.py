@@ -87,7 +87,7 @@ def metric_rows(stats: dict) -> list[tuple[str, str]]:
     low, high = stats["success_ci95"]
     time_s = stats["mean_time_s"]
     rows = [
-        ("success rate", f"{100 * stats['success_rate']:.0f}% ({100 * low:.0f}-{100 * high:.0f}%)"),
+        ("success rate (95% interval)", f"{100 * stats['success_rate']:.0f}% ({100 * low:.0f}-{100 * high:.0f}%)"),
         ("mean execution time, successful episodes (robot s)", "-" if time_s is None else f"{time_s:.2f}"),
         ("mean steps (control ticks)", f"{stats['mean_steps']:.0f}"),
     ]

@@ -196,7 +196,9 @@ def describe_task(name: str) -> str:
     for o in scene.objects:
         size = " x ".join(f"{100 * v:.1f}" for v in o.extent)
         reach = ", ".join(o.reachable_by) if o.reachable_by else "no arm"
-        lines.append(f"  {o.name:<12} {o.description:<22} size {size} cm at ({o.pos[0]:+.2f}, {o.pos[1]:+.2f}) m, reached by: {reach}")
+        words = o.description.split()
+        description = " ".join(w for k, w in enumerate(words) if k == 0 or w != words[k - 1])  # "red red block"
+        lines.append(f"  {o.name:<12} {description:<22} size {size} cm at ({o.pos[0]:+.2f}, {o.pos[1]:+.2f}) m, reached by: {reach}")
     lines.append("regions:" if scene.regions else "regions: none")
     for r in scene.regions:
         lines.append(f"  {r.name:<12} {r.description} (centre ({r.center[0]:+.2f}, {r.center[1]:+.2f}) m, radius {100 * r.radius:.0f} cm)")

@@ -157,6 +157,11 @@ Goal = Annotated[Poured | Placed | Inside | On | HandedOver | Inserted | Folded,
 GOAL_KINDS: tuple[type[_Goal], ...] = (Poured, Placed, Inside, On, HandedOver, Inserted, Folded)
 
 
+def _kind_name(goal: type[_Goal]) -> str:
+    """The ``kind`` a goal class is written with in a goal file."""
+    return str(goal.model_fields["kind"].default)
+
+
 class GoalSpec(BaseModel):
     """An ordered list of goal predicates.
 
@@ -169,6 +174,17 @@ class GoalSpec(BaseModel):
 
     goals: list[Goal] = Field(min_length=1, max_length=64)
     home: bool = True
+
+    @model_validator(mode="before")
+    @classmethod
+    def _kind_read_as_a_boolean(cls, data: object) -> object:
+        # YAML reads a bare `on`, `yes` or `true` as a boolean: `kind: on` arrives as True.
+        goals = data.get("goals") if isinstance(data, dict) else None
+        for k, goal in enumerate(goals if isinstance(goals, list) else []):
+            if isinstance(goal, dict) and isinstance(goal.get("kind"), bool):
+                raise ValueError(f"goals[{k}].kind: YAML read it as {str(goal['kind']).lower()} (a bare on, yes or true is a "
+                                 f"boolean there); the kinds are {', '.join(_kind_name(g) for g in GOAL_KINDS)} (on top of: on_top_of)")
+        return data
 
     @model_validator(mode="after")
     def _coherent(self) -> GoalSpec:
