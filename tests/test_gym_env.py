@@ -152,3 +152,20 @@ def test_more_careless_arguments_are_refused_at_construction(kwargs, message):
 
     with pytest.raises(ValueError, match=message):
         AgentChordEnv("single_arm_pour_water", **kwargs)
+
+
+def test_one_conversion_between_the_worlds_grip_and_the_gym_opening():
+    """Issue 61: docs/world_protocol.md said 0 open .. 1 closed, the Gymnasium environments 0 closed .. 1 open;
+    the two now meet in one named conversion, which the environments use both ways."""
+    import numpy as np
+
+    from agentchord.gym.aloha import arm_commands, joint_action
+    from agentchord.worlds.protocol import ArmCommand, gripper_grip, gripper_opening
+
+    assert gripper_opening(1.0) == 0.0 and gripper_opening(0.0) == 1.0 and gripper_grip(gripper_opening(0.3)) == pytest.approx(0.3)
+    assert gripper_grip(1.5) == 0.0 and gripper_grip(-1.0) == 1.0  # clipped
+    commands = {"left": ArmCommand(q=np.zeros(6), grip=1.0), "right": ArmCommand(q=np.zeros(6), grip=0.25)}
+    action = joint_action(commands)
+    assert action[6] == 0.0 and action[13] == 0.75  # closed -> opening 0
+    back = arm_commands(action)
+    assert back["left"].grip == 1.0 and back["right"].grip == 0.25

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from agentchord.robot.aloha import ARM_JOINTS, ARMS, FINGER_GAP_OFFSET, FINGER_RANGE
-from agentchord.worlds.protocol import ArmCommand, World
+from agentchord.worlds.protocol import ArmCommand, World, gripper_grip, gripper_opening
 
 #: Names of the 14 entries of state and action.
 JOINT_NAMES = [f"{arm}_{j}" for arm in ARMS for j in (*ARM_JOINTS, "gripper")]
@@ -37,7 +37,7 @@ def joint_action(commands: dict[str, ArmCommand]) -> np.ndarray:
     parts = []
     for arm in ARMS:
         parts.extend(np.asarray(commands[arm].q, dtype=float).tolist())
-        parts.append(1.0 - float(commands[arm].grip))
+        parts.append(gripper_opening(commands[arm].grip))
     return np.asarray(parts, dtype=np.float32)
 
 
@@ -47,7 +47,7 @@ def arm_commands(action: np.ndarray) -> dict[str, ArmCommand]:
     out = {}
     for i, arm in enumerate(ARMS):
         block = action[7 * i : 7 * i + 7]
-        out[arm] = ArmCommand(q=block[:6].copy(), grip=float(np.clip(1.0 - block[6], 0.0, 1.0)))
+        out[arm] = ArmCommand(q=block[:6].copy(), grip=gripper_grip(block[6]))
     return out
 
 

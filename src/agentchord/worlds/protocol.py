@@ -118,6 +118,19 @@ def half_extent_along(shape: str, size: tuple[float, ...], matrix: np.ndarray, d
     return float(local @ np.asarray(size[:3], dtype=float))
 
 
+def gripper_opening(grip: float) -> float:
+    """A World command's ``grip`` (0 open .. 1 closed, what the arm is told to close) as the opening the
+    Gymnasium environments and the LeRobot datasets use (0 closed .. 1 open, ALOHA's and LeRobot's
+    convention). The one place the two conventions meet; :func:`gripper_grip` is its inverse."""
+    return 1.0 - float(grip)
+
+
+def gripper_grip(opening: float) -> float:
+    """An opening (0 closed .. 1 open, Gymnasium and LeRobot) as a World command's ``grip`` (0 open .. 1
+    closed), clipped to [0, 1]; the inverse of :func:`gripper_opening`."""
+    return min(1.0, max(0.0, 1.0 - float(opening)))
+
+
 def upright_height(shape: str, size: tuple[float, ...]) -> float:
     """Full height (m) of a ``cylinder`` (radius, half-height) or ``box`` (half-sizes) standing upright."""
     return 2.0 * (size[1] if shape == "cylinder" else size[2])
