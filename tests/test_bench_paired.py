@@ -70,3 +70,13 @@ def test_paired_csv_has_a_row_per_other_method_with_every_number():
 def test_a_reference_without_records_is_refused():
     with pytest.raises(ValueError, match="no records of 'agentchord'"):
         paired_rows([_record("rekep", 0, True, 20.0, 700)])
+
+
+def test_one_pair_is_shown_without_a_degenerate_interval():
+    """Issue 61: the paired table printed "+165 [+165, +165]" for a difference of one pair."""
+    from agentchord.bench.paired import Difference, _cells
+
+    one = Difference(n=1, reference=1000.0, other=1165.0, low=-165.0, high=-165.0, reference_better=1)
+    assert _cells(one, 0)[1] == "-165 (no interval: 1 pair)"
+    many = Difference(n=3, reference=1000.0, other=1165.0, low=-200.0, high=-130.0, reference_better=3)
+    assert _cells(many, 0)[1] == "-165 [-200, -130]"

@@ -134,9 +134,10 @@ def _cells(d: Difference | None, digits: int) -> list[str]:
     """``reference / other``, ``Δ [low, high]``, ``wins/n``."""
     if d is None:
         return ["-", "-", "-"]
-    return [f"{d.reference:.{digits}f} / {d.other:.{digits}f}",
-            f"{d.mean:+.{digits}f} [{d.low:+.{digits}f}, {d.high:+.{digits}f}]",
-            f"{d.reference_better}/{d.n}"]
+    # One pair (or pairs all alike) has no spread to make an interval of: say so, not "+165 [+165, +165]".
+    interval = (f"[{d.low:+.{digits}f}, {d.high:+.{digits}f}]" if d.n > 1 and d.low != d.high
+                else f"(no interval: {d.n} pair{'' if d.n == 1 else 's'})")
+    return [f"{d.reference:.{digits}f} / {d.other:.{digits}f}", f"{d.mean:+.{digits}f} {interval}", f"{d.reference_better}/{d.n}"]
 
 
 def paired_layout(records: list[dict], reference: str = REFERENCE) -> tuple[list[str], list[list[str]]]:

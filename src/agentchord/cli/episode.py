@@ -345,9 +345,9 @@ def _print_episode(console: Console, result) -> None:
         elif kind == "unrecoverable":
             console.print(f"{tick}  [red]unrecoverable[/red]: {event['obj']}: {event['reason']}")
         elif kind == "repair":
-            state = "added" if event["accepted"] else f"rejected ({event.get('reason')})"
-            console.print(f"{tick}  [cyan]online repair[/cyan] after {event['edge']}: {event['observation']} -> "
-                          f"{event['failure']} / {event['recovery']} {state}")
+            outcome = (f"added {event['failure']}, recovering by {event['recovery']}" if event["accepted"]
+                       else f"no branch added: {event.get('reason')}")
+            console.print(f"{tick}  [cyan]online repair[/cyan] after {event['edge']}: {event['observation']} -> {outcome}")
         elif kind == "reasoner_call":
             status = "ok" if event["ok"] else f"failed: {event['error']}"
             console.print(f"{tick}  {event['agent']} ({event['reasoner']}): {status}, {1000 * event['latency_s']:.0f} ms")
