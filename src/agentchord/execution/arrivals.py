@@ -496,8 +496,12 @@ class PlanArrivals(ExecutorState):
     @property
     def plan_wait_s(self) -> float:
         """Seconds the robot held still for parts of the plan, the wait under way included."""
-        ongoing = self.world.tick - self.waiting.began if self.waiting is not None else 0
-        return (self.plan_wait_ticks + ongoing) / CONTROL_HZ
+        return self.held_for_plan_ticks / CONTROL_HZ
+
+    @property
+    def held_for_plan_ticks(self) -> int:
+        """Ticks the robot held still for parts of the plan, the wait under way included."""
+        return self.plan_wait_ticks + (self.world.tick - self.waiting.began if self.waiting is not None else 0)
 
 
 def _headline(error: str | None) -> str:

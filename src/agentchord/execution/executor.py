@@ -320,7 +320,7 @@ class Executor(RecoverySwitching, PlanArrivals):
             if event is not None:
                 self.disturbances.injected(event, self.reasoning_s)
                 self.trace.add(event.tick, "disturbance", kind=event.kind, arm=event.arm, obj=event.obj, action=event.action)
-        waited = round(self.plan_wait_s * CONTROL_HZ)
+        waited = self.held_for_plan_ticks
         if self.world.tick - waited >= self.config.tick_limit:
             besides = f" ({waited} more ticks held still for the plan, not counted)" if waited else ""
             return False, f"tick limit {self.config.tick_limit} reached at {self._where()}{besides}"
