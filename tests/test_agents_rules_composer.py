@@ -104,8 +104,10 @@ def test_a_re_plan_in_the_middle_of_a_pour_untilts_before_the_cup_under_the_bott
     assert poured_into(mid_pour) == {"right": ["cup"]}
     goal = GoalSpec.model_validate({"goals": [{"kind": "placed", "obj": "cup"}, {"kind": "placed", "obj": "bottle"}]})
     steps = fns(compose(goal, mid_pour).graph)
-    # Untilted alone first: not while the cup moves from under it in the same step.
-    assert steps[0] == [("right", "rotate_eef")] and [("left", "place"), ("right", "place")] in steps[1:]
+    # Untilted alone first: not while the cup moves from under it in the same step. Then each set down
+    # where it is, one after the other: 7 cm apart, two hands going down at once would meet.
+    assert steps[0] == [("right", "rotate_eef")]
+    assert [("left", "place")] in steps[1:] and [("right", "place")] in steps[1:]
 
 
 def _mid_handover(grip_height: float, holder: str = "left"):
@@ -135,11 +137,23 @@ def test_a_re_plan_hands_over_what_the_other_arm_is_to_put_down():
     assert grasp < next(i for i, step in enumerate(steps) if ("right", "place") in step)
 
 
-def test_two_placements_into_one_container_are_made_in_the_goals_order_not_at_once():
+def test_two_hands_never_go_down_at_once_closer_than_the_clearance():
+    """Two blocks set down 8 cm apart are placed one after the other; 30 cm apart, at once."""
+    scene = scene_of("blocks_and_cup", 0)
+    for gap, together in ((0.08, False), (0.30, True)):
+        goal = GoalSpec.model_validate({"goals": [
+            {"kind": "placed", "obj": "red_block", "at": [-0.05, 0.45], "arm": "left"},
+            {"kind": "placed", "obj": "blue_block", "at": [-0.05 + gap, 0.45], "arm": "right"}]})
+        steps = fns(compose(goal, scene, "blocks_and_cup").graph)
+        assert ([("left", "place"), ("right", "place")] in steps) is together, (gap, steps)
+
+
+@pytest.mark.parametrize("second", [{"kind": "on_top_of", "obj": "blue_block", "support": "cup"},
+                                    {"kind": "inside", "obj": "blue_block", "container": "cup"}], ids=["on_top_of", "inside"])
+def test_two_placements_into_one_container_are_made_in_the_goals_order_not_at_once(second):
     """Issue 61: "the red block inside the cup, then the blue block on top of the cup" was planned as one two-arm
     step: both arms reached into the cup at once and the run ended "failure budget exhausted"."""
-    goal = GoalSpec.model_validate({"goals": [{"kind": "inside", "obj": "red_block", "container": "cup"},
-                                              {"kind": "on_top_of", "obj": "blue_block", "support": "cup"}]})
+    goal = GoalSpec.model_validate({"goals": [{"kind": "inside", "obj": "red_block", "container": "cup"}, second]})
     graph = compose(goal, scene_of("blocks_and_cup", 0), "blocks_and_cup").graph
     placing = [[call.args.get("obj") for _, call in edge.calls if call.fn == "place"] for edge in graph.nominal_edges()]
     placing = [objs for objs in placing if objs]

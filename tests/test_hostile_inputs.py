@@ -684,9 +684,10 @@ def test_nonsense_instructions_are_refused_with_the_reason(tmp_path, task, instr
         ([{"kind": "poured", "source": "red_block", "target": "cup"}], "'red_block' is not a vessel to pour from"),
         ([{"kind": "handed_over", "obj": "cup", "giver": "left", "receiver": "left"}], "cannot hand 'cup' over to itself"),
         ([{"kind": "placed", "obj": "red_block", "at": [0.1, 0.4], "relative_to": "cup"}], "one way only"),
+        ([{"kind": "on_top_of", "obj": "red_block", "support": "cup"}], "fits through the opening of 'cup'"),
     ],
     ids=["cycle", "inside itself", "into a block", "unknown object", "unknown region", "pour from a block",
-         "hand over to itself", "two places at once"],
+         "hand over to itself", "two places at once", "on a cup it falls into"],
 )
 def test_nonsense_goal_specs_are_refused(tmp_path, goals, message):
     path = write(tmp_path, {"goals": goals}, "goal.yaml")

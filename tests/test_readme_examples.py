@@ -97,3 +97,28 @@ def test_tasks_details_lists_the_scene_and_an_example_goal_that_runs(tmp_path):
     ran = run_episode(EpisodeSpec("blocks_and_cup", seed=0, goal=_goal(goal_file)))
     assert ran.success, ran.reason
     assert CliRunner().invoke(main, ["tasks", "nosuch"]).exit_code == 2
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_two_blocks_into_one_cup_succeed_in_the_order_asked(seed):
+    """Issue 61: two placements at one cup once sent both arms into it at once ("failure budget exhausted")."""
+    path = ROOT / "examples" / "goals" / "blocks_both_into_cup_in_order.yaml"
+    result = run_episode(EpisodeSpec("blocks_and_cup", seed=seed, goal=_goal(path)))
+    assert result.success, result.reason  # the order itself: test_agents_rules_composer
+
+
+@pytest.mark.parametrize("how", ["goal", "instruction"])
+def test_a_block_on_top_of_a_cup_it_falls_into_is_refused_before_the_robot_moves(how, tmp_path):
+    """The red block into the cup, then the blue one "on top of the cup": it fits through the opening."""
+    if how == "goal":
+        goal = tmp_path / "goal.yaml"
+        goal.write_text("goals:\n  - {kind: inside, obj: red_block, container: cup}\n"
+                        "  - {kind: on_top_of, obj: blue_block, support: cup}\n")
+        args = ["--goal", str(goal)]
+    else:
+        args = ["--instruction", "put the red block in the cup, then stack the blue one on top of the cup"]
+    out = tmp_path / "episode.json"
+    result = CliRunner().invoke(main, ["run", "blocks_and_cup", *args, "--seed", "2", "--json", str(out)])
+    assert result.exit_code == 2, result.output
+    assert "fits through the opening of 'cup'" in result.output and "kind inside" in result.output
+    assert not out.exists()

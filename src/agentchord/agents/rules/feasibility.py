@@ -2,9 +2,10 @@
 
 The STRIPS planner reasons over symbols: it would happily plan "put the cup into the red
 block" or "put the tray into the capsule". These checks refuse such goals with the reason:
-the receiving object is not a container, or the object does not fit through its opening;
-a stack or a containment that closes a cycle (also refused by the goal spec itself); a
-goal naming an object the scene does not have.
+the receiving object is not a container, or the object does not fit through its opening; an
+object set on top of an open container it would fall into; a stack or a containment that
+closes a cycle (also refused by the goal spec itself); a goal naming an object the scene
+does not have.
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ from __future__ import annotations
 from pydantic import ValidationError
 
 from agentchord.agents.rules import knowledge as kb
-from agentchord.agents.rules.goals import GoalSpec, Inside, Placed, Poured, static_problems
+from agentchord.agents.rules.goals import GoalSpec, Inside, On, Placed, Poured, static_problems
 from agentchord.agents.scene import Scene, SceneObject
 from agentchord.graph.models import TaskGraph
 from agentchord.graph.validation import Problem
@@ -39,6 +40,8 @@ def goal_problems(goal: GoalSpec, scene: Scene) -> list[str]:
             continue
         if isinstance(item, Inside) and item.obj in objects and item.container in objects:
             problems += _fit(where, objects[item.obj], objects[item.container], "put into")
+        elif isinstance(item, On) and item.obj in objects and item.support in objects:
+            problems += _falls_in(where, objects[item.obj], objects[item.support])
         elif isinstance(item, Poured) and item.source in objects and item.target in objects:
             if not kb.is_pourable(objects[item.source]):
                 problems.append(f"{where}: {item.source!r} is not a vessel to pour from")
@@ -63,6 +66,19 @@ def _fit(where: str, obj: SceneObject, container: SceneObject, verb: str) -> lis
             f"({inner * 100:.1f} cm inside)"
         ]
     return []
+
+
+def _falls_in(where: str, obj: SceneObject, support: SceneObject) -> list[str]:
+    """An object set on top of an open container it fits into falls in: it cannot rest on the rim."""
+    if not kb.is_container(support) or _fit(where, obj, support, "put into"):
+        return []
+    size = min(obj.extent[0], obj.extent[1])
+    inner = min(support.extent[0], support.extent[1]) * FIT_FRACTION
+    return [
+        f"{where}: {obj.name!r} ({size * 100:.1f} cm across) fits through the opening of {support.name!r} "
+        f"({inner * 100:.1f} cm inside): set on top of it, it falls in (to put it in: kind inside, "
+        f"container {support.name})"
+    ]
 
 
 def stated_goal(graph: TaskGraph) -> GoalSpec | None:

@@ -166,7 +166,9 @@ class GoalSpec(BaseModel):
     """An ordered list of goal predicates.
 
     Attributes:
-        goals: Predicates achieved in this order, each kept once achieved.
+        goals: Predicates planned in this order, each kept once achieved. Two that meet at one object
+            (two placements into one cup) are made one after the other; independent ones the two arms
+            may make at once.
         home: Both arms end at home.
     """
 

@@ -39,6 +39,7 @@ class Operator:
         steps: The edge's steps, each ``{arm: {"fn": ..., "args": {...}}}``.
         semantic: What holds afterwards, in words.
         skill: The skill it instantiates (``grasp``, ``pour``, ...).
+        spot: The table point (m) a place sets its object down on, where known. Two operators whose spots are closer than ``PARALLEL_CLEARANCE`` never share a round.
     """
 
     name: str
@@ -52,6 +53,7 @@ class Operator:
     steps: tuple = ()
     semantic: str = ""
     skill: str = ""
+    spot: tuple[float, float] | None = None
 
     def applicable(self, state: State) -> bool:
         """Whether the preconditions hold in ``state``."""
@@ -197,7 +199,8 @@ def schedule(plan_: Plan, initial: State) -> tuple[list[Round], list[State]]:
         members = [op for op, lv in zip(plan_.operators, level, strict=True) if lv == lvl]
         group: list[Round] = []
         for op in members:
-            fit = next((r for r in group if not (r.arms & set(op.arms)) and all(len(o.steps) == len(op.steps) for o in r.operators)), None)
+            fit = next((r for r in group if not (r.arms & set(op.arms))
+                        and all(len(o.steps) == len(op.steps) and _apart(o, op) for o in r.operators)), None)
             if fit is None:
                 group.append(Round([op]))
             else:
@@ -214,6 +217,18 @@ def schedule(plan_: Plan, initial: State) -> tuple[list[Round], list[State]]:
             state = op.apply(state)
         states.append(state)
     return rounds, states
+
+
+#: Distance (m) two places' table points must keep to be made at once: a wrist and its open fingers
+#: are about 8 cm across, so two hands closer would meet (two grasps go down on objects already apart).
+PARALLEL_CLEARANCE = 0.12
+
+
+def _apart(a: Operator, b: Operator) -> bool:
+    """Whether two operators set their objects down far enough apart to run at once (unknown spots are apart)."""
+    if a.spot is None or b.spot is None:
+        return True
+    return ((a.spot[0] - b.spot[0]) ** 2 + (a.spot[1] - b.spot[1]) ** 2) ** 0.5 >= PARALLEL_CLEARANCE
 
 
 def _unblocks(a: Operator, b: Operator) -> bool:

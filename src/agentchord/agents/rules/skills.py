@@ -152,6 +152,7 @@ def _one_arm_ops(
                 add=frozenset({("free", arm), ("on_table", name), ("at", name, key)} | {("reach", a, name) for a in reachers}),
                 delete=_released(arm, name) | {("reach", a, name) for a in set(ARMS) - reachers}, cost=170 + reach,
                 steps=({arm: _call("place", **args)},), semantic=f"The {name} released {_where(key)}.", skill="place",
+                spot=point,
             )
         )
     if may_grasp or handed:
