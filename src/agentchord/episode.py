@@ -107,6 +107,20 @@ def run_episode(spec: EpisodeSpec, on_tick: Callable[[Executor], None] | None = 
         return _run_in(world, spec, on_tick)
 
 
+def run_episode_on(world: World, spec: EpisodeSpec, on_tick: Callable[[Executor], None] | None = None) -> EpisodeResult:
+    """Run the episode of ``spec`` on a world the caller opened (a fresh trial of its task and seed):
+    a driver of your own, or a world another loop steps (:class:`agentchord.gym.AgentChordExpert`).
+
+    Raises:
+        KeyError: Unknown task.
+        ValueError: Unknown strategy.
+        GraphNotRunnableError: The graph fails ``graph check`` or names objects the scene lacks.
+    """
+    if spec.task not in SIM_TASKS:
+        raise KeyError(f"unknown task {spec.task!r} (tasks: {', '.join(SIM_TASKS)})")
+    return _run_in(world, spec, on_tick)
+
+
 def _run_in(world: World, spec: EpisodeSpec, on_tick: Callable[[Executor], None] | None) -> EpisodeResult:
     """The episode of ``spec`` on ``world`` (a fresh trial of its task and seed)."""
     task = SIM_TASKS[spec.task]

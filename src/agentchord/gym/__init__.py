@@ -5,6 +5,8 @@
     env = gymnasium.make("agentchord/SingleArmPourWater-v0", disturb="shift")
 
 (or, without the import: ``gymnasium.make("agentchord.gym:agentchord/SingleArmPourWater-v0")``).
+AgentChord itself as the expert that answers each step: :class:`AgentChordExpert`
+(``agentchord.gym.expert``).
 """
 
 from __future__ import annotations
@@ -35,4 +37,15 @@ def _register() -> None:
 
 _register()
 
-__all__ = ["ENV_IDS", "NAMESPACE", "env_id"]
+
+
+def __getattr__(name: str):
+    # The expert imports the agents and the executor: only for who asks for it.
+    if name == "AgentChordExpert":
+        from agentchord.gym.expert import AgentChordExpert
+
+        return AgentChordExpert
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+__all__ = ["ENV_IDS", "NAMESPACE", "AgentChordExpert", "env_id"]

@@ -1,5 +1,8 @@
 """Errors of the MuJoCo world."""
 
+from agentchord.guard.exceptions import InputError
+
+
 
 class SimError(Exception):
     """Base class of the simulator's errors."""
@@ -11,3 +14,8 @@ class SceneError(SimError):
 
 class UnknownObjectError(SimError, KeyError):
     """An action or expression named an object the scene does not have."""
+
+
+class TaskPluginError(InputError):
+    """A task module outside the package (``AGENTCHORD_TASKS``, an ``agentchord.tasks`` entry point)
+    cannot be loaded: a missing file, an import that fails, no ``TASK``, or a name already taken."""

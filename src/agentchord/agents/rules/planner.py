@@ -39,7 +39,8 @@ class Operator:
         steps: The edge's steps, each ``{arm: {"fn": ..., "args": {...}}}``.
         semantic: What holds afterwards, in words.
         skill: The skill it instantiates (``grasp``, ``pour``, ...).
-        spot: The table point (m) a place sets its object down on, where known. Two operators whose spots are closer than ``PARALLEL_CLEARANCE`` never share a round.
+        spot: The table point (m) a place sets its object down on, where known. Two operators whose
+            spots are closer than ``PARALLEL_CLEARANCE`` never share a round.
     """
 
     name: str
