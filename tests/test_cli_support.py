@@ -109,6 +109,8 @@ SIGTERM_DURING_VIDEO = textwrap.dedent("""
             self.trace = type("T", (), {"events": []})()
             self.program = None
             self.node = "v0"
+            from agentchord.library import load_task_graph
+            self.graph = load_task_graph("single_arm_pour_water")
 
     def terminated(spec, on_tick, *args):
         on_tick(Executor())  # the renderer is open and a frame taken

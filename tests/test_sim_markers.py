@@ -112,3 +112,19 @@ def test_the_hand_is_drawn_into_the_frame(tmp_path):
         assert np.abs(after[42, 317].astype(int) - [255, 140, 0]).max() < 10  # the banner
     finally:
         recorder.close()
+
+
+def test_the_last_frame_shows_the_outcome_held_whatever_the_tick(tmp_path):
+    from agentchord.sim.render import VideoRecorder
+
+    world = _world()
+    recorder = VideoRecorder(world, tmp_path / "v.mp4", every=2, size=(160, 120))
+    try:
+        world.step()  # tick 1: not a filmed tick
+        recorder.capture("c")
+        assert recorder.frames == []
+        recorder.final("node v6 (task complete)", "SUCCESS", seconds=1.0)
+        assert len(recorder.frames) == 25 and all(f is recorder.frames[0] for f in recorder.frames)
+        assert np.abs(recorder.frames[-1][-2, 80].astype(int) - [227, 119, 194]).max() < 10  # the outcome's band
+    finally:
+        recorder.close()

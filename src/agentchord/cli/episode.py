@@ -125,6 +125,7 @@ def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, inst
             recorder["video"] = VideoRecorder(executor.world, video_path, camera=camera)
             recorder["seen"] = 0
         video = recorder["video"]
+        recorder["graph"] = executor.graph
         for event in executor.trace.events[recorder["seen"]:]:
             if event["event"] == "failure_detected":
                 video.announce(f"FAILURE {event['failure']} on {event['edge']}")
@@ -140,7 +141,7 @@ def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, inst
                 video.announce(f"DISTURBANCE: {event['kind']} {event['obj']}", ticks=25)
         recorder["seen"] = len(executor.trace.events)
         program = executor.program
-        caption = f"{task}  node {executor.node}  edge {program.edge_id if program else '-'} ({program.kind if program else ''})"
+        caption = f"{task}  node {_node_words(executor.graph, executor.node)}  edge {program.edge_id if program else '-'} ({program.kind if program else ''})"
         video.capture(caption)
 
     spec = EpisodeSpec(task=task, strategy=strategy, seed=seed, graph=graph, disturbances=disturbance_setting(p, disturb, protocol),
@@ -149,6 +150,12 @@ def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, inst
     # Ctrl-C or SIGTERM (@catches_sigterm) release the renderer; _write_video leaves no temporary file.
     try:
         result = _run_or_explain(spec, on_tick, trace_path, graph_path)
+        if "video" in recorder:
+            end = next((step for step in reversed(result.path) if not step.startswith("e")), "")
+            graph_ran = recorder.get("graph")
+            where = _node_words(graph_ran, end) if graph_ran is not None else end
+            outcome = "SUCCESS" if result.success else f"FAILURE: {result.reason}"
+            recorder["video"].final(f"{task}  node {where}  (episode over)", outcome[:110])
         _print_episode(console, result)
         _write_outputs(console, [
             ("trace", trace_path, lambda: result.trace.write(trace_path)),
@@ -160,6 +167,17 @@ def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, inst
         if "video" in recorder:
             recorder["video"].close()
     sys.exit(0 if result.success else 1)
+
+
+def _node_words(graph, node_id: str, width: int = 44) -> str:
+    """``v3 (bottle tilted over the cup)``: a node id with the start of its meaning, for the video's caption."""
+    try:
+        semantic = graph.node(node_id).semantic.strip().rstrip(".")
+    except KeyError:
+        return node_id
+    if not semantic:
+        return node_id
+    return f"{node_id} ({semantic if len(semantic) <= width else semantic[: width - 3].rstrip() + '...'})"
 
 
 def _load_graph_option(graph_path: str | None):

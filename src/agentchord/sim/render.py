@@ -55,6 +55,18 @@ class VideoRecorder:
         image = self.renderer.render()
         self.frames.append(self._annotate(image, caption))
 
+    def final(self, caption: str, outcome: str, seconds: float = 1.5) -> None:
+        """The last frame, whatever the tick: the node the episode ended at and its outcome, held for
+        ``seconds`` (the frames filmed before it show the node the arms were leaving)."""
+        if self.renderer is None:
+            return
+        self.markers.update()
+        self.renderer.update_scene(self.world.data, camera=self.camera)
+        add_to_scene(self.renderer.scene, self.markers.shapes())
+        self.flash, self._flash_until = outcome, self.world.tick + 1
+        frame = self._annotate(self.renderer.render(), caption)
+        self.frames += [frame] * max(1, round(seconds * CONTROL_HZ / self.every))
+
     def announce(self, text: str, ticks: int = 50) -> None:
         """Show a highlighted message (a failure, a recovery switch) for a while.
 
