@@ -1,7 +1,7 @@
-"""One-way imports: every module imports, the package layers hold, and the README states them.
+"""One-way imports: every module imports, the package layers hold, and docs/architecture.md states them.
 
 The layers and the no-circle rule are import-linter contracts in ``pyproject.toml``
-(``lint-imports`` runs them too); this file runs them and checks that the README's
+(``lint-imports`` runs them too); this file runs them and checks that docs/architecture.md's
 architecture section lists the same layers in the same order.
 """
 
@@ -19,7 +19,7 @@ import agentchord
 
 ROOT = Path(__file__).resolve().parents[1]
 PYPROJECT = ROOT / "pyproject.toml"
-README = ROOT / "README.md"
+ARCHITECTURE = ROOT / "docs" / "architecture.md"
 
 
 def _modules() -> list[str]:
@@ -38,8 +38,8 @@ def _contract_layers() -> list[list[str]]:
 
 def _readme_layers() -> list[list[str]]:
     """The architecture section's package lines, top to bottom; ``| pkg`` lines join the layer above."""
-    text = README.read_text()
-    section = text[text.index("## Architecture") :]
+    text = ARCHITECTURE.read_text()
+    section = text[text.index("# Architecture") :]
     start = section.index("```\nsrc/agentchord/") + 4
     block = section[start : section.index("\n```", start)]
     layers: list[list[str]] = []
