@@ -9,8 +9,13 @@ import textwrap
 
 import pytest
 
+from pathlib import Path
+
+from agentchord.episode import EpisodeSpec, run_episode
 from agentchord.sim import tasks as task_registry
-from agentchord.sim.exceptions import TaskPluginError
+from agentchord.sim.exceptions import SceneSpecError, TaskPluginError
+
+EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "scenes" / "fruit_and_bowl.py"
 
 SCENE = textwrap.dedent('''
     """Two blocks and a cup, under another name: a scene a user writes outside the package."""
@@ -43,9 +48,10 @@ def test_a_file_and_a_folder_of_task_modules_are_registered(tmp_path, monkeypatc
     ("x = 1\n", "defines no TASK"),
     ("raise RuntimeError('boom')\n", "importing it raised RuntimeError: boom"),
     ("TASK = object()\n", "its TASK has no name, description, sample_scene, success_tracker"),
+    (SCENE.replace("TASK = MyBlocks()", "TASK = MyBlocks"), "its TASK is the class MyBlocks, not a task: make one, TASK = MyBlocks()"),
     (SCENE.replace('"my_blocks"', '"blocks_and_cup"'), "a task named 'blocks_and_cup' exists already"),
     (SCENE.replace('"my_blocks"', '"my blocks!"'), "is not a plain identifier"),
-], ids=["missing", "no TASK", "raises", "not a task", "name taken", "bad name"])
+], ids=["missing", "no TASK", "raises", "not a task", "a class", "name taken", "bad name"])
 def test_a_bad_task_module_is_refused_naming_the_variable_the_file_and_the_problem(tmp_path, monkeypatch, content, message):
     path = tmp_path / "scene.py"
     if content is not None:
@@ -81,3 +87,29 @@ def test_an_installed_packages_entry_point_is_registered(tmp_path, monkeypatch):
     points[0] = EntryPoint(name="gone", value="no_such_module_here:TASK", group=task_registry.ENTRY_POINT_GROUP)
     with pytest.raises(TaskPluginError, match="entry point gone = no_such_module_here:TASK .* ModuleNotFoundError"):
         task_registry._plugins({})
+
+
+def test_the_guides_worked_example_registers_and_its_instruction_succeeds(monkeypatch):
+    """docs/scenes.md's example scene, as a user registers it: the guide stays true."""
+    monkeypatch.setenv(task_registry.TASKS_VARIABLE, str(EXAMPLE))
+    found = task_registry._plugins({})
+    assert list(found) == ["fruit_and_bowl"]
+    monkeypatch.setitem(task_registry.SIM_TASKS, "fruit_and_bowl", found["fruit_and_bowl"])
+    result = run_episode(EpisodeSpec("fruit_and_bowl", seed=0, instruction="put the apple into the bowl, then the lime on the board"))
+    assert result.success, result.reason
+
+
+@pytest.mark.parametrize(("change", "message"), [
+    ({"shape": "sphere", "size": (0.03,)}, "shape 'sphere' is not one the simulator builds"),
+    ({"shape": "cylinder", "size": (0.03, 0.02, 0.01)}, "a cylinder takes 2 sizes (radius, half-height), got 3"),
+    ({"size": (0.02, 0.02, float("nan"))}, "must be finite"),
+    ({"size": (0.02, 0.02, 2.0)}, "each size must be from 0.002 to 1 m"),
+    ({"mass": 0.0}, "mass must be from 0.001 to 20 kg"),
+], ids=["unknown shape", "wrong size count", "nan", "too big", "no mass"])
+def test_an_object_written_wrong_is_refused_naming_it(change, message):
+    from agentchord.sim.scene import ObjectSpec
+
+    fields = {"name": "apple", "shape": "box", "size": (0.02, 0.02, 0.02), "mass": 0.1, "pos": (0.0, 0.5)} | change
+    with pytest.raises(SceneSpecError, match="object 'apple'") as caught:
+        ObjectSpec(**fields)
+    assert message in str(caught.value)

@@ -12,6 +12,11 @@ class SceneError(SimError):
     """The scene could not be built (missing assets, a model that does not compile)."""
 
 
+class SceneSpecError(SceneError, InputError):
+    """An object of a scene is written wrong (an unknown shape, the wrong number of sizes, a size or
+    mass out of range): the scene's author's error, reported as bad input."""
+
+
 class UnknownObjectError(SimError, KeyError):
     """An action or expression named an object the scene does not have."""
 

@@ -8,6 +8,7 @@ floor, lights and cameras. Objects are added as free bodies with explicit inerti
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import mujoco
@@ -26,7 +27,7 @@ from agentchord.robot.aloha import (  # noqa: F401  (the robot's numbers, re-exp
 from agentchord.robot.exceptions import RobotModelError
 from agentchord.robot.model import add_collision_proxies, edit_robot, robot_xml
 from agentchord.worlds.protocol import grip_width, half_extent_along, upright_height
-from agentchord.sim.exceptions import SceneError
+from agentchord.sim.exceptions import SceneError, SceneSpecError
 
 #: Sliding friction of the table top (MuJoCo takes the larger of two touching geoms' coefficients).
 TABLE_FRICTION = 1.0
@@ -62,6 +63,30 @@ class ObjectSpec:
     rgba: tuple[float, float, float, float] = (0.2, 0.5, 0.9, 1.0)
     friction: float = 1.0
     parts: tuple[tuple[tuple[float, float, float], tuple[float, float, float]], ...] = ()
+
+    def __post_init__(self) -> None:
+        # A scene written outside the package (docs/scenes.md) is input: refused here, named, not
+        # deep in MuJoCo or the features.
+        sizes = {"cylinder": 2, "box": 3}
+        where = f"object {self.name!r}"
+        if self.shape not in sizes:
+            raise SceneSpecError(f"{where}: shape {self.shape!r} is not one the simulator builds (cylinder or box)")
+        try:
+            size = [float(v) for v in self.size]
+            numbers = [float(self.mass), float(self.pos[0]), float(self.pos[1]), float(self.yaw), float(self.friction)]
+        except (TypeError, ValueError, IndexError):
+            raise SceneSpecError(f"{where}: size, mass, pos, yaw and friction must be numbers") from None
+        if len(size) != sizes[self.shape]:
+            what = "radius, half-height" if self.shape == "cylinder" else "three half-sizes"
+            raise SceneSpecError(f"{where}: a {self.shape} takes {sizes[self.shape]} sizes ({what}), got {len(size)}")
+        if not all(math.isfinite(v) for v in size + numbers):
+            raise SceneSpecError(f"{where}: its size, mass, pos, yaw and friction must be finite")
+        if not all(0.002 <= v <= 1.0 for v in size):
+            raise SceneSpecError(f"{where}: each size must be from 0.002 to 1 m (half-sizes), got {tuple(size)}")
+        if not 0.001 <= self.mass <= 20.0:
+            raise SceneSpecError(f"{where}: mass must be from 0.001 to 20 kg, got {self.mass}")
+        if self.parts and self.shape != "box":
+            raise SceneSpecError(f"{where}: a compound object (parts) must have shape 'box' (its bounding box)")
 
     @property
     def height(self) -> float:

@@ -72,6 +72,8 @@ def _load_file(path: Path) -> object:
 
 
 def _register(tasks: dict[str, SimTask], task: object, where: str) -> None:
+    if isinstance(task, type):
+        raise TaskPluginError(f"{where}: its TASK is the class {task.__name__}, not a task: make one, TASK = {task.__name__}()")
     missing = [attr for attr in ("name", "description", "sample_scene", "success_tracker") if not hasattr(task, attr)]
     if missing:
         raise TaskPluginError(f"{where}: its TASK has no {', '.join(missing)} (a task: docs/scenes.md)")
