@@ -1,6 +1,6 @@
 """Label the blind evaluation set (issue 59): the goal each instruction means, written to labels.yaml.
 
-The four writers' files (writer_A.yaml ... writer_D.yaml) hold 210 instructions, each with the
+The five writers' files (writer_A.yaml ... writer_E.yaml) hold 270 instructions, each with the
 writer's own ``meaning`` (the intended end state) and ``possible``. This script states, per id, the
 goal the instruction means as a goal spec's goals (``agentchord schema goal``), written with the
 label helpers of ../build_corpus.py and its conventions (docs/language.md): ``put X down``/``back``
@@ -18,7 +18,8 @@ little``, ``a splash``, ``fill it up``) is a pour; a stated fraction (``about ha
 half full``) cannot be said and is refused.
 
 The labels were written from the instructions and the writers' meanings only: no composer, planner
-or benchmark was run on the instructions. Each goal list is validated as a ``GoalSpec`` and checked
+or benchmark was run on the instructions. Where an instruction and its writer's meaning disagree, the
+instruction's words decide (what a reader could know); the entry's comment says so. Each goal list is validated as a ``GoalSpec`` and checked
 against its scene (``goal_problems``: the objects and regions exist, things fit).
 
     .venv/bin/python tests/data/language/blind/build_labels.py   # rewrites labels.yaml
@@ -363,6 +364,87 @@ LABELS: dict[str, object] = {
     "D-058": [rel(B, "red_block", "blue_block", "left")],
     "D-059": [nudge(B, "cup", "front"), into("blue_block", "cup")],
     "D-060": REFUSE,
+    # --- writer E ----------------------------------------------------------------------------
+    "E-001": POUR1,  # "some water": a vague amount, a pour
+    # "use your right hand to pour ...": the pour's arm; the bottle was not taken in a clause of its own (as D-001).
+    "E-002": [pour(arm="right"), put("bottle")],
+    "E-003": [pour(arm="right"), put("bottle", "right")],  # "right arm:" heads grab, pour, set it back down
+    "E-004": POUR1,  # end state: water in the cup, the bottle standing back where it was
+    # "take the bottle with right hand": taken by a said arm, so its put-back is the right arm's too (as B-002).
+    "E-005": [pour(arm="right"), put("bottle", "right")],
+    "E-006": REFUSE,
+    "E-007": [rel(P1, "cup", "bottle")],  # right beside the bottle, on its left (where the cup is; as B-005)
+    "E-008": REFUSE,
+    "E-009": POUR2_LR,
+    "E-010": POUR2_LR,  # "tip the bottle into it with your right": the pour's arm; the bottle's put-down has none
+    "E-011": POUR2,  # held cup, arms unsaid (the writer's "presumably left" is not in the words)
+    "E-012": POUR2_LR,  # "First ... left arm. Second, pour ... using the right arm. Finally, put ... back"
+    # "End state: cup has water, both ... upright on the table": no hold said (as C-015): the plain pour,
+    # the bottle back.
+    "E-013": POUR1,
+    "E-014": POUR2_LR,  # "lift up the red cup with left and pour it some water by the right arm"
+    # Picked up by the right arm (it is handed to the left) and handed over; nothing said about putting it
+    # down: by the convention the left arm that holds it puts it back (the writer's meaning, the bottle
+    # still held at the end, is not sayable; the instruction does not ask for it, unlike A-026/B-025).
+    "E-015": [hand("bottle", "right", "left"), put("bottle", "left")],
+    # Swap the two places: absolute points, each the other's start (as B-012), in the order said (the cup first).
+    "E-016": [at_xy("cup", *spot(P2, "bottle")), at_xy("bottle", *spot(P2, "cup"))],
+    "E-017": SETTING,  # "next to the plate": each on the side it is on (fork left, spoon right)
+    "E-018": SETTING_ARMS,  # "both pointing away from you": the setting convention (turned along y)
+    "E-019": SETTING,
+    "E-020": [on("spoon", "plate")],
+    # "line them both up beside the plate, handles toward you": beside on their own sides, turned along y
+    # (the yaw of the long axis; which end is the handle is not sayable and no more than the setting).
+    "E-021": SETTING,
+    "E-022": SETTING,  # "by the plate", "do the same with the spoon": each beside it, on its own side
+    "E-023": REFUSE,
+    # "pass the spoon over to your left hand": from the right arm; the left lays it left of the plate (as D-023).
+    "E-024": [hand("spoon", "right", "left"), rel(T, "spoon", "plate", "left", "left")],
+    "E-025": [on("fork", "plate"), on("spoon", "plate")],  # in the order said
+    "E-026": HANDOVER,
+    "E-027": HANDOVER,
+    "E-028": TARGET,
+    "E-029": TARGET,  # "standing up like it is now": placed stands it upright anyway
+    "E-030": HANDOVER,
+    # "with your left arm, don't bother handing it over": the left arm alone (as C-028 for the right arm).
+    "E-031": [region("block", "target", "left")],
+    "E-032": REFUSE,
+    # "Lift the block up a bit with your left hand and then just put it back down where it was": put back
+    # is placed with no place (where it was taken from), by the said arm. The lift's height is manner, not
+    # an end state. (Unlike D-056 no achieved goal is undone: nothing but the put-back is stated.)
+    "E-033": [put("block", "left")],
+    "E-034": COFFEE,  # "carry the tray forward with both hands": the tray's carry is two-handed anyway
+    "E-035": COFFEE_LEFT,  # capsule "with your left hand"; "a bit further away from you": the forward spot
+    "E-036": COFFEE,
+    "E-037": COFFEE,  # "a little farther back" = away from the robot (the writer's meaning; as A-031)
+    "E-038": COFFEE,  # "put it down a little further away": the forward spot
+    "E-039": COFFEE,  # "bring it more far": the forward spot
+    "E-040": [into("capsule", "tray")],  # "leave the tray where it is": no goal for the tray
+    "E-041": REFUSE,
+    "E-042": FOLD,
+    "E-043": FOLD,
+    "E-044": FOLD,  # near corners "toward the back": onto the far corners
+    "E-045": FOLD,
+    "E-046": FOLD,  # "half as deep, with the folded edge facing me": near corners onto far corners, crease near
+    "E-047": REFUSE,
+    "E-048": REFUSE,
+    # "fold it in half the long way round... well you know, front to back": the words settle on front to
+    # back (front corners onto the back ones): the fold.
+    "E-049": FOLD,
+    "E-050": REFUSE,
+    "E-051": [into("red_block", "cup")],
+    "E-052": [on("blue_block", "red_block")],
+    "E-053": [into("red_block", "cup"), into("blue_block", "cup")],  # "Red one first, then the blue one"
+    # Side unsaid: beside it on the side the blue block is on (its right).
+    "E-054": [rel(B, "blue_block", "red_block")],
+    # "the bowl": the bowl-like white cup (as C-048); the blue block just left of it.
+    "E-055": [into("red_block", "cup"), rel(B, "blue_block", "cup", "left")],
+    "E-056": [hand("red_block"), into("red_block", "cup", "right")],  # as B-049
+    "E-057": [rel(B, "blue_block", "cup", "right"), into("red_block", "cup")],
+    "E-058": [into("blue_block", "cup"), rel(B, "red_block", "cup", "front")],  # "right in front of": directly in front
+    # Each block's arm said; order unsaid: as named (blue first; as C-045).
+    "E-059": [into("blue_block", "cup", "right"), into("red_block", "cup", "left")],
+    "E-060": [nudge(B, "cup", "right"), into("blue_block", "cup")],  # "over a bit to the right": a nudge (as C-050)
 }
 
 #: Why each refused entry is refused.
@@ -397,11 +479,19 @@ WHY = {
     "D-048": "no drawer in the scene",
     "D-056": "into the cup and out again: goals are kept once achieved, so a put-in undone later cannot be said (the end state is the start)",
     "D-060": "no water in this scene",
+    "E-006": "'fill the cup about halfway': a stated amount; poured states no amount",
+    "E-008": "no glass jug in the scene (only the bottle and the cup)",
+    "E-023": "no knife in the scene",
+    "E-032": "no cup in the handover scene",
+    "E-041": "making coffee: no coffee machine, water or cup in the scene; brewing is not a goal",
+    "E-047": "a side fold (left edge onto right edge): folded is only near corners onto far corners",
+    "E-048": "moving the whole towel to the right side: the cloth is only its corner points and folded; no goal moves a cloth",
+    "E-050": "ironing the towel: no iron in the scene and ironing is not a goal (the fold alone would be sayable, not the whole)",
 }
 
 HEADER = """# Labels of the blind evaluation set (issue 59). Built by build_labels.py; do not edit by hand.
 #
-# For each instruction of writer_A.yaml ... writer_D.yaml (210): its scene, and the goal it means
+# For each instruction of writer_A.yaml ... writer_E.yaml (five writers, 270): its scene, and the goal it means
 # as a goal spec's goals (`agentchord schema goal`), or expect: refused with why (the scene cannot
 # do it, or the goal language cannot say it). Written from the instruction and the writer's
 # `meaning` by a labeller who did not write them, following build_corpus.py's label conventions
@@ -417,10 +507,10 @@ def _scene_obs(task: str):
 
 def main() -> None:
     entries = []
-    for name in ("A", "B", "C", "D"):
+    for name in ("A", "B", "C", "D", "E"):
         entries += yaml.safe_load((HERE / f"writer_{name}.yaml").read_text(encoding="utf-8"))["entries"]
     ids = [e["id"] for e in entries]
-    assert len(ids) == len(set(ids)) == 210, len(ids)
+    assert len(ids) == len(set(ids)) == 270, len(ids)
     assert set(LABELS) == set(ids), (set(ids) - set(LABELS), set(LABELS) - set(ids))
     assert set(WHY) == {k for k, v in LABELS.items() if v == REFUSE}, set(WHY) ^ {k for k, v in LABELS.items() if v == REFUSE}
     scenes: dict = {}
@@ -444,7 +534,7 @@ def main() -> None:
         counts[eid[0], "labelled"] += 1
     text = yaml.dump({"labels": labels}, Dumper=_Dumper, sort_keys=False, width=200, allow_unicode=True)
     (HERE / "labels.yaml").write_text(HEADER + text, encoding="utf-8")
-    for name in "ABCD":
+    for name in "ABCDE":
         print(f"writer {name}: {counts[name, 'labelled']} labelled, {counts[name, 'refused']} refused")
     print(f"labels.yaml: {len(labels)} entries")
 
