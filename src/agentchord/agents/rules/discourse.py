@@ -86,6 +86,21 @@ _TRAILING_ORDER = re.compile(r" (?:first|afterwards|after that|after it|after th
 _AWAY = re.compile(r"\b(?:a (?:little |tiny )?bit |a little |slightly )?(?:further|farther)(?: away)?(?: back)?(?: from (?:me|you|the robot))?"
                    r"(?: than (?:it is|it does|it was)(?: now)?)?\b|\baway from (?:me|you|the robot)\b|\btowards? the (?:back|far side|far end)\b|"
                    r"\bto the back\b")
+#: "a little closer to you", "towards the robot": the robot's side of the table.
+_TOWARD_YOU = re.compile(r"\b(?:a (?:little |tiny )?bit |a little |slightly )?(?:closer|nearer) (?:to|towards?) (?:you|me|the robot|yourself)\b|"
+                         r"\btowards? (?:you|me|the robot|yourself)\b")
+#: "so it's (lying) right next to the plate": what the move is for is where it goes.
+_SO_IT = re.compile(r"(?: ,)? so (?:that )?(?:it|they)(?:'s|'re| is| are| ends? up| sits?| lies| lie)?(?: (?:lying|sitting|standing))?"
+                    r"(?: (?:right|just|directly))? (?=(?:next to|beside|near|in|inside|into|on|onto|at|to the|behind|in front of)\b)")
+#: "next to the plate on the right": on that side of it (not the table's right side).
+_BESIDE_ON_SIDE = re.compile(r"\b(?:next to|beside|by) (the [a-z]+(?: [a-z]+)?) (?:on|to) (?:the|its) (left|right)(?: side| hand side)?(?: of it)?(?= ,|$| then\b| and\b| with\b)")
+#: "with one hand ... with the other": two arms, the planner's to choose.
+_ONE_AND_OTHER = (re.compile(r" with one (?:hand|arm|gripper)\b"), re.compile(r" with the other arm\b"))
+#: "and the bottle too", "then the red one as well": the step before, for another object.
+_TOO = re.compile(r"^(then |and |and then )?(?:also )?((?:the )?[a-z]+(?: [a-z]+)?|it|them) (?:too|as well|also)$")
+#: "do the same with the spoon (on the right)": the step before, for another object (and side).
+_SAME = re.compile(r"^(then |and |and then )?(?:do|repeat) (?:the same|that|the same thing|it) (?:with|for|to) ((?:the )?[a-z]+(?: [a-z]+)?)"
+                   r"(?: (?:on|to|at) (?:the )?(left|right)(?: side)?(?: of it)?)?$")
 #: "a bit closer to the bottle": next to it.
 _CLOSER = re.compile(r"\b(?:a (?:little |tiny )?bit |a little |slightly )?(?:closer|nearer) to\b")
 _POINTING = re.compile(r"(?: ,)? (?:and )?(?:both |each )?(?:of them )?(?:pointing|facing|oriented|aimed|tips?|handles?)"
@@ -95,7 +110,8 @@ _POINTING = re.compile(r"(?: ,)? (?:and )?(?:both |each )?(?:of them )?(?:pointi
 
 #: Shorthand people type -> the word.
 _SHORTHAND = [(re.compile(r"\b(?:pls|plz|plse)\b"), ""), (re.compile(r"\bw/ ?|\bw (?=the |your |my |both |left |right )"), "with "),
-              (re.compile(r"\bur\b"), "your"), (re.compile(r"\bu\b"), "you"), (re.compile(r"\bthx\b"), "thanks")]
+              (re.compile(r"\bur\b"), "your"), (re.compile(r"\bu\b"), "you"), (re.compile(r"\bthx\b"), "thanks"),
+              (re.compile(r"\bl (?=arm|hand|gripper)\b"), "left "), (re.compile(r"\br (?=arm|hand|gripper)\b"), "right ")]
 #: Vague amounts and distances: the goal has none (a pour is a pour; a nudge is the rules' nudge).
 _AMOUNT = re.compile(r"(?: ,)? (?:just |only |maybe )?(?:like )?(?:a (?:little|tiny|small|wee) (?:bit )?(?:of )?|a bit(?: more)?(?: of)? |"
                      r"some |a splash of |a drop of |a little more |a few centimet(?:er|re)s |about \w+ (?:cm|centimet(?:er|re)s|mm)(?: or so)? |"
@@ -348,13 +364,19 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
         s = _drop(how, s, note, "how")
     s = _sub(_POINTING, "", s, note, "how")
     s = _sub(_AWAY, "forward", s, note, "direction")
+    s = _sub(_TOWARD_YOU, "closer", s, note, "direction")
     s = _sub(_CLOSER, "next to", s, note, "direction")
+    s = _sub(_SO_IT, " ", s, note, "place")
+    s = _sub(_BESIDE_ON_SIDE, r"to the \2 of \1", s, note, "place")
     s = _sub(re.compile(r"\bforward(?: ,)? (to the \w+ region)\b"), r"\1", s, note, "direction")
     s = _sub(re.compile(r"\bto (inside|into|onto)\b"), r"\1", s, note, "place")
     s = _drop(re.compile(r" (?:standing|sitting|lying|upright|up)(?= ,|$)"), s, note, "how")
 
     s = _sub(re.compile(r" ?-> ?"), " ", s, note, "shorthand")
     s = _sub(re.compile(r"\bwith the other(?: one| hand| arm| gripper)?\b"), "with the other arm", s, note, "arm")
+    if all(p.search(s) for p in _ONE_AND_OTHER):
+        for pattern in _ONE_AND_OTHER:
+            s = _drop(pattern, s, note, "how")
     s = _drop(re.compile(r"(?: ,)? while (?:you(?:'re| are)? holding it|it(?:'s| is)? (?:up|held|in the air))(?= ,|$)"), s, note, "how")
     s = _sub(_AMOUNT, " ", s, note, "amount")
     s = _sub(_AMOUNT_TAIL, "", s, note, "amount")
@@ -386,6 +408,8 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
             note("order")
             clause = clause[ordinal.end():]
         clause = _drop(_TRAILING_ORDER, clause, note, "order")
+        if clauses:
+            clause = _again(clause, clauses[-1], objects, note)
         clause = _arm_subject(clause, note, verb)
         for pattern, repl in _WATER_IN:
             clause = _sub(pattern, repl, clause, note, "end state")
@@ -411,6 +435,31 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
     if re.search(r"\bfold", out) or "towel" in objects:  # "fold it in half, towards the far side": the only fold the rules make
         out = _drop(_FOLD_WAY, out, note, "cloth part")
     return out.strip(" ,")
+
+
+def _again(clause: str, before: str, objects: frozenset[str], note: Callable[[str], None]) -> str:
+    """``the bottle too`` / ``do the same with the spoon on the right`` after a step: that step again, for the
+    object named (and on the side named)."""
+    too, same = _TOO.match(clause), _SAME.match(clause)
+    match = too or same
+    if match is None:
+        return clause
+    lead, new = match[1] or "", match[2]
+    if new not in ("it", "them") and not new.startswith("the "):
+        new = "the " + new
+    if not any(w in objects or w == "one" for w in new.split()[1:]) and new not in ("it", "them"):
+        return clause
+    step = before.removeprefix("then ")
+    names = "|".join(sorted((re.escape(w) for w in objects), key=len, reverse=True)) or "(?!)"
+    found = re.search(rf"\bthe (?:[a-z]+ )*?(?:{names}|one)\b|\b(?:it|them)\b", step)
+    if found is None:
+        return clause
+    again = step[: found.start()] + new + step[found.end():]
+    if same is not None and same[3]:
+        other = "left" if same[3] == "right" else "right"
+        again = re.sub(rf"\b{other}\b", same[3], again) if re.search(rf"\b{other}\b", again) else again
+    note("ellipsis")
+    return (lead + again).strip()
 
 
 def _arm_subject(clause: str, note: Callable[[str], None], verb: Callable[[str], str | None]) -> str:

@@ -114,7 +114,8 @@ def normalise(instruction: str) -> str:
     text = _VERB_FORMS.sub(r"\1", text)
     text = re.sub(r"^(?:could|can|would|will) you\s+|^(?:i want|i'd like|i would like) you to\s+|^(?:please\s+)", "", text.strip())
     # A heading names the arm of every step under it (read by agents.rules.discourse).
-    text = re.sub(r"(?:^|(?<=[;.]\s))(?:the\s+)?(left|right|both)\s+(arm|hand|gripper)s?\s*:", r"armheading \1 ,", text)
+    text = re.sub(r"\b([lr])\s+(?=(?:arm|hand|gripper)s?\b)", lambda m: "left " if m[1] == "l" else "right ", text)  # "R arm:"
+    text = re.sub(r"(?:^|(?<=[;.]\s))(?:the\s+)?(left|right|both)(?:\s+(arm|hand|gripper)s?)?\s*:", r"armheading \1 ,", text)
     text = re.sub(r"\b(on|to|at) its (left|right)(?: hand)?(?: side)?\b", r"\1 the \2 of it", text)
     text = re.sub(r"\b(upright|steady|steadily|firmly|securely|safely|upside up)\b", " ", text)
     text = re.sub(r"\b(please|carefully|gently|slowly|now|just|again)\b", " ", text)

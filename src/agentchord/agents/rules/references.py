@@ -52,6 +52,11 @@ def lemma_noun(word: str) -> str:
     return word
 
 
+#: Words for a bowl, and the depth / width of a container they may name when the scene has no bowl.
+BOWL_WORDS = frozenset({"bowl", "basin", "dish"})
+BOWL_DEPTH = (0.3, 1.0)
+
+
 class Context:
     """What the clauses of one instruction share: the scene, the objects named so far, who holds what.
 
@@ -147,7 +152,9 @@ class Context:
             return earlier[-1]
         if len(np.words) > 1 and np.words[-1] in ("back", "down"):  # "put the bottle back" read as one phrase
             np = NounPhrase(words=np.words[:-1], of=np.of)
-        words = [kb.SYNONYMS.get(w, w) for w in np.words if w not in FILLER_WORDS] or list(np.words)
+        # A synonym ("mug" for the cup) only where the scene has nothing the word itself names (a scene may have a mug).
+        named = {w for o in self.scene.objects for w in kb.words(o)}
+        words = [w if w in named else kb.SYNONYMS.get(w, w) for w in np.words if w not in FILLER_WORDS] or list(np.words)
         if words[-1] == "one":
             if self.last_kind is None:
                 # "the blue one" said first: the one object its other words (a colour) name, if just one.
@@ -180,6 +187,10 @@ class Context:
             # The head noun alone may still be unique ("coffee capsule" -> capsule); a colour that
             # does not match is a contradiction, not a modifier to ignore.
             head = [o for o in pool if plain[-1] in kb.words(o)]
+            if not head and plain[-1] in BOWL_WORDS:
+                # "The bowl" for the scene's one bowl-shaped container: open, about as deep as it is wide
+                # (an open cup, not a tall drinking cup or a flat tray).
+                head = [o for o in pool if kb.is_container(o) and BOWL_DEPTH[0] <= o.extent[2] / max(o.extent[:2]) <= BOWL_DEPTH[1]]
             if len(head) == 1 and not set(plain[:-1]) & set(COLOURS):
                 candidates = head
         for word in sizes:
@@ -191,7 +202,8 @@ class Context:
             known = sorted({w for o in pool for w in kb.words(o)} | set(self.objects))
             close = difflib.get_close_matches(plain[-1] if plain else np.text, known, n=2, cutoff=0.6)
             hint = f"; did you mean {' or '.join(map(repr, close))}?" if close else ""
-            raise self.error(np.text, f"names no scene object (the scene has {', '.join(o.name for o in pool)}){hint}")
+            scene_objects = ", ".join(o.name for o in self.scene.objects if o.name not in self.corners) or "no objects"
+            raise self.error(np.text, f"names no scene object (the scene has {scene_objects}){hint}")
         if len(candidates) > 1:
             names = ", ".join(o.name for o in candidates)
             raise self.error(np.text, f"is ambiguous: it could be {names}; name one by colour, size or name")
