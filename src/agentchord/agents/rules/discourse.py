@@ -93,7 +93,17 @@ _TOWARD_YOU = re.compile(r"\b(?:a (?:little |tiny )?bit |a little |slightly )?(?
 _SO_IT = re.compile(r"(?: ,)? so (?:that )?(?:it|they)(?:'s|'re| is| are| ends? up| sits?| lies| lie)?(?: (?:lying|sitting|standing))?"
                     r"(?: (?:right|just|directly))? (?=(?:next to|beside|near|in|inside|into|on|onto|at|to the|behind|in front of)\b)")
 #: "next to the plate on the right": on that side of it (not the table's right side).
-_BESIDE_ON_SIDE = re.compile(r"\b(?:next to|beside|by) (the [a-z]+(?: [a-z]+)?) (?:on|to) (?:the|its) (left|right)(?: side| hand side)?(?: of it)?(?= ,|$| then\b| and\b| with\b)")
+_BESIDE_ON_SIDE = re.compile(r"\b(?:right |just )?(?:next to|beside|by|near|near to|close to) (the [a-z]+(?: [a-z]+)?)(?: ,)? (?:on|to|at) (?:the|its) (left|right)"
+                             r"(?: side| hand side)?(?: of it)?(?= ,|$| then\b| and\b| with\b)")
+#: "the marked circle on the right": a drawn place, its side only describing it.
+_MARKED_ON_SIDE = re.compile(r"\b((?:the )?(?:marked |taped |drawn |painted |target )?(?:circle|area|spot|zone|region|mark|target)) (?:on|to|at) the "
+                             r"(?:left|right)(?: side| half)?(?: of the table)?(?= ,|$| then\b| and\b| with\b)")
+#: "a bit to the left so it's beside the cup": beside it (the way there is not the side: coming from its
+#: right, the bottle ends on the cup's right).
+_SIDE_BESIDE = re.compile(r"\b(?:a (?:little |tiny )?bit |a little |slightly )?(?:over )?to the (left|right)(?: ,)? (?:so )?(?:right |just )?(?:beside|next to|by) "
+                          r"(the [a-z]+(?: [a-z]+)?)(?= ,|$| then\b| and\b| with\b)")
+#: "near to the fork", "close to it": next to it.
+_NEAR_TO = re.compile(r"\b(?:near|close)(?: to)? (?=the |it\b|them\b)")
 #: "with one hand ... with the other": two arms, the planner's to choose.
 _ONE_AND_OTHER = (re.compile(r" with one (?:hand|arm|gripper)\b"), re.compile(r" with the other arm\b"))
 #: "and the bottle too", "then the red one as well": the step before, for another object.
@@ -150,6 +160,9 @@ _ARM_ELLIPSIS = [
 _ACROSS = re.compile(r"\b(?:from )?(?:the )?(?:left|right)(?: half| side| edge| corners?)?(?: of it)? (?:to|onto|over|over to|on top of|towards?) "
                      r"(?:the )?(?:right|left)(?: half| side| edge| corners?)?\b|\bside to side\b|\blengthwise\b|\bsideways\b|\bleft-right\b")
 #: Where a pour happens, said beside it: the goal is the pour (holding the cup is said by "hold").
+#: A table setting's manner said after it: ", like a proper place setting", "like they do at a restaurant".
+_LIKE_A_SETTING = re.compile(r"(?: ,)? (?:just )?like (?:for (?:dinner|lunch|breakfast|a meal)|(?:a |an )?(?:proper |normal |usual |formal |nice )?"
+                             r"(?:place|table|dinner) setting|(?:they do |you'd see |you see |you would see )?(?:at|in) a restaurant)(?= ,|$)")
 _IN_THE_AIR = re.compile(r"(?: ,)? (?:in (?:the )?(?:mid-? ?air|air)|up in the air|off the table|above the table|over the table)\b")
 
 
@@ -177,6 +190,11 @@ _TALK_SENTENCES = [re.compile(p) for p in (
     r"(?:then )?(?:pull|move|bring|take) (?:the |your )?(?:left|right|both) arms? (?:back|away|home)(?: out of the way)?",
     r"(?:the |my )?[a-z ]+ (?:is|are) (?:kind of |sort of |a bit |rather |quite )?(?:in the way|far away|too far(?: away)?|too close)",
     r"(?:just )?(?:next |close )?to it",
+    r"(?:the )?(?:cup|bottle|plate|tray|towel|block|capsule)(?: is)? (?:right )?(?:there|here|over there|in front of you)",
+    r"(?:and )?(?:both|they|them|each|all)(?: of them)? (?:should |must |need to )?(?:point|face|pointing|facing|be pointing|be facing)"
+    r" (?:forwards?|away(?: from (?:me|you))?|ahead|up|the same way)",
+    r"(?:just )?like (?:for (?:dinner|lunch|breakfast|a meal)|(?:a |an )?(?:proper |normal |usual |formal |nice )?(?:place|table|dinner) setting|"
+    r"(?:they do |you'd see |you see |you would see )?(?:at|in) a restaurant)",
 )]
 #: "bottle standing back where it was", "the cup back in the same spot": put back.
 _BACK_AS_IT_WAS = re.compile(r"^(?:and )?(?:the )?(\w+)(?: is| should be| to be)?(?: standing| sitting| upright)*(?: back)?(?: upright)?"
@@ -204,16 +222,18 @@ _LAST = [
     (re.compile(r"\bgive (?:some )?water (?:from (?:the )?(\w+) )?(?=into|in|to)\b"), r"pour water from the \1 ", "verb"),
     (re.compile(r"\b(hold|lift|take|pick) ([^,]+?) , (?:then )?pour(?= with| ,|$)"), r"\1 \2 , pour into it", "ellipsis"),
     (re.compile(r"^(?:set|lay) (?:up )?the table(?: properly)?(?: for me)? , "), "", "talk"),
-    (re.compile(r"(?: ,)? with the folded edge (?:nearest|closest|near|towards?)(?: to)? (?:me|you)"), "", "cloth part"),
+    (re.compile(r"(?: ,)? with the folded edge (?:on the side |at the side |on the edge )?(?:nearest|closest|near|towards?)(?: to)? (?:me|you)"),
+     "", "cloth part"),
     (re.compile(r"(?: ,)? lying on the (?:top|far) half(?: of where it is(?: now)?)?"), "", "cloth part"),
     (re.compile(r" (?:standing up|sitting up|standing|sitting|lying|upright)(?= ,|$)"), "", "how"),
     (re.compile(r" while it(?:'s| is)?(?= ,|$)"), "", "how"),
     (re.compile(r"\b(fill|lift|hold|pick|take) (the \w+|it|them) up\b"), r"\1 \2", "particle"),
 ]
 #: Which way a fold goes, said of the only fold the rules make (near edge onto far edge).
-_FOLD_WAY = re.compile(r"(?:^|(?: ,)? )(?:towards? |to )(?:the )?(?:top|far|back) (?:side|edge|end|half)(?= ,|$)|(?: ,)? forward(?= ,|$)")
+_FOLD_WAY = re.compile(r"(?:^|(?: ,)? )(?:towards? |to )(?:the )?(?:top|far|back) (?:side|edge|end|half)(?= ,|$)|(?: ,)? forward(?= ,|$)|"
+                       r"(?: ,)? (?:from )?(?:near|front|bottom)(?: edge| side)?(?: to| onto| over)? (?:far|back|top)(?: edge| side)?(?= ,|$)")
 #: "the capsule should end up in the tray", "the blue one goes in the cup", "the block to end up inside the target".
-_SHOULD_BE = re.compile(r"^(?:and )?((?:the |my )?[a-z]+(?: (?!should|must|needs?|has|is|will|to|shall)[a-z]+)?) "
+_SHOULD_BE = re.compile(r"^(?:and )?((?:the |my )?[a-z]+(?: (?!should|must|needs?|has|is|will|to|shall)[a-z]+)?(?: and (?:the |my )?[a-z]+)?) "
                         r"(?:should|must|needs? to|has to|is to|will|to|shall)? ?"
                         r"(?:end up|be|go|goes|sit|sits|stay|get|gets|belong|belongs|land|lands)(?: back)? "
                         r"(in|inside|into|on|onto|at|next to|beside|on top of) ")
@@ -279,7 +299,10 @@ def read_sentences(sentences: list[str], objects: frozenset[str], note: Callable
     names the arm of every step after it."""
     out = []
     arm: str | None = None
-    for sentence in sentences:
+    for k, sentence in enumerate(sentences):
+        if k < len(sentences) - 1 and _TITLE_SENTENCE.fullmatch(sentence.strip()):
+            note("talk")  # "Can you set the table? The fork ...": the sentences after it say how
+            continue
         alone = _ARM_ALONE.fullmatch(sentence.strip())
         if alone is not None:
             arm = alone[1]
@@ -287,10 +310,24 @@ def read_sentences(sentences: list[str], objects: frozenset[str], note: Callable
             continue
         if arm is not None and not re.match(r"^armheading ", sentence) and not re.search(r"\b(?:left|right|both) (?:arm|hand|gripper)", sentence):
             sentence = f"armheading {arm} , {sentence}"
-        out.append(read_sentence(sentence, objects, note, verb))
+        read = read_sentence(sentence, objects, note, verb)
+        if out and read == "hand it over" and (placed := _PLACE_STEP.match(out[-1])) is not None and placed[1] != "it":
+            obj = placed[1] if placed[1].startswith("the ") else f"the {placed[1]}"
+            out[-1] = f"hand {obj} over , then {out[-1]}"  # the sentence before, done by a hand-over
+            note("order")
+            continue
+        out.append(read)
     return out
 
 
+#: A hand-over said as the way of doing a step: "use a handover", "do it via handover".
+_BY_HANDOVER = re.compile(r"^(?:and )?(?:then )?(?:use|using|do it (?:via|with|by|using)|via|with|by|through) (?:a )?handover(?: please)?$")
+#: A hand-over with no place of its own ("hand it across", "hand the block over").
+_HANDOVER_ALONE = re.compile(r"(?:and )?(?:hand|pass|give) (it|them|the [a-z]+(?: [a-z]+)?) over")  # no "then": the way, not a next step
+#: A step that takes an object somewhere ("get the block onto the target").
+_PLACE_STEP = re.compile(r"(?:(?:get|put|place|move|bring|take|carry|set) )?((?:the )?[a-z]+(?: [a-z]+)?|it) (?:over )?(?:onto|on|to|into|in|at) ")
+#: A sentence that names the job the sentences after it spell out.
+_TITLE_SENTENCE = re.compile(r"(?:please )?(?:set|lay) (?:up )?the table(?: properly)?(?: for me)?(?: please)?")
 #: Verbs that start a step joined by "and" ("pick up the bottle and pour ...").
 _VERB_STARTS = ("pick", "take", "grab", "grasp", "hold", "lift", "put", "place", "set", "lay", "stand", "drop", "pour", "fill",
                 "empty", "hand", "pass", "give", "move", "carry", "bring", "push", "slide", "fold", "stack", "insert")
@@ -330,7 +367,7 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
         note("talk")
         return ""
     if not re.search(r"\b(?:pour|fill|empt)", s):  # for a pour, both arms say who holds the cup; else how it is carried
-        s = _drop(re.compile(r"(?:^|(?: ,)? )(?:use|using|with) (?:both|two|the two) (?:of your )?(?:hands?|arms?|grippers?)"
+        s = _drop(re.compile(r"(?:^|(?: ,)? )(?:(?:use|using|with) )?(?:both|two|the two) (?:of your )?(?:hands?|arms?|grippers?)"
                              r"(?: for (?:that|this|it))?(?: at the same time)?$"), s, note, "how")
     s = _drop(_LEFT_AS_IS_INSIDE, s, note, "left as is")
     s = _drop(_END_STATE, s, note, "end state")
@@ -363,11 +400,14 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
     for how in _HOW:
         s = _drop(how, s, note, "how")
     s = _sub(_POINTING, "", s, note, "how")
+    s = _drop(_LIKE_A_SETTING, s, note, "how")
     s = _sub(_AWAY, "forward", s, note, "direction")
     s = _sub(_TOWARD_YOU, "closer", s, note, "direction")
     s = _sub(_CLOSER, "next to", s, note, "direction")
     s = _sub(_SO_IT, " ", s, note, "place")
     s = _sub(_BESIDE_ON_SIDE, r"to the \2 of \1", s, note, "place")
+    s = _sub(_SIDE_BESIDE, r"next to \2", s, note, "place")
+    s = _sub(_NEAR_TO, "next to ", s, note, "place")
     s = _sub(re.compile(r"\bforward(?: ,)? (to the \w+ region)\b"), r"\1", s, note, "direction")
     s = _sub(re.compile(r"\bto (inside|into|onto)\b"), r"\1", s, note, "place")
     s = _drop(re.compile(r" (?:standing|sitting|lying|upright|up)(?= ,|$)"), s, note, "how")
@@ -378,9 +418,12 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
         for pattern in _ONE_AND_OTHER:
             s = _drop(pattern, s, note, "how")
     s = _drop(re.compile(r"(?: ,)? while (?:you(?:'re| are)? holding it|it(?:'s| is)? (?:up|held|in the air))(?= ,|$)"), s, note, "how")
+    s = _sub(re.compile(r"\bpour (?:me |us |him |her )?(?:a|some) (glass|cup|mug) of water\b"), r"pour water into the \1", s, note, "verb")
     s = _sub(_AMOUNT, " ", s, note, "amount")
     s = _sub(_AMOUNT_TAIL, "", s, note, "amount")
     s = _sub(_IN_THE_AIR, "", s, note, "how")
+    s = _sub(re.compile(r"\b(hand|pass|give) (it|them|the [a-z]+(?: [a-z]+)?) (?:across|over)(?= ,|$)"), r"\1 \2 over", s, note, "particle")
+    s = _sub(_MARKED_ON_SIDE, r"\1", s, note, "place")
     for pattern, repl in _PARTICLES:
         s = _sub(pattern, repl, s, note, "particle")
     for pattern, repl in _ARM_ELLIPSIS:
@@ -408,6 +451,7 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
             note("order")
             clause = clause[ordinal.end():]
         clause = _drop(_TRAILING_ORDER, clause, note, "order")
+        clause = _sub(_BY_HANDOVER, "hand it over", clause, note, "order")
         if clauses:
             clause = _again(clause, clauses[-1], objects, note)
         clause = _arm_subject(clause, note, verb)
@@ -428,6 +472,7 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
             steps = re.split(r" (then|and then|and(?= (?:" + "|".join(_VERB_STARTS) + r")\b)) ", clause)
             clause = "".join(f"{part} {with_arm}" if k % 2 == 0 else f" {part} " for k, part in enumerate(steps))
         clauses.append(clause)
+    clauses = _handover_first(clauses, objects, note)
     out = " , ".join(clauses).strip(" ,")
     out = _sub(_EACH_IN_ORDER, _each_in_order, out, note, "order")
     for pattern, repl, name in _LAST:
@@ -435,6 +480,21 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
     if re.search(r"\bfold", out) or "towel" in objects:  # "fold it in half, towards the far side": the only fold the rules make
         out = _drop(_FOLD_WAY, out, note, "cloth part")
     return out.strip(" ,")
+
+
+def _handover_first(clauses: list[str], objects: frozenset[str], note: Callable[[str], None]) -> list[str]:
+    """"get the block onto the target , hand it across": the hand-over is how it gets there, so it comes first."""
+    out = list(clauses)
+    for k in range(1, len(out)):
+        handed = _HANDOVER_ALONE.fullmatch(out[k])
+        placed = _PLACE_STEP.match(out[k - 1].removeprefix("then "))
+        if handed is None or placed is None:
+            continue
+        obj = placed[1] if handed[1] in ("it", "them") else handed[1]
+        obj = obj if obj in ("it", "them") or obj.startswith("the ") else f"the {obj}"
+        out[k - 1], out[k] = f"hand {obj} over", "then " + out[k - 1].removeprefix("then ")
+        note("order")
+    return out
 
 
 def _again(clause: str, before: str, objects: frozenset[str], note: Callable[[str], None]) -> str:

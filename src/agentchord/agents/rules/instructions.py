@@ -39,6 +39,7 @@ from agentchord.agents.rules.references import (
     CLOTH_SIDE_WORDS,
     FILLER_WORDS,
     GROUP_WORDS,
+    MARK_WORDS,
     POSITION_WORDS,
     SIZE_WORDS,
     Context,
@@ -229,7 +230,7 @@ def _place_at(names: list[str], where: Where | None, c: Clause, ctx: Context) ->
             np = np.of
         support = ctx.resolve(np, exclude=tuple(names))
         return [On(obj=n, support=support, arm=arms[n]) for n in names]
-    named = ctx.region(np) if set(np.words) & {"region", "area", "zone", "spot", "position"} else None
+    named = ctx.region(np) if set(np.words) & {"region", "area", "zone", "spot", "position", *MARK_WORDS} else None
     if named is not None:  # "the forward position": the scene's region of that name, not a part of the table
         return [Placed(obj=n, region=named, arm=arms[n]) for n in names]
     table = ctx.table_place(np)

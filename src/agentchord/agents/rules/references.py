@@ -52,6 +52,8 @@ def lemma_noun(word: str) -> str:
     return word
 
 
+#: Words for a place drawn or taped on the table (a scene's region).
+MARK_WORDS = frozenset({"marked", "mark", "circle", "circled", "taped", "drawn", "outlined", "painted"})
 #: Words for a bowl, and the depth / width of a container they may name when the scene has no bowl.
 BOWL_WORDS = frozenset({"bowl", "basin", "dish"})
 BOWL_DEPTH = (0.3, 1.0)
@@ -230,6 +232,12 @@ class Context:
         words = [w for w in np.words if w not in ("region", "area", "zone", "spot", "position", "place")]
         if not words:
             return None
+        if len(self.scene.regions) == 1 and set(words) & MARK_WORDS:
+            # "the marked area", "the circle": a place drawn on the table, and the scene has one.
+            region = self.scene.regions[0]
+            vocabulary = set(region.name.lower().replace("_", " ").split()) | set(region.description.lower().split())
+            if all(w in MARK_WORDS or w in vocabulary for w in words):
+                return region.name
         for region in self.scene.regions:
             vocabulary = set(region.name.lower().replace("_", " ").split()) | set(region.description.lower().split())
             if region.name.lower() in words or (all(w in vocabulary for w in words) and set(np.words) & {"region", "area", "zone"}):
