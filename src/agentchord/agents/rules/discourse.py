@@ -93,14 +93,16 @@ _TOWARD_YOU = re.compile(r"\b(?:a (?:little |tiny )?bit |a little |slightly )?(?
 _SO_IT = re.compile(r"(?: ,)? so (?:that )?(?:it|they)(?:'s|'re| is| are| ends? up| sits?| lies| lie)?(?: (?:lying|sitting|standing))?"
                     r"(?: (?:right|just|directly))? (?=(?:next to|beside|near|in|inside|into|on|onto|at|to the|behind|in front of)\b)")
 #: "next to the plate on the right": on that side of it (not the table's right side).
-_BESIDE_ON_SIDE = re.compile(r"\b(?:right |just )?(?:next to|beside|by|near|near to|close to) (the [a-z]+(?: [a-z]+)?)(?: ,)? (?:on|to|at) (?:the|its) (left|right)"
+_BESIDE_ON_SIDE = re.compile(r"\b(?:right |just )?(?:next to|beside|by|near|near to|close to) (the [a-z]+(?: [a-z]+)?)(?: ,)? "
+                             r"(?:on|to|at) (?:the|its) (left|right)"
                              r"(?: side| hand side)?(?: of it)?(?= ,|$| then\b| and\b| with\b)")
 #: "the marked circle on the right": a drawn place, its side only describing it.
 _MARKED_ON_SIDE = re.compile(r"\b((?:the )?(?:marked |taped |drawn |painted |target )?(?:circle|area|spot|zone|region|mark|target)) (?:on|to|at) the "
                              r"(?:left|right)(?: side| half)?(?: of the table)?(?= ,|$| then\b| and\b| with\b)")
 #: "a bit to the left so it's beside the cup": beside it (the way there is not the side: coming from its
 #: right, the bottle ends on the cup's right).
-_SIDE_BESIDE = re.compile(r"\b(?:a (?:little |tiny )?bit |a little |slightly )?(?:over )?to the (left|right)(?: ,)? (?:so )?(?:right |just )?(?:beside|next to|by) "
+_SIDE_BESIDE = re.compile(r"\b(?:a (?:little |tiny )?bit |a little |slightly )?(?:over )?to the (left|right)(?: ,)? (?:so )?(?:right |just )?"
+                          r"(?:beside|next to|by) "
                           r"(the [a-z]+(?: [a-z]+)?)(?= ,|$| then\b| and\b| with\b)")
 #: "near to the fork", "close to it": next to it.
 _NEAR_TO = re.compile(r"\b(?:near|close)(?: to)? (?=the |it\b|them\b)")
@@ -197,9 +199,11 @@ _TALK_SENTENCES = [re.compile(p) for p in (
     r"(?:they do |you'd see |you see |you would see )?(?:at|in) a restaurant)",
 )]
 #: "bottle standing back where it was", "the cup back in the same spot": put back.
-_BACK_AS_IT_WAS = re.compile(r"^(?:and )?(?:the )?(\w+)(?: is| should be| to be)?(?: standing| sitting| upright)*(?: back)?(?: upright)?"
-                             r" (?:where it was|where it started|where you found it|in the same (?:spot|place|position)|in its (?:old )?place|"
-                             r"back where it (?:was|started))$")
+_BACK_AS_IT_WAS = re.compile(r"^(?:and )?(?:the )?(\w+)(?: and (?:the )?(\w+))?(?: both)?(?: is| are| should be| to be)?(?: both)?"
+                             r"(?: standing| sitting| upright| stood)*(?: back)?(?: upright)?(?: again)?"
+                             r" (?:about |roughly |more or less |right |exactly |just )?(?:where (?:it|they) (?:was|were|started|stood|is|are)"
+                             r"(?: now| before| at the start)?|where you found (?:it|them)|in the same (?:spot|place|position)|"
+                             r"in (?:its|their) (?:old |original )?(?:place|places|spot|spots)|back where (?:it|they) (?:was|were|started))$")
 #: "(pick up both blocks and) put them in the cup, red first then blue": each, in the order said.
 _EACH_IN_ORDER = re.compile(r"^(?:(?:pick up|take|grab|lift) (?:both|the two|the) (\w+?)s and (put|place|drop|set|move) them|"
                             r"(put|place|drop|set|move) (?:both|the two|the) (\w+?)s) (.+?) , (?:the )?(\w+)(?: one)? first"
@@ -207,7 +211,8 @@ _EACH_IN_ORDER = re.compile(r"^(?:(?:pick up|take|grab|lift) (?:both|the two|the
 
 
 def _put_back(m: re.Match[str]) -> str:
-    return "put it back" if m[1] in ("it", "they", "them") else f"put the {m[1]} back"
+    first = "put it back" if m[1] in ("it", "they", "them") else f"put the {m[1]} back"
+    return first if m[2] is None else f"{first} , put the {m[2]} back"
 
 
 def _each_in_order(m: re.Match[str]) -> str:
@@ -326,6 +331,10 @@ _BY_HANDOVER = re.compile(r"^(?:and )?(?:then )?(?:use|using|do it (?:via|with|b
 _HANDOVER_ALONE = re.compile(r"(?:and )?(?:hand|pass|give) (it|them|the [a-z]+(?: [a-z]+)?) over")  # no "then": the way, not a next step
 #: A step that takes an object somewhere ("get the block onto the target").
 _PLACE_STEP = re.compile(r"(?:(?:get|put|place|move|bring|take|carry|set) )?((?:the )?[a-z]+(?: [a-z]+)?|it) (?:over )?(?:onto|on|to|into|in|at) ")
+#: An end state said with a participle: "the cup moved over to the right", "the capsule put in the tray".
+_PARTICIPLE = re.compile(r"^(?:and )?((?:the )?[a-z]+(?: [a-z]+)?) (moved|put|placed|pushed|slid|shifted|set|laid|stacked|dropped) (?!back$)(.+)$")
+#: "leave the bottle standing up afterwards": put it back.
+_LEAVE_STANDING = re.compile(r"^(?:and )?(?:then )?leave (the \w+|it) (?:standing|upright|standing up|up)(?: (?:afterwards|after|after that|at the end))?$")
 #: A sentence that names the job the sentences after it spell out.
 _TITLE_SENTENCE = re.compile(r"(?:please )?(?:set|lay) (?:up )?the table(?: properly)?(?: for me)?(?: please)?")
 #: Verbs that start a step joined by "and" ("pick up the bottle and pour ...").
@@ -458,6 +467,13 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
         for pattern, repl in _WATER_IN:
             clause = _sub(pattern, repl, clause, note, "end state")
         clause = _sub(_BACK_AS_IT_WAS, _put_back, clause, note, "end state")
+        clause = _sub(_LEAVE_STANDING, r"put \1 back", clause, note, "end state")
+        participle = _PARTICIPLE.match(clause)
+        if (participle is not None and verb(participle[2]) is not None
+                and (participle[1].startswith("the ") or participle[1].split()[-1] in objects)):
+            subject = participle[1] if participle[1].startswith("the ") else f"the {participle[1]}"
+            clause = f"{verb(participle[2])} {subject} {participle[3].removeprefix('over ')}"
+            note("end state")
         clause = _sub(_SHOULD_BE, r"put \1 \2 ", clause, note, "end state")
         clause = _sub(_BOTH_BACK, "put them back", clause, note, "end state")
         if _TITLE.fullmatch(clause):
