@@ -302,7 +302,7 @@ def read_sentences(sentences: list[str], objects: frozenset[str], note: Callable
                    verb: Callable[[str], str | None]) -> list[str]:
     """Each sentence read (:func:`read_sentence`); a sentence that only names an arm ("use the right arm only")
     names the arm of every step after it."""
-    out = []
+    out: list[str] = []
     arm: str | None = None
     for k, sentence in enumerate(sentences):
         if k < len(sentences) - 1 and _TITLE_SENTENCE.fullmatch(sentence.strip()):
