@@ -1,9 +1,9 @@
-"""The blind evaluation set (issue 59, tests/data/language/blind/): rates that must not fall, and never a wrong goal.
+"""The blind evaluation set (tests/data/language/blind/): rates that must not fall, and never a wrong goal.
 
-Written by four helpers who saw only the scenes' descriptions, labelled by a fifth. Writers A-C were read for
-their kinds of failure while the rules grew (73 % planned to the goal they mean); writer D was held out and
-measured once (29 of 60, 48 %, with 3 wrong goals; the mechanisms behind the wrong ones were then fixed, so D
-is no longer blind: the next round needs a new held-out writer). Grounding only (the goal), a few seconds.
+Written by helpers who saw only the scenes' descriptions, labelled by another. Writers A-D are read for their
+kinds of failure while the rules grow (A-C 122 of 150, D 44 of 60 planned to the goal they mean); writer E is
+the held-out part, measured once at the end (benchmarks/bench_language.py --part blind-final), not here.
+Grounding only (the goal), a few seconds.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from agentchord.sim.world import SimWorld
 
 BLIND = Path(__file__).parent / "data" / "language" / "blind"
 #: Measured floors (right / all).
-FLOOR = {"ABC": 0.72, "D": 0.48}
+FLOOR = {"ABC": 0.80, "D": 0.72}
 
 
 @cache
@@ -32,8 +32,8 @@ def scene(task: str) -> Scene:
 
 
 def test_the_blind_set_is_large_and_labelled():
-    entries = corpus.load_blind(BLIND, "ABCD")
-    assert len(entries) >= 150 and len({e["id"] for e in entries}) == len(entries)
+    entries = corpus.load_blind(BLIND, "ABCDE")
+    assert len(entries) >= 270 and len({e["id"] for e in entries}) == len(entries)
     assert all("goal" in e or e.get("expect") == "refused" for e in entries)
 
 
