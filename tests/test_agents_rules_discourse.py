@@ -70,6 +70,11 @@ SAME = [
      ["pour water from the bottle into the cup and leave the bottle upright afterwards"]),
     ("blocks_and_cup", "put the red block into the cup",
      ["put the red block into the bowl"]),  # no bowl: the scene's open, bowl-shaped cup
+    # Steps said without their verb; two end states joined by "and".
+    ("blocks_and_cup", "put the blue block into the cup , put the red block on the right of the cup",
+     ["blue into cup, red beside cup on the right"]),
+    ("single_arm_pour_water", "pour water from the bottle into the cup, put the bottle back",
+     ["in the end i need some water in the cup and the bottle standing about where it is now"]),
 ]
 
 

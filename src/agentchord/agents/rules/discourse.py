@@ -93,7 +93,7 @@ _TOWARD_YOU = re.compile(r"\b(?:a (?:little |tiny )?bit |a little |slightly )?(?
 _SO_IT = re.compile(r"(?: ,)? so (?:that )?(?:it|they)(?:'s|'re| is| are| ends? up| sits?| lies| lie)?(?: (?:lying|sitting|standing))?"
                     r"(?: (?:right|just|directly))? (?=(?:next to|beside|near|in|inside|into|on|onto|at|to the|behind|in front of)\b)")
 #: "next to the plate on the right": on that side of it (not the table's right side).
-_BESIDE_ON_SIDE = re.compile(r"\b(?:right |just )?(?:next to|beside|by|near|near to|close to) (the [a-z]+(?: [a-z]+)?)(?: ,)? "
+_BESIDE_ON_SIDE = re.compile(r"\b(?:right |just )?(?:next to|beside|by|near|near to|close to) ((?:the )?[a-z]+(?: [a-z]+)?)(?: ,)? "
                              r"(?:on|to|at) (?:the|its) (left|right)"
                              r"(?: side| hand side)?(?: of it)?(?= ,|$| then\b| and\b| with\b)")
 #: "the marked circle on the right": a drawn place, its side only describing it.
@@ -170,12 +170,13 @@ _IN_THE_AIR = re.compile(r"(?: ,)? (?:in (?:the )?(?:mid-? ?air|air)|up in the a
 
 #: Frames that say "the end state is": dropped, the state that follows is read as usual.
 _END_STATE = re.compile(r"^(?:(?:the )?end result|result|the goal|goal|in the end|at the end|by the end|when you're done|"
-                        r"what i(?:'d| would) like is|what i want is|i (?:just |really )?(?:want|need|would like|'d like)|"
-                        r"want|i'd like)(?: ,| :)? (?=the |a |an |there |both |my |water )")
+                        r"what i(?:'d| would) like (?:in the end |at the end )?is|what i want (?:in the end |at the end )?is|"
+                        r"(?:at the end |in the end )?i (?:just |really )?(?:want|need|would like|'d like)|"
+                        r"want|i'd like)(?: ,| :)? (?=the |a |an |there |both |my |water |some water )")
 #: "there to be water in the cup", "the cup with water in it", "cup has water in it": a pour into the cup.
 _WATER_IN = [
     (re.compile(r"^(?:there (?:to be|is|should be) )?(?:some )?water in (?:the |my )?(\w+)(?: (?:at the end|in the end))?$"), r"pour water into the \1"),
-    (re.compile(r"^(?:the |my )?(\w+) (?:with|has|should have|to have|having|ends up with|to end up with) (?:some )?water in it"
+    (re.compile(r"^(?:the |my )?(\w+(?: \w+)?) (?:with|has|should have|to have|having|ends up with|to end up with) (?:some )?water in it"
                 r"(?: (?:at the end|in the end))?$"), r"pour water into the \1"),
 ]
 #: Whole sentences or clauses that are talk though they name things: permission, questions about the ask, remarks.
@@ -335,6 +336,9 @@ _PLACE_STEP = re.compile(r"(?:(?:get|put|place|move|bring|take|carry|set) )?((?:
 _PARTICIPLE = re.compile(r"^(?:and )?((?:the )?[a-z]+(?: [a-z]+)?) (moved|put|placed|pushed|slid|shifted|set|laid|stacked|dropped) (?!back$)(.+)$")
 #: "leave the bottle standing up afterwards": put it back.
 _LEAVE_STANDING = re.compile(r"^(?:and )?(?:then )?leave (the \w+|it) (?:standing|upright|standing up|up)(?: (?:afterwards|after|after that|at the end))?$")
+#: A step said without its verb: "red into cup", "blue next to the cup on the right".
+_VERBLESS = re.compile(r"^(?:and )?(then )?((?:the )?[a-z]+(?: one)?) "
+                       r"(into|in|onto|on top of|next to|beside|to the (?:left|right) of|behind|in front of) (.+)$")
 #: A sentence that names the job the sentences after it spell out.
 _TITLE_SENTENCE = re.compile(r"(?:please )?(?:set|lay) (?:up )?the table(?: properly)?(?: for me)?(?: please)?")
 #: Verbs that start a step joined by "and" ("pick up the bottle and pour ...").
@@ -379,7 +383,10 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
         s = _drop(re.compile(r"(?:^|(?: ,)? )(?:(?:use|using|with) )?(?:both|two|the two) (?:of your )?(?:hands?|arms?|grippers?)"
                              r"(?: for (?:that|this|it))?(?: at the same time)?$"), s, note, "how")
     s = _drop(_LEFT_AS_IS_INSIDE, s, note, "left as is")
-    s = _drop(_END_STATE, s, note, "end state")
+    stated = _drop(_END_STATE, s, note, "end state")
+    if stated != s:  # "I want water in the cup and the bottle where it was": two end states
+        stated = re.sub(r" and (?=(?:the|my|both) )", " , ", stated)
+    s = stated
     s = _sub(re.compile(r"\bthe whole thing\b"), "it", s, note, "pronoun")
     s = _drop(re.compile(r"(?: ,)? (?:and )?(?:let go|release it|release them|go)$"), s, note, "talk")
     for pattern, repl in _HANDLES:
@@ -468,6 +475,11 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
             clause = _sub(pattern, repl, clause, note, "end state")
         clause = _sub(_BACK_AS_IT_WAS, _put_back, clause, note, "end state")
         clause = _sub(_LEAVE_STANDING, r"put \1 back", clause, note, "end state")
+        verbless = _VERBLESS.match(clause)
+        if verbless is not None and verb(verbless[2].split()[-1]) is None and verbless[2].split()[-1] not in ("it", "them", "they"):
+            thing = verbless[2] if verbless[2].startswith("the ") else f"the {verbless[2]}"
+            clause = f"{verbless[1] or ''}put {thing} {verbless[3]} {verbless[4]}"
+            note("verb")
         participle = _PARTICIPLE.match(clause)
         if (participle is not None and verb(participle[2]) is not None
                 and (participle[1].startswith("the ") or participle[1].split()[-1] in objects)):
