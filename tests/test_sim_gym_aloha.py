@@ -151,6 +151,7 @@ def test_a_gym_aloha_task_is_not_served_over_the_world_protocol_which_cannot_car
     ["run", "gym_aloha_insertion", "--perception", "rgbd"],
     ["demo", "--task", "gym_aloha_insertion", "--perception", "rgbd"],
     ["record", "gym_aloha_transfer_cube", "--out", "ds"],
+    ["run", "gym_aloha_transfer_cube", "--rerun", "x.rrd"],  # it crashed the process (a segfault) in its GL context
 ])
 def test_rendering_its_cameras_is_refused_with_a_reason_not_a_crash(args, tmp_path, monkeypatch):
     from click.testing import CliRunner
@@ -160,3 +161,14 @@ def test_rendering_its_cameras_is_refused_with_a_reason_not_a_crash(args, tmp_pa
     monkeypatch.chdir(tmp_path)
     result = CliRunner().invoke(main, args)
     assert result.exit_code == 2 and "cannot render yet" in result.output, result.output
+
+
+@pytest.mark.parametrize("kwargs", [{"obs_type": "pixels_state"}, {"render_mode": "rgb_array"}])
+def test_its_gymnasium_environment_refuses_images_at_make_not_with_a_crash_at_reset(kwargs):
+    import gymnasium
+
+    import agentchord.gym  # noqa: F401 -- registers the ids
+
+    with pytest.raises(ValueError, match="cannot be rendered here yet"):
+        gymnasium.make("agentchord/GymAlohaTransferCube-v0", **kwargs)
+    assert gymnasium.make("agentchord/GymAlohaTransferCube-v0").reset(seed=0)[0]["agent_pos"].shape == (14,)

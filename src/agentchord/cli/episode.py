@@ -97,8 +97,8 @@ def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, inst
     check_graph_source(task, "TASK", graph_path, instruction, goal_path)
     if world is not None:
         check_served(task, "--world")
-    if video_path is not None or perception == "rgbd":
-        check_rendered(task, "--video" if video_path is not None else "--perception rgbd")
+    if video_path is not None or perception == "rgbd" or rerun_path is not None:
+        check_rendered(task, "--video" if video_path is not None else "--rerun" if rerun_path is not None else "--perception rgbd")
     if world is not None and video_path is not None:
         raise click.UsageError("--video renders the simulator in this process: it cannot be used with --world")
     if world is not None and rerun_path is not None:

@@ -88,6 +88,10 @@ class AgentChordEnv(gym.Env):
             raise ValueError(f"cameras: expected a tuple of camera names, e.g. ('top',), got {cameras!r}")
         if disturb is not None and (not isinstance(disturb, str) or not disturb.strip()):
             raise ValueError(f"disturb: expected None, a protocol ('real', 'stress') or kinds ('drop,pull'), got {disturb!r}")
+        if (obs_type == "pixels_state" or render_mode is not None) and hasattr(SIM_TASKS[task], "open_world"):
+            # Its dm_control physics keeps its own GL context: rendering it through ours crashes the process.
+            raise ValueError(f"{task} runs in gym-aloha's own physics, whose cameras cannot be rendered here yet: "
+                             "use obs_type='state' and render_mode=None (or gym-aloha's own environment for images)")
         self.task = task
         self.disturbances = disturbance_setting(disturb, window)
         self.obs_type = obs_type

@@ -160,7 +160,7 @@ def read_marker(world, obj: str) -> DisturbanceMarker | None:
         world: The simulated world (``model``, ``data``, ``object_pose``, ``object_spec``).
         obj: One of its objects.
     """
-    wrench = world.data.xfrc_applied[world.model.body(obj).id]
+    wrench = world.data.xfrc_applied[world.object_body_id(obj)]
     force, torque = wrench[:3], wrench[3:]
     if float(np.abs(wrench).max()) < _EPS:
         return None

@@ -212,6 +212,13 @@ class SimWorld:
         """Names of the scene's objects."""
         return list(self._object_body)
 
+    def object_body_id(self, name: str) -> int:
+        """The MuJoCo body id of an object (its body may be named otherwise: gym-aloha's ``box`` is our ``cube``)."""
+        try:
+            return self._object_body[name]
+        except KeyError:
+            raise UnknownObjectError(f"no object {name!r} in the scene (objects: {', '.join(self._object_body)})") from None
+
     def object_spec(self, name: str):
         """The object's specification (shape, size, mass)."""
         try:
