@@ -85,7 +85,7 @@ _TRAILING_ORDER = re.compile(r" (?:first|afterwards|after that|after it|after th
 #: Direction phrases that mean "away from the robot".
 _AWAY = re.compile(r"\b(?:a (?:little |tiny )?bit |a little |slightly )?(?:further|farther)(?: away)?(?: back)?(?: from (?:me|you|the robot))?"
                    r"(?: than (?:it is|it does|it was)(?: now)?)?\b|\baway from (?:me|you|the robot)\b|\btowards? the (?:back|far side|far end)\b|"
-                   r"\bto the back\b")
+                   r"\bto the back\b(?! of the table| edge| of the)")
 #: "a little closer to you", "towards the robot": the robot's side of the table.
 _TOWARD_YOU = re.compile(r"\b(?:a (?:little |tiny )?bit |a little |slightly )?(?:closer|nearer) (?:to|towards?) (?:you|me|the robot|yourself)\b|"
                          r"\btowards? (?:you|me|the robot|yourself)\b")
@@ -493,6 +493,10 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
             continue
         if is_talk(clause.removeprefix("then "), objects):
             note("talk")
+            continue
+        if heading_arm is not None and re.search(r"\b(?:hand|pass|give|transfer)\w*\b.*\bto (?:the )?(?:left|right|other) (?:arm|hand|gripper|one)\b", clause):
+            heading_arm = None  # handed over: the arm that took it does the steps after, not the heading's
+            clauses.append(clause)
             continue
         if heading_arm is not None and not re.search(r"\b(?:left|right|both|other) (?:arm|hand|gripper|one)s?\b", clause):
             # A heading ("Right arm: grab ..., pour ..., set it down") names the arm of every step under it.
