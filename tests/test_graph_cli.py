@@ -153,3 +153,29 @@ def test_render_style_full_keeps_every_detail_on_the_arcs(runner: CliRunner, tmp
     assert result.exit_code == 0, result.output
     assert "rankdir=TB" in readable.read_text() and "rankdir=LR" in full.read_text()
     assert "when bottle_dropped on e2" in full.read_text()
+
+
+def _with_goal(tmp_path: Path, goals: list[dict]) -> Path:
+    from agentchord.library import library_path
+
+    data = yaml.safe_load(Path(library_path("single_arm_pour_water")).read_text())
+    data["success"] = {"judge": "goal", "goal_spec": {"goals": goals}}
+    return _write(tmp_path, data)
+
+
+def test_check_refuses_a_goal_spec_run_would_refuse(runner: CliRunner, tmp_path: Path) -> None:
+    """``graph check`` validates the goal the graph is judged by, as ``run`` does (it said ok, run said no)."""
+    path = _with_goal(tmp_path, [{"kind": "stacked", "obj": "cup"}])
+    result = runner.invoke(main, ["graph", "check", str(path)])
+    assert result.exit_code == 2 and "success.goal_spec.goals[0]: Input tag 'stacked'" in result.output
+    run = runner.invoke(main, ["run", "single_arm_pour_water", "--graph", str(path)])
+    assert run.exit_code == 2 and "success.goal_spec.goals[0]: Input tag 'stacked'" in run.output
+
+
+def test_a_goal_naming_an_object_the_scene_lacks_is_refused_before_the_robot_moves(runner: CliRunner, tmp_path: Path) -> None:
+    """It ran the whole episode and ended on an internal error (``KeyError: 'mug'``) when judged."""
+    path = _with_goal(tmp_path, [{"kind": "inside", "obj": "bottle", "container": "mug"}])
+    result = runner.invoke(main, ["graph", "check", str(path), "--task", "single_arm_pour_water"])
+    assert result.exit_code == 2 and "goals[0].container: the single_arm_pour_water scene has no object 'mug'" in result.output
+    run = runner.invoke(main, ["run", "single_arm_pour_water", "--graph", str(path)])
+    assert run.exit_code == 2 and "has no object 'mug'" in run.output

@@ -203,8 +203,9 @@ def _load_graph_option(graph_path: str | None):
         try:
             GoalSpec.model_validate(graph.success.goal_spec)
         except ValidationError as exc:
-            lines = "\n".join(f"{graph_path}: success.goal_spec.{'.'.join(map(str, e['loc']))}: {e['msg']}"
-                              for e in exc.errors())
+            from agentchord.agents.rules.feasibility import spec_problems
+
+            lines = "\n".join(f"{graph_path}: {problem}" for problem in spec_problems(exc))
             raise click.UsageError(f"the graph is not valid:\n{lines}") from None
     return graph
 

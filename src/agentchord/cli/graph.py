@@ -69,7 +69,7 @@ def check_command(files: tuple[Path, ...], task: str | None, seed: int) -> None:
         except GraphFileError as error:
             problems = error.problems
         else:
-            found = check_graph(graph)
+            found = check_graph(graph) + _goal_spec_problems(graph, scene)
             if scene is not None:
                 from agentchord.agents.reach_check import reach_problems
 
@@ -85,6 +85,25 @@ def check_command(files: tuple[Path, ...], task: str | None, seed: int) -> None:
             f"{path}: ok ({len(graph.nodes)} nodes, {len(graph.edges)} edges, {len(graph.failures())} failure modes)"
         )
     sys.exit(EXIT_BAD_INPUT if failed else 0)
+
+
+def _goal_spec_problems(graph, scene) -> list:
+    """What is wrong with the goal the graph is judged by (``success.goal_spec``), as ``run`` refuses it; with a
+    scene, also whether it can be done there (its objects and regions, things that fit)."""
+    if graph.success.goal_spec is None:
+        return []
+    from pydantic import ValidationError
+
+    from agentchord.agents.rules.feasibility import spec_problems, stated_goal_problems
+    from agentchord.agents.rules.goals import GoalSpec
+
+    if scene is not None:  # an object the scene lacks is check_scene's to say
+        return [p for p in stated_goal_problems(graph, scene) if "the scene has no '" not in p.message]
+    try:
+        GoalSpec.model_validate(graph.success.goal_spec)
+    except ValidationError as error:
+        return spec_problems(error)
+    return []
 
 
 def _task_scene(task: str, seed: int):

@@ -26,11 +26,22 @@ def check_scene(graph: TaskGraph, scene_objects: Iterable[str], scene: str = "th
     names = list(scene_objects)
     known = set(names)
     listed = ", ".join(names) or "no objects"
-    return [
+    problems = [
         Problem(f"objects[{i}]", f"the {scene} scene has no object {name!r} (it has {listed})")
         for i, name in enumerate(graph.objects)
         if name not in known
     ]
+    # The goal the graph is judged by names objects too (a cloth by its name: its points are ``towel_bl`` ...).
+    goals = (graph.success.goal_spec or {}).get("goals")
+    for i, goal in enumerate(goals if isinstance(goals, list) else []):
+        for key, name in (goal.items() if isinstance(goal, dict) else ()):
+            if key in GOAL_OBJECT_FIELDS and isinstance(name, str) and name not in known and not any(n.startswith(f"{name}_") for n in known):
+                problems.append(Problem(f"success.goal_spec.goals[{i}].{key}", f"the {scene} scene has no object {name!r} (it has {listed})"))
+    return problems
+
+
+#: Fields of a goal spec's goals that name a scene object.
+GOAL_OBJECT_FIELDS = frozenset({"obj", "container", "support", "source", "target", "relative_to", "into", "cloth"})
 
 
 def require_runnable(graph: TaskGraph, scene_objects: Iterable[str], scene: str = "the", source: str = "graph") -> None:

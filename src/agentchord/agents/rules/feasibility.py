@@ -91,6 +91,15 @@ def stated_goal(graph: TaskGraph) -> GoalSpec | None:
         return None
 
 
+def spec_problems(error: ValidationError, where: str = "success.goal_spec") -> list[Problem]:
+    """A goal spec's validation errors, one problem each, at its path (``success.goal_spec.goals[0].kind``)."""
+    return [
+        Problem(where + "".join(f"[{part}]" if isinstance(part, int) else f".{part}" for part in detail["loc"]),
+                detail["msg"].removeprefix("Value error, "))
+        for detail in error.errors()
+    ]
+
+
 def stated_goal_problems(graph: TaskGraph, scene: Scene) -> list[Problem]:
     """What is wrong with the goal the composer states: missing, not a goal spec, or not in this scene.
 
@@ -104,11 +113,7 @@ def stated_goal_problems(graph: TaskGraph, scene: Scene) -> list[Problem]:
     try:
         goal = GoalSpec.model_validate(graph.success.goal_spec)
     except ValidationError as error:
-        return [
-            Problem(".".join([where, *(str(part) for part in detail["loc"])]) if detail["loc"] else where,
-                    detail["msg"].removeprefix("Value error, "))
-            for detail in error.errors()
-        ]
+        return spec_problems(error, where)
     problems = []
     for line in goal_problems(goal, scene):  # "goals[1]: what is wrong"
         head, _, rest = line.partition(": ")
