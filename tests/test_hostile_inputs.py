@@ -685,9 +685,10 @@ def test_nonsense_instructions_are_refused_with_the_reason(tmp_path, task, instr
         ([{"kind": "handed_over", "obj": "cup", "giver": "left", "receiver": "left"}], "cannot hand 'cup' over to itself"),
         ([{"kind": "placed", "obj": "red_block", "at": [0.1, 0.4], "relative_to": "cup"}], "one way only"),
         ([{"kind": "on_top_of", "obj": "red_block", "support": "cup"}], "fits through the opening of 'cup'"),
+        ([{"kind": "placed", "obj": "red_block", "at": [0.0, 1.5]}], "is beyond both arms' reach for 'red_block'"),
     ],
     ids=["cycle", "inside itself", "into a block", "unknown object", "unknown region", "pour from a block",
-         "hand over to itself", "two places at once", "on a cup it falls into"],
+         "hand over to itself", "two places at once", "on a cup it falls into", "beyond reach"],
 )
 def test_nonsense_goal_specs_are_refused(tmp_path, goals, message):
     path = write(tmp_path, {"goals": goals}, "goal.yaml")

@@ -14,7 +14,8 @@ from pydantic import ValidationError
 
 from agentchord.agents.rules import knowledge as kb
 from agentchord.agents.rules.goals import GoalSpec, Inside, On, Placed, Poured, static_problems
-from agentchord.agents.scene import Scene, SceneObject
+from agentchord.agents.scene import Scene, SceneObject, arms_reaching, grasp_reach
+from agentchord.solvers.reach import BASE, table_distance
 from agentchord.graph.models import TaskGraph
 from agentchord.graph.validation import Problem
 
@@ -47,6 +48,8 @@ def goal_problems(goal: GoalSpec, scene: Scene) -> list[str]:
                 problems.append(f"{where}: {item.source!r} is not a vessel to pour from")
             if not kb.is_container(objects[item.target]):
                 problems.append(f"{where}: {item.target!r} is not a container: nothing can be poured into it")
+        elif isinstance(item, Placed) and item.at is not None and item.obj in objects:
+            problems += _beyond_reach(where, objects[item.obj], (float(item.at[0]), float(item.at[1])))
         elif isinstance(item, Placed) and item.region is not None:
             regions = [r.name for r in scene.regions]
             if item.region not in regions:
@@ -66,6 +69,16 @@ def _fit(where: str, obj: SceneObject, container: SceneObject, verb: str) -> lis
             f"({inner * 100:.1f} cm inside)"
         ]
     return []
+
+
+def _beyond_reach(where: str, obj: SceneObject, point: tuple[float, float]) -> list[str]:
+    """A table point no arm reaches to set ``obj`` down (the measured reach of each arm from its base)."""
+    if arms_reaching(point, obj.extent):
+        return []
+    limit = grasp_reach(obj.extent)
+    far = ", ".join(f"{arm} {table_distance(arm, point):.2f} m" for arm in BASE)
+    return [f"{where}: ({point[0]:.2f}, {point[1]:.2f}) m is beyond both arms' reach for {obj.name!r}: each reaches "
+            f"{limit:.2f} m from its base, and the point is {far} away"]
 
 
 def _falls_in(where: str, obj: SceneObject, support: SceneObject) -> list[str]:
