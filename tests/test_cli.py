@@ -199,7 +199,7 @@ def test_a_graph_whose_goal_spec_is_invalid_is_refused(tmp_path):
     graph.write_text(yaml.safe_dump(data))
     result = CliRunner().invoke(main, ["run", "single_arm_pour_water", "--graph", str(graph)])
     assert result.exit_code == 2, result.output
-    assert f"{graph}: success.goal_spec.goals.0" in result.output
+    assert f"{graph}: success.goal_spec.goals[0]" in result.output
     data["success"] = {"judge": "maybe"}
     graph.write_text(yaml.safe_dump(data))
     result = CliRunner().invoke(main, ["run", "single_arm_pour_water", "--graph", str(graph)])
