@@ -244,7 +244,9 @@ def write_report(records: list[dict], out: Path, config, console: Console | None
     if drops:
         tables.append(("table1", "Table I: random drops", drops, {}))
     if protocols:
-        tables.append(("table2", f"Table II: {protocols[0]['protocol']}-world protocol", protocols,
+        protocol = protocols[0]["protocol"]
+        title = "Table II: real-world protocol" if protocol == "real" else f"The {protocol} protocol"
+        tables.append(("table2", title, protocols,
                        {"with_steps": False, "with_condition": False}))
         if {r["method"] for r in protocols} >= set(ABLATION_METHODS):
             tables.append(("table5", "Table V: forward-moving recovery vs backtracking", protocols,
