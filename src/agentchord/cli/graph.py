@@ -82,9 +82,14 @@ def check_command(files: tuple[Path, ...], task: str | None, seed: int) -> None:
                 click.echo(line)
             continue
         click.echo(
-            f"{path}: ok ({len(graph.nodes)} nodes, {len(graph.edges)} edges, {len(graph.failures())} failure modes)"
+            f"{path}: ok ({_count(len(graph.nodes), 'node')}, {_count(len(graph.edges), 'edge')}, "
+            f"{_count(len(graph.failures()), 'failure mode')})"
         )
     sys.exit(EXIT_BAD_INPUT if failed else 0)
+
+
+def _count(n: int, noun: str) -> str:
+    return f"{n} {noun}" if n == 1 else f"{n} {noun}s"
 
 
 def _goal_spec_problems(graph, scene) -> list:
