@@ -1,7 +1,7 @@
 """The four baselines of the paper's comparison, on the same executor as AgentChord.
 
 They differ from AgentChord only in how a failure is detected and what happens then
-(DESIGN section 6; docs/results.md, "Baselines", says how each follows its paper):
+(DESIGN section 6; docs/results.md, "The methods", says how each follows its paper):
 
 - ``inner-monologue``: a VQA success query when each sub-goal's edge ends; on a "no", re-plan.
 - ``doremi``: a VQA query on the step's constraints every k ticks of motion and at each
