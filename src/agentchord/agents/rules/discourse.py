@@ -162,10 +162,12 @@ _ARM_ELLIPSIS = [
 _ACROSS = re.compile(r"\b(?:from )?(?:the )?(?:left|right)(?: half| side| edge| corners?)?(?: of it)? (?:to|onto|over|over to|on top of|towards?) "
                      r"(?:the )?(?:right|left)(?: half| side| edge| corners?)?\b|\bside to side\b|\blengthwise\b|\bsideways\b|\bleft-right\b")
 #: Where a pour happens, said beside it: the goal is the pour (holding the cup is said by "hold").
-#: A table setting's manner said after it: ", like a proper place setting", "like they do at a restaurant".
-_LIKE_A_SETTING = re.compile(r"(?: ,)? (?:just )?like (?:for (?:dinner|lunch|breakfast|a meal)|(?:a |an )?(?:proper |normal |usual |formal |nice )?"
-                             r"(?:place|table|dinner) setting|(?:they do |you'd see |you see |you would see )?(?:at|in) a restaurant)(?= ,|$)")
 _IN_THE_AIR = re.compile(r"(?: ,)? (?:in (?:the )?(?:mid-? ?air|air)|up in the air|off the table|above the table|over the table)\b")
+#: How a table setting is meant ("like for dinner", "like a proper place setting", "like at a restaurant").
+_SETTING_MANNER = (r"(?:just )?like (?:for (?:dinner|lunch|breakfast|a meal)|(?:a |an )?(?:proper |normal |usual |formal |nice )?"
+                   r"(?:place|table|dinner) setting|(?:they do |you'd see |you see |you would see )?(?:at|in) a restaurant)")
+#: A table setting's manner said after it: ", like a proper place setting", "like they do at a restaurant".
+_LIKE_A_SETTING = re.compile(rf"(?: ,)? {_SETTING_MANNER}(?= ,|$)")
 
 
 #: Frames that say "the end state is": dropped, the state that follows is read as usual.
@@ -196,8 +198,7 @@ _TALK_SENTENCES = [re.compile(p) for p in (
     r"(?:the )?(?:cup|bottle|plate|tray|towel|block|capsule)(?: is)? (?:right )?(?:there|here|over there|in front of you)",
     r"(?:and )?(?:both|they|them|each|all)(?: of them)? (?:should |must |need to )?(?:point|face|pointing|facing|be pointing|be facing)"
     r" (?:forwards?|away(?: from (?:me|you))?|ahead|up|the same way)",
-    r"(?:just )?like (?:for (?:dinner|lunch|breakfast|a meal)|(?:a |an )?(?:proper |normal |usual |formal |nice )?(?:place|table|dinner) setting|"
-    r"(?:they do |you'd see |you see |you would see )?(?:at|in) a restaurant)",
+    _SETTING_MANNER,
 )]
 #: "bottle standing back where it was", "the cup back in the same spot": put back.
 _BACK_AS_IT_WAS = re.compile(r"^(?:and )?(?:the )?(\w+)(?: and (?:the )?(\w+))?(?: both)?(?: is| are| should be| to be)?(?: both)?"
@@ -504,7 +505,7 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
             steps = re.split(r" (then|and then|and(?= (?:" + "|".join(_VERB_STARTS) + r")\b)) ", clause)
             clause = "".join(f"{part} {with_arm}" if k % 2 == 0 else f" {part} " for k, part in enumerate(steps))
         clauses.append(clause)
-    clauses = _handover_first(clauses, objects, note)
+    clauses = _handover_first(clauses, note)
     out = " , ".join(clauses).strip(" ,")
     out = _sub(_EACH_IN_ORDER, _each_in_order, out, note, "order")
     for pattern, repl, name in _LAST:
@@ -514,7 +515,7 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
     return out.strip(" ,")
 
 
-def _handover_first(clauses: list[str], objects: frozenset[str], note: Callable[[str], None]) -> list[str]:
+def _handover_first(clauses: list[str], note: Callable[[str], None]) -> list[str]:
     """"get the block onto the target , hand it across": the hand-over is how it gets there, so it comes first."""
     out = list(clauses)
     for k in range(1, len(out)):
