@@ -752,3 +752,15 @@ def test_an_output_name_no_file_system_takes_is_refused_before_the_work(tmp_path
     `bench --out ''` wrote its sweep into the current folder."""
     invoke([a.replace("{t}", str(tmp_path)) for a in args], 2, "--out" if "bench" in args or "record" in args else "bytes long")
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(("goal_text", "message"), [
+    ("goal:\n  - {kind: inside, obj: red_block, container: cup}\n", "goal: Extra inputs are not permitted (did you mean 'goals'?)"),
+    ("goals:\n  - {kind: inside, obj: red_block, contianer: cup}\n",
+     "goals[0].contianer: Extra inputs are not permitted (did you mean 'container'?)"),
+], ids=["goal for goals", "a kind's field"])
+def test_a_goal_files_typo_is_answered_with_the_field_it_meant(tmp_path, goal_text, message):
+    """It suggested the graph's fields ('goal' for 'goal'), the goal file being read with the graph's hints."""
+    path = tmp_path / "goal.yaml"
+    path.write_text(goal_text)
+    invoke(["plan", "--goal", path, "--task", "blocks_and_cup", "-o", tmp_path / "g.yaml"], 2, message)

@@ -11,6 +11,7 @@ from __future__ import annotations
 import contextlib
 import gc
 import json
+import typing
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
@@ -71,7 +72,7 @@ def load_model(path: str | Path, model: type[BaseModel]) -> BaseModel:
         try:
             return model.model_validate(data)
         except ValidationError as error:
-            raise GraphFileError(path, validation_messages(error, data)) from None
+            raise GraphFileError(path, validation_messages(error, data, model)) from None
 
 
 def dump_graph(graph: TaskGraph, path: str | Path) -> Path:
@@ -137,19 +138,21 @@ def format_loc(loc: Sequence[str | int], data: Any = None) -> str:
     return "".join(parts)
 
 
-def validation_messages(error: ValidationError, data: Any = None) -> list[str]:
+def validation_messages(error: ValidationError, data: Any = None, root: type[BaseModel] = TaskGraph) -> list[str]:
     """Turn every error of a pydantic ``ValidationError`` into ``path: message``.
 
     Args:
         error: The validation error.
         data: The raw document that was validated (to name fields as written).
+        root: The model the document was validated as (a graph, a goal spec): where an unknown
+            field's "did you mean" looks for the fields it could have been.
     """
     lines = []
     for detail in error.errors(include_url=False):
         loc = detail["loc"]
         message = detail["msg"].removeprefix("Value error, ")  # our validators' messages read as they are
         if detail["type"] == "extra_forbidden" and loc:
-            message += _field_hint(loc)
+            message += _field_hint(loc, root)
         cause = (detail.get("ctx") or {}).get("error")
         if isinstance(cause, NonFiniteNumberError) and cause.where:
             # The number's own path inside the field (args.offset[1]), not just the field.
@@ -176,10 +179,12 @@ def _child(node: Any, item: str | int) -> Any:
     return None
 
 
-def _model_at(parent: Sequence[str | int]) -> type[BaseModel] | None:
+def _model_at(parent: Sequence[str | int], root: type[BaseModel] = TaskGraph) -> type[BaseModel] | None:
     # Which model a location's parent is, from the shape of the path.
     if not parent:
-        return TaskGraph
+        return root
+    if root is not TaskGraph:
+        return _walk(root, parent)
     if len(parent) >= 2 and isinstance(parent[-1], int):
         return {"nodes": Node, "edges": Edge, "failures": FailureMode}.get(str(parent[-2]))
     if "actions" in parent:
@@ -187,8 +192,30 @@ def _model_at(parent: Sequence[str | int]) -> type[BaseModel] | None:
     return None
 
 
-def _field_hint(loc: Sequence[str | int]) -> str:
-    model = _model_at(loc[:-1])
+def _models_in(annotation: Any) -> list[type[BaseModel]]:
+    """The pydantic models an annotation holds (``list[Goal]``, a union of goal kinds, ``X | None``)."""
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return [annotation]
+    return [m for arg in typing.get_args(annotation) for m in _models_in(arg)]
+
+
+def _walk(model: type[BaseModel], path: Sequence[str | int]) -> type[BaseModel] | None:
+    """The model at ``path`` below ``model``: fields by name, list items by index, a union's member by
+    the tag pydantic puts in the path (``goals[0].inside`` is the goal whose kind is ``inside``)."""
+    candidates: list[type[BaseModel]] = [model]
+    for item in path:
+        if isinstance(item, int):
+            continue  # a list's item: the models the list holds
+        field_models = [m for c in candidates if item in c.model_fields for m in _models_in(c.model_fields[item].annotation)]
+        tagged = [c for c in candidates if getattr(c.model_fields.get("kind"), "default", None) == item]
+        candidates = field_models or tagged
+        if not candidates:
+            return None
+    return candidates[0] if len(candidates) == 1 else None
+
+
+def _field_hint(loc: Sequence[str | int], root: type[BaseModel] = TaskGraph) -> str:
+    model = _model_at(loc[:-1], root)
     if model is None:
         return ""
     fields = list(model.model_fields)
