@@ -172,12 +172,10 @@ def run(task, strategy, p, disturb, protocol, perception, seed, graph_path, inst
 def _node_words(graph, node_id: str, width: int = 44) -> str:
     """``v3 (bottle tilted over the cup)``: a node id with the start of its meaning, for the video's caption."""
     try:
-        semantic = graph.node(node_id).semantic.strip().rstrip(".")
+        semantic = graph.node(node_id).semantic
     except KeyError:
         return node_id
-    if not semantic:
-        return node_id
-    return f"{node_id} ({semantic if len(semantic) <= width else semantic[: width - 3].rstrip() + '...'})"
+    return f"{node_id} ({_short(semantic, width)})" if semantic else node_id
 
 
 def _load_graph_option(graph_path: str | None):
