@@ -1,26 +1,25 @@
 """What the towel's physics costs, and what a cheaper setting of it costs the fold.
 
-A fold-towel control tick is ~20 ms of MuJoCo (10 substeps of ~2 ms: the Newton solver over the
-cloth's 147 degrees of freedom and ~300 constraint rows, then the noslip pass the corner pinch
-holds by). Each variant below changes one physics setting of the towel scene only (the rigid
-tasks are untouched) and runs whole episodes with the executor, so a variant is judged by what
-the fold does with it, not by a replay: success, the failures that ended the others, and the
+The towel as shipped (:class:`FoldTowel`): a 7 x 7 grid, a 4 ms step (5 substeps a tick), the
+conjugate-gradient solver, and the noslip pass (what a corner pinch holds by) only on the ticks after
+a finger touched the cloth. Each variant below changes a physics setting of the towel scene only
+(the rigid tasks are untouched) and runs whole episodes with the executor, so a variant is judged by
+what the fold does with it, not by a replay: success, the failures that ended the others, and the
 episode's speed in multiples of real time.
 
     .venv/bin/python benchmarks/bench_cloth_physics.py [--seeds 0,1,2] [--protocols none,real] [--variants all]
 
 Variants (``--variants`` takes a comma-separated subset):
 
-- ``as-is``: the shipped scene (timestep 2 ms, noslip 3 iterations, a 7 x 7 grid).
-- ``noslip-off``: no noslip pass.
-- ``noslip-touch``: the noslip pass only on ticks after a finger touched the cloth.
-- ``dt-4ms`` / ``dt-5ms``: a longer physics step (5 or 4 substeps a tick).
-- ``dt-4ms-noslip-touch``: both.
-- ``grid-5``: a 5 x 5 grid (75 degrees of freedom).
-- ``pyramidal``: pyramidal friction cones instead of elliptic ones (the noslip pass stays).
-- ``cg``: the conjugate-gradient solver instead of Newton (the same problem, solved to the same
-  tolerance, within the same 100 iterations).
-- ``pyramidal-cg``, ``pyramidal-dt-4ms``, ``pyramidal-cg-dt-4ms``: combinations.
+- ``as-is``: the shipped scene.
+- ``before``: the setting shipped before: a 2 ms step, Newton, the noslip pass on every step
+  (0.86x real time); ``before-*``: it with one or more changes (``noslip-off``, ``noslip-touch``,
+  ``dt-4ms``, ``cg``, ``pyramidal``, ``grid-6-dt-4ms-noslip-touch``).
+- ``noslip-off`` / ``noslip-always``: no noslip pass / on every step.
+- ``newton``: Newton's solver instead of conjugate gradient.
+- ``dt-2ms`` / ``dt-5ms``: another physics step.
+- ``grid-5`` / ``grid-6``: a coarser grid (the corner's place offsets are tuned for 7 x 7).
+- ``pyramidal``: pyramidal friction cones instead of elliptic ones.
 
 Two cheaper pinches MuJoCo 3.8 does not offer a flex, so they are not variants: an ``adhesion``
 actuator on the finger bodies pulls on geom contacts only (on the cloth's it applies no force),
@@ -54,63 +53,68 @@ TASK = "fold_towel"
 
 @dataclass(frozen=True)
 class Variant:
-    """One setting of the towel scene's physics (None: as shipped)."""
+    """One setting of the towel scene's physics (None: as shipped, see :class:`FoldTowel`)."""
 
     timestep: float | None = None
     noslip: int | None = None
-    noslip_on_touch: bool = False
+    noslip_on_touch: bool | None = None
     grid: tuple[int, int] | None = None
     cone: str | None = None
     solver: str | None = None
 
 
+#: The setting shipped before the towel's physics was made cheaper: a 2 ms step, Newton, noslip always.
+BEFORE = dict(timestep=0.002, solver="newton", noslip_on_touch=False)
+
 VARIANTS = {
     "as-is": Variant(),
+    "before": Variant(**BEFORE),
     "noslip-off": Variant(noslip=0),
-    "noslip-touch": Variant(noslip_on_touch=True),
-    "dt-4ms": Variant(timestep=0.004),
+    "noslip-always": Variant(noslip_on_touch=False),
+    "newton": Variant(solver="newton"),
+    "dt-2ms": Variant(timestep=0.002),
     "dt-5ms": Variant(timestep=0.005),
-    "dt-4ms-noslip-touch": Variant(timestep=0.004, noslip_on_touch=True),
     "grid-5": Variant(grid=(5, 5)),
+    "grid-6": Variant(grid=(6, 6)),
     "pyramidal": Variant(cone="pyramidal"),
-    "cg": Variant(solver="cg"),
-    "pyramidal-cg": Variant(cone="pyramidal", solver="cg"),
-    "pyramidal-dt-4ms": Variant(cone="pyramidal", timestep=0.004),
-    "pyramidal-cg-dt-4ms": Variant(cone="pyramidal", solver="cg", timestep=0.004),
+    "before-noslip-off": Variant(**{**BEFORE, "noslip": 0}),
+    "before-noslip-touch": Variant(**{**BEFORE, "noslip_on_touch": True}),
+    "before-dt-4ms": Variant(**{**BEFORE, "timestep": 0.004}),
+    "before-dt-4ms-noslip-touch": Variant(**{**BEFORE, "timestep": 0.004, "noslip_on_touch": True}),
+    "before-cg": Variant(**{**BEFORE, "solver": "cg"}),
+    "before-pyramidal": Variant(**{**BEFORE, "cone": "pyramidal"}),
+    "before-grid-6-dt-4ms-noslip-touch": Variant(**{**BEFORE, "grid": (6, 6), "timestep": 0.004, "noslip_on_touch": True}),
 }
 
 
 @contextmanager
 def towel_physics(variant: Variant) -> Iterator[None]:
     """Worlds built inside take the variant's settings when their scene has a cloth."""
-    init, step, count = sim_world.SimWorld.__init__, sim_world.SimWorld.step, FoldTowel.COUNT
+    init, count = sim_world.SimWorld.__init__, FoldTowel.COUNT
 
     def patched_init(world, scene, *args, **kwargs):
-        if scene.cloth is not None and variant.timestep is not None:
-            scene.timestep = variant.timestep
+        if scene.cloth is not None:
+            if variant.timestep is not None:
+                scene.timestep = variant.timestep
+            if variant.solver is not None:
+                scene.solver = variant.solver
+            if variant.noslip_on_touch is not None:
+                scene.noslip_while_touching_cloth = variant.noslip_on_touch
+            if variant.noslip is not None:
+                scene.noslip_while_touching_cloth = False
         init(world, scene, *args, **kwargs)
         if scene.cloth is not None and variant.noslip is not None:
             world.model.opt.noslip_iterations = variant.noslip
         if scene.cloth is not None and variant.cone is not None:
             world.model.opt.cone = getattr(mujoco.mjtCone, f"mjCONE_{variant.cone.upper()}")
-        if scene.cloth is not None and variant.solver is not None:
-            world.model.opt.solver = getattr(mujoco.mjtSolver, f"mjSOL_{variant.solver.upper()}")
-
-    def touch_step(world):
-        if world.scene.cloth is not None:
-            # The contacts of the last tick: a pinch loads the cloth on the ticks after it closed on it.
-            world.model.opt.noslip_iterations = 3 if world._finger_cloth_contacts else 0
-        step(world)
 
     sim_world.SimWorld.__init__ = patched_init
-    if variant.noslip_on_touch:
-        sim_world.SimWorld.step = touch_step
     if variant.grid is not None:
         FoldTowel.COUNT = variant.grid
     try:
         yield
     finally:
-        sim_world.SimWorld.__init__, sim_world.SimWorld.step, FoldTowel.COUNT = init, step, count
+        sim_world.SimWorld.__init__, FoldTowel.COUNT = init, count
 
 
 def run_variant(variant: Variant, seeds: list[int], protocol: str | None) -> dict:

@@ -86,13 +86,17 @@ def timed_parts(totals: dict[str, float]) -> Iterator[None]:
         Executor.run = run
 
 
-def physics_only(task: str, seed: int, controls: list[np.ndarray]) -> tuple[float, np.ndarray]:
-    """Wall time of replaying ``controls`` as pure physics on a fresh world of the trial; its final qpos."""
+def physics_only(task: str, seed: int, controls: list[np.ndarray], noslip: list[int]) -> tuple[float, np.ndarray]:
+    """Wall time of replaying ``controls`` as pure physics on a fresh world of the trial; its final qpos.
+
+    ``noslip``: the noslip iterations of each tick (a cloth's world runs the pass only while a finger touches it).
+    """
     world = open_world(task, seed)
     model, data = world.model, world.data
     t0 = time.perf_counter()
-    for ctrl in controls:
+    for ctrl, iterations in zip(controls, noslip, strict=True):
         data.ctrl[:] = ctrl
+        model.opt.noslip_iterations = iterations
         for _ in range(world.substeps):
             mujoco.mj_step(model, data)
     return time.perf_counter() - t0, data.qpos.copy()
@@ -101,14 +105,16 @@ def physics_only(task: str, seed: int, controls: list[np.ndarray]) -> tuple[floa
 def measure(task: str, seed: int) -> dict[str, float]:
     """One seed of a task: the bare episode, its physics replayed, and the timed episode."""
     controls: list[np.ndarray] = []
+    noslip: list[int] = []
     final: list[np.ndarray] = []
 
     def record(executor: Executor) -> None:
         controls.append(executor.world.data.ctrl.copy())
+        noslip.append(int(executor.world.model.opt.noslip_iterations))
         final[:] = [executor.world.data.qpos]
 
     result = run_episode(EpisodeSpec(task, seed=seed), on_tick=record)
-    physics_s, qpos = physics_only(task, seed, controls)
+    physics_s, qpos = physics_only(task, seed, controls, noslip)
     totals: dict[str, float] = defaultdict(float)
     with timed_parts(totals):
         timed = run_episode(EpisodeSpec(task, seed=seed))

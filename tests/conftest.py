@@ -21,3 +21,18 @@ def straight_carry(monkeypatch):
     import agentchord.sim.disturbances as disturbances
 
     monkeypatch.setattr(disturbances, "_carry_height", lambda *args, **kwargs: None)
+
+
+@pytest.fixture
+def numerics_before_lean_solves(monkeypatch):
+    """The live IK's two whole QPs every tick, and the towel's 2 ms Newton step with the noslip pass
+    always on: the numerics the scenes pinned by the older regression tests were recorded with (the
+    lean IK and the cheaper towel move the arms and the cloth by millimetres, and a pinned scene's
+    failure may not happen there)."""
+    import agentchord.solvers.ik as ik
+    from agentchord.sim.tasks.fold_towel import FoldTowel
+
+    monkeypatch.setattr(ik, "LEAN_SOLVES", False)
+    monkeypatch.setattr(FoldTowel, "TIMESTEP", 0.002)
+    monkeypatch.setattr(FoldTowel, "SOLVER", "newton")
+    monkeypatch.setattr(FoldTowel, "NOSLIP_WHILE_TOUCHING", False)

@@ -113,6 +113,7 @@ def _episode(task, seed, protocol, monkeypatch, switched_off=None):
     return run_episode(EpisodeSpec(task, seed=seed, disturbances=DisturbanceSetting.from_options(protocol=protocol)))
 
 
+@pytest.mark.usefixtures("numerics_before_lean_solves")
 @pytest.mark.parametrize("makes_way", [True, False])
 def test_a_regrasp_held_back_by_the_idle_arm_has_it_step_back(makes_way, monkeypatch):
     # Stress protocol, dual-arm pour, seed 26: the bottle knocked over during the first grasp lies

@@ -35,13 +35,18 @@ class _MinkStep(BimanualIK):
     def _set_target(self, arm, task, target):
         task.set_target(mink.SE3.from_rotation_and_translation(mink.SO3(np.asarray(target.quat)), np.asarray(target.pos)))
 
-    def _qp_velocity(self, tasks, guarded):
+    def _qp_velocity(self, tasks, guarded, only=None):
+        assert only is None
         limits = [*self.limits, self.arm_collision_limit] if guarded else self.limits
         return mink.solve_ik(self.configuration, tasks, self.dt, solver="daqp", damping=DAMPING, limits=limits)
 
 
+#: Every iteration, both arms in every QP: the solver as mink's own loop runs it.
+_EVERY_ITERATION = dict(lean=False)
+
+
 def test_the_lean_qp_step_moves_the_arms_as_mink_solve_ik_does_bit_for_bit():
-    lean, reference = BimanualIK(), _MinkStep()
+    lean, reference = BimanualIK(**_EVERY_ITERATION), _MinkStep(**_EVERY_ITERATION)
     start = {arm: lean.tcp_pose(arm) for arm in ("left", "right")}
     goals = {"left": np.array([0.05, 0.5, 0.2]), "right": np.array([-0.05, 0.5, 0.2])}  # through each other
     guarded = 0
@@ -152,3 +157,56 @@ def test_a_scratch_solve_aimed_at_the_pose_reaches_a_top_down_grasp_a_solve_from
     ik.reset(home)
     ik.set_arm_q("left", q)
     assert ik.residual("left", pose) < 0.01
+
+
+def _counting_qps(ik: BimanualIK) -> list:
+    calls, solve = [], ik._qp_velocity
+
+    def counted(tasks, guarded, only=None):
+        calls.append(only)
+        return solve(tasks, guarded, only)
+
+    ik._qp_velocity = counted
+    return calls
+
+
+def test_an_arm_that_holds_still_is_left_out_of_the_qp_and_does_not_move():
+    ik = BimanualIK()
+    calls = _counting_qps(ik)
+    hold = ik.tcp_pose("left")
+    start = ik.tcp_pose("right")
+    goal = start.pos + np.array([-0.1, 0.05, -0.1])
+    for k in range(60):
+        s = min(1.0, (k + 1) / 30)
+        before = ik.arm_q("left")
+        ik.solve({"left": hold, "right": PoseTarget(start.pos + s * (goal - start.pos), start.quat)})
+        if k >= 2:
+            assert np.array_equal(ik.arm_q("left"), before)
+    assert np.linalg.norm(ik.tcp_pose("right").pos - goal) < 0.003
+    assert calls[0] is None and set(calls[2:]) == {"right"}  # both at first, then the right arm's joints alone
+
+
+def test_the_one_arm_qp_moves_that_arm_as_the_whole_qp_does():
+    lean, whole = BimanualIK(iterations=1), BimanualIK(iterations=1, lean=False)  # one QP a tick each
+    hold = lean.tcp_pose("left")
+    start = lean.tcp_pose("right")
+    goal = start.pos + np.array([-0.12, 0.08, -0.12])
+    for k in range(60):
+        s = min(1.0, (k + 1) / 30)
+        targets = {"left": hold, "right": PoseTarget(start.pos + s * (goal - start.pos), start.quat)}
+        assert np.allclose(lean.solve(targets)["right"], whole.solve(targets)["right"], atol=1e-6)
+
+
+def test_a_tick_whose_arms_have_arrived_solves_no_qp_and_a_small_move_takes_one():
+    ik = BimanualIK()
+    calls = _counting_qps(ik)
+    poses = {arm: ik.tcp_pose(arm) for arm in ("left", "right")}
+    for _ in range(3):
+        ik.solve(poses)
+    calls.clear()
+    ik.solve(poses)
+    assert calls == []
+    nudged = PoseTarget(poses["right"].pos + np.array([0.0, 0.0, 0.001]), poses["right"].quat)
+    ik.solve({"left": poses["left"], "right": nudged})
+    assert calls == ["right"]
+    assert ik.residual("right", nudged) < 1e-4

@@ -155,6 +155,7 @@ def test_plate_shifted_during_the_place_is_followed():
     assert (switch["failure"], switch["edge"], switch["to"]) == ("plate_shifted", "e3", "e3_r_replace")
 
 
+@pytest.mark.usefixtures("numerics_before_lean_solves")
 @pytest.mark.parametrize("level", [True, False])
 def test_a_fork_that_flipped_over_is_grasped_lying_flat(level, monkeypatch):
     # Stress protocol, seed 45: the fork, shifted against the plate's rim, is dropped by the right arm

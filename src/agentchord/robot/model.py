@@ -40,12 +40,16 @@ def aloha_assets_dir() -> str:
     return path
 
 
+#: Iterations of MuJoCo's noslip pass: the friction of a grasp (a pinch of cloth) held without creep.
+NOSLIP_ITERATIONS = 3
+
+
 def robot_xml(timestep: float = 0.002, extra_worldbody: str = "") -> str:
     """The MJCF document of both arms (``extra_worldbody``: more elements of the world body)."""
     assets = aloha_assets_dir()
     return f"""<mujoco model="agentchord_aloha">
   <compiler meshdir="{assets}" angle="radian"/>
-  <option timestep="{timestep}" integrator="implicitfast" cone="elliptic" noslip_iterations="3"/>
+  <option timestep="{timestep}" integrator="implicitfast" cone="elliptic" noslip_iterations="{NOSLIP_ITERATIONS}"/>
   <include file="{assets}/vx300s_dependencies.xml"/>
   <worldbody>
     <include file="{assets}/vx300s_left.xml"/>

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Literal
 
 import mujoco
 import numpy as np
@@ -25,7 +26,7 @@ from agentchord.robot.aloha import (  # noqa: F401  (the robot's numbers, re-exp
     TCP_OFFSET,
 )
 from agentchord.robot.exceptions import RobotModelError
-from agentchord.robot.model import add_collision_proxies, edit_robot, robot_xml
+from agentchord.robot.model import NOSLIP_ITERATIONS, add_collision_proxies, edit_robot, robot_xml  # noqa: F401  (re-exported)
 from agentchord.worlds.protocol import grip_width, half_extent_along, upright_height
 from agentchord.sim.exceptions import SceneError, SceneSpecError
 
@@ -195,11 +196,24 @@ def _cloth_xml(cloth: ClothSpec) -> str:
 
 @dataclass
 class SceneSpec:
-    """Everything needed to build one trial's scene (``cloth``: an optional flex cloth, None = none)."""
+    """Everything needed to build one trial's scene, and how its physics is solved.
+
+    Attributes:
+        objects: The rigid objects and their initial placement.
+        timestep: Physics step (s); a control tick at 50 Hz is ``0.02 / timestep`` steps.
+        cloth: An optional flex cloth (None = none).
+        solver: MuJoCo's constraint solver: ``newton`` (a few exact iterations, each a sparse
+            factorisation) or ``cg`` (conjugate gradient: many cheap iterations; on a cloth's ~450
+            constraint rows a step costs about a third of Newton's).
+        noslip_while_touching_cloth: Run the noslip pass only on the ticks after a finger touched the
+            cloth (the pass holds a pinch; a cloth nobody holds, lying or folded, does not need it).
+    """
 
     objects: list[ObjectSpec] = field(default_factory=list)
     timestep: float = 0.002
     cloth: ClothSpec | None = None
+    solver: Literal["newton", "cg"] = "newton"
+    noslip_while_touching_cloth: bool = False
 
 
 def _add_environment(spec: mujoco.MjSpec) -> None:
@@ -300,6 +314,8 @@ def build_model(scene: SceneSpec, collision_proxies: bool = False) -> mujoco.MjM
         _add_environment(spec)
         for obj in scene.objects:
             _add_object(spec, obj)
+        if scene.solver == "cg":
+            spec.option.solver = mujoco.mjtSolver.mjSOL_CG
         return spec.compile()
     except (ValueError, RobotModelError) as exc:
         raise SceneError(f"the scene does not compile: {exc}") from exc

@@ -19,6 +19,7 @@ from agentchord.sim.scene import (
     FINGER_GAP_OFFSET,
     FINGER_RANGE,
     HOME_Q,
+    NOSLIP_ITERATIONS,
     SceneSpec,
     build_model,
 )
@@ -170,6 +171,9 @@ class SimWorld:
     def step(self) -> None:
         """Advance one control tick (``substeps`` physics steps)."""
         self._apply_commands()
+        if self.scene.noslip_while_touching_cloth:
+            # The contacts of the last tick: a pinch loads the cloth on the ticks after the fingers closed on it.
+            self.model.opt.noslip_iterations = NOSLIP_ITERATIONS if self._finger_cloth_contacts else 0
         for _ in range(self.substeps):
             for hand in self._hands:
                 hand.apply(self.model.opt.timestep)
@@ -350,9 +354,9 @@ class SimWorld:
 
     def _holding_cloth_point(self, arm: str, name: str) -> bool:
         # Cloth between the pads: fingers closed on nothing but resting on the cloth do not count.
-        if self.gripper_width(arm) < CLOTH_MIN_PINCH:
+        if not self._finger_cloth_contacts or self.gripper_width(arm) < CLOTH_MIN_PINCH:
             return False
-        pos, _ = self.cloth_point(name)
+        pos = self.data.flexvert_xpos[self._cloth_vert0 + self._cloth_points[name][0]]
         for geom in self._finger_geoms[arm]:
             contacts = self._finger_cloth_contacts.get(geom)
             if contacts is None or np.linalg.norm(contacts - pos, axis=1).min() > CLOTH_HOLD_RADIUS:

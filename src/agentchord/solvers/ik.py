@@ -37,6 +37,21 @@ ARM_CLEARANCE = 0.02
 DAMPING = 1e-4
 #: The collision proxies from this index on are the gripper's (``robot.aloha.COLLISION_PROXIES``).
 HAND_PROXIES_FROM = 2
+#: Whether a solver built without saying otherwise solves leanly: an arm that holds still left out of
+#: the QP, and no more iterations once the arms are at their targets or a step is negligible
+#: (:data:`STILL_STEP`, :data:`ARRIVED_POSITION`, :data:`LIVE_CONVERGED_STEP`). False: every
+#: iteration with both arms, the solver the scenes pinned by regression tests before it were recorded with.
+LEAN_SOLVES = True
+#: An arm holds still when its target is the one it was solved for last tick and that solve moved
+#: none of its joints more than this (rad): it is then left out of the QP (see :meth:`BimanualIK.solve`).
+STILL_STEP = 1e-6
+#: The live solver stops iterating once a QP step moves no joint more than this (rad; ~2 µm at the tool).
+LIVE_CONVERGED_STEP = 1e-5
+#: A solve stops iterating once every arm it moves is this close to its target: position (m) and
+#: rotation (rad). One QP step from last tick's solution usually lands there; the next would move
+#: the tool by microns.
+ARRIVED_POSITION = 1e-4
+ARRIVED_ROTATION = 1e-3
 #: DAQP's "no lower bound" on a constraint row (what qpsolvers passes for ``G x <= h``).
 NO_LOWER_BOUND = -1e30
 
@@ -50,11 +65,15 @@ class BimanualIK:
         avoid_arm_collisions: Keep the two arms apart.
         converged_step: Stop before ``iterations`` once a QP step moves the joints less than
             this (rad): a scratch solve that converges in 30 of its 150 iterations (or stalls
-            against a limit) costs a fifth. None runs every iteration (the live solver).
+            against a limit) costs a fifth. None: :data:`LIVE_CONVERGED_STEP` when lean, else every iteration.
+        lean: Leave an arm that holds still (:data:`STILL_STEP`) out of the QP (a tick with one arm
+            moving solves that arm's six joints, a tick with none solves nothing) and stop iterating
+            once every arm solved for is at its target (:data:`ARRIVED_POSITION`,
+            :data:`ARRIVED_ROTATION`): a live tick then takes one QP, not two. None: :data:`LEAN_SOLVES`.
     """
 
     def __init__(self, iterations: int = 2, dt: float = 0.05, avoid_arm_collisions: bool = True,
-                 converged_step: float | None = None) -> None:
+                 converged_step: float | None = None, lean: bool | None = None) -> None:
         self.model = build_robot_model()
         self.configuration = mink.Configuration(self.model)
         self.iterations = iterations
@@ -97,12 +116,31 @@ class BimanualIK:
         self._tcp_site = {arm: self.model.site(f"{arm}_tcp").id for arm in ARM_PREFIX}
         # Per arm, the pose (quaternion and position bytes) its frame task's target was last set to.
         self._targets_set: dict[str, tuple[bytes, bytes]] = {}
+        self._target_position = {arm: np.zeros(3) for arm in ARM_PREFIX}
+        self._target_rotation = {arm: np.zeros(9) for arm in ARM_PREFIX}  # row-major, as MuJoCo's site_xmat
+        self.lean = LEAN_SOLVES if lean is None else lean
+        if converged_step is None and self.lean:
+            self.converged_step = LIVE_CONVERGED_STEP
+        # Arms that held still at the last solve: their target unchanged and their joints unmoved by it.
+        self._still: set[str] = set()
+        # The joints (velocity indices) of each arm: the columns of its part of the QP.
+        self._arm_dofs = {arm: adr.copy() for arm, adr in self._arm_qadr.items()}  # hinges: qpos = qvel layout
         # What every QP shares (see _qp_velocity): the posture task's weighted Jacobian (its Jacobian
         # is the identity) and the joint limits' constraint rows, built as mink builds them.
         nv = self.model.nv
         self._posture_jacobian = self.posture.cost[:, None] * np.eye(nv)
         joint_limit = self.limits[0]
         self._limit_rows = np.vstack([joint_limit.projection_matrix, -joint_limit.projection_matrix])
+        # The same for one arm's QP: which joint-limit rows are its joints', those rows and the
+        # posture Jacobian on its columns.
+        self._daqp_rows_of: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        # Every joint a hinge or a slide: mink's mj_differentiatePos of a joint limit is a difference.
+        assert self.model.nq == nv and not np.isin(self.model.jnt_type, (mujoco.mjtJoint.mjJNT_FREE, mujoco.mjtJoint.mjJNT_BALL)).any()
+        self._one_arm_qp = {}
+        for arm, dofs in self._arm_dofs.items():
+            mask = np.isin(joint_limit.indices, dofs)
+            rows = joint_limit.projection_matrix[mask][:, dofs]
+            self._one_arm_qp[arm] = (mask, np.vstack([rows, -rows]), self._posture_jacobian[np.ix_(dofs, dofs)])
         q0 = self.configuration.q.copy()
         for arm in ARM_PREFIX:
             q0[self._arm_qadr[arm]] = HOME_Q
@@ -118,12 +156,14 @@ class BimanualIK:
         """Warm start from a full robot configuration (IK model layout)."""
         self.configuration.update(q)
         self.posture.set_target(q)
+        self._still.clear()
 
     def set_arm_q(self, arm: str, q6: np.ndarray) -> None:
         """Overwrite one arm's joints in the warm start (e.g. after a joint-space move)."""
         q = self.configuration.q.copy()
         q[self._arm_qadr[arm]] = q6
         self.configuration.update(q)
+        self._still.discard(arm)
 
     def aimed_home(self, arm: str, point: np.ndarray) -> np.ndarray:
         """The arm's home joints with its waist turned to face ``point`` (world frame).
@@ -165,40 +205,71 @@ class BimanualIK:
         Returns:
             Joint targets (6 per arm) for every arm.
         """
-        tasks = [self.posture]
+        tasks, moving = [self.posture], []
         for arm, task in self.tasks.items():
             target = targets.get(arm)
             if target is None:
                 # Hold: the current solution is the target.
                 task.set_target_from_configuration(self.configuration)
-                self._targets_set.pop(arm, None)
+                changed = self._targets_set.pop(arm, None) is not None
             else:
-                self._set_target(arm, task, target)
-            tasks.append(task)
+                changed = self._set_target(arm, task, target)
+            if changed or arm not in self._still or not self.lean:
+                tasks.append(task)
+                moving.append(arm)
+        if not moving:
+            return {arm: self.arm_q(arm) for arm in ARM_PREFIX}
         self.posture.set_target(self.configuration.q)
         guarded = self.arm_collision_limit is not None and self.arms_close()
-        if guarded:
-            previous = self.configuration.q.copy()
+        # Both arms: the whole QP, every joint (the fingers' included, as mink solves it); one arm: its joints only.
+        only = None if len(moving) == len(ARM_PREFIX) else moving[0]
+        start = self.configuration.q.copy()
         for _ in range(self.iterations):
-            velocity = self._qp_velocity(tasks, guarded)
+            velocity = self._qp_velocity(tasks, guarded, only)
             self.configuration.integrate_inplace(velocity, self.dt)
             if self.converged_step is not None and float(np.max(np.abs(velocity))) * self.dt < self.converged_step:
+                break
+            if self.lean and all(self._arrived(arm) for arm in moving):
                 break
         if guarded and self.arm_clearance() < 0.0:
             # The linearised limit can still be stepped through when targets cross: then both
             # arms hold their last configuration rather than collide.
-            self.configuration.update(previous)
+            self.configuration.update(start)
+        moved = np.abs(self.configuration.q - start)
+        self._still = {arm for arm in ARM_PREFIX if float(np.max(moved[self._arm_qadr[arm]])) < STILL_STEP}
         return {arm: self.arm_q(arm) for arm in ARM_PREFIX}
 
-    def _set_target(self, arm: str, task: mink.FrameTask, target: PoseTarget) -> None:
-        """Set a frame task's target, unless it holds the same pose already (an arm holding still)."""
+    def _set_target(self, arm: str, task: mink.FrameTask, target: PoseTarget) -> bool:
+        """Set a frame task's target, unless it holds the same pose already (an arm holding still).
+
+        Returns:
+            Whether the target changed.
+        """
         quat, pos = np.asarray(target.quat), np.asarray(target.pos)
         key = (quat.tobytes(), pos.tobytes())
-        if self._targets_set.get(arm) != key:
-            task.set_target(mink.SE3.from_rotation_and_translation(mink.SO3(quat), pos))
-            self._targets_set[arm] = key
+        if self._targets_set.get(arm) == key:
+            return False
+        task.set_target(mink.SE3.from_rotation_and_translation(mink.SO3(quat), pos))
+        self._targets_set[arm] = key
+        mujoco.mju_quat2Mat(self._target_rotation[arm], quat)
+        self._target_position[arm] = pos.copy()
+        return True
 
-    def _qp_velocity(self, tasks: list[mink.Task], guarded: bool) -> np.ndarray:
+    def _arrived(self, arm: str) -> bool:
+        """Whether the arm's tool is at its target (:data:`ARRIVED_POSITION`, :data:`ARRIVED_ROTATION`).
+
+        An arm without a target of its own (held where it is) has arrived when nothing moved it.
+        """
+        if arm not in self._targets_set:
+            return False
+        data, site = self.configuration.data, self._tcp_site[arm]
+        if float(np.linalg.norm(data.site_xpos[site] - self._target_position[arm])) > ARRIVED_POSITION:
+            return False
+        # The angle of R_target^T R from its trace.
+        cosine = 0.5 * (float(self._target_rotation[arm] @ data.site_xmat[site]) - 1.0)
+        return cosine > np.cos(ARRIVED_ROTATION)
+
+    def _qp_velocity(self, tasks: list[mink.Task], guarded: bool, only: str | None = None) -> np.ndarray:
         """One differential-IK step: what ``mink.solve_ik(configuration, tasks, dt, solver="daqp",
         damping=DAMPING, limits=...)`` returns, bit for bit.
 
@@ -211,6 +282,9 @@ class BimanualIK:
         Args:
             tasks: The posture task, then the frame tasks, targets set.
             guarded: Whether the arm-collision limit joins the joint limits.
+            only: Solve this arm's joints alone, every other joint held (its velocity 0): the same
+                QP with the other columns, their joint-limit rows and the still arm's frame task
+                taken out (``tasks`` then holds only this arm's frame task).
 
         Raises:
             mink.NoSolutionFound: DAQP found no solution.
@@ -219,31 +293,50 @@ class BimanualIK:
         # The objective: mink's _compute_qp_objective with the posture task's constant Jacobian.
         error = posture.cost * (-posture.gain * posture.compute_error(configuration))
         mu_total = 0.0 + posture.lm_damping * float(error @ error)
-        jacobians, errors = [self._posture_jacobian], [error]
+        if only is None:
+            dofs, jacobians, errors = slice(None), [self._posture_jacobian], [error]
+        else:
+            dofs = self._arm_dofs[only]
+            limit_mask, limit_rows, posture_jacobian = self._one_arm_qp[only]
+            jacobians, errors = [posture_jacobian], [error[dofs]]
         for task in tasks[1:]:
             jacobian, error, mu = task.compute_qp_residual(configuration)
-            jacobians.append(jacobian)
+            jacobians.append(jacobian[:, dofs] if only is not None else jacobian)
             errors.append(error)
             mu_total += mu
         stacked = np.vstack(jacobians)
         hessian = stacked.T @ stacked
         gradient = -(np.concatenate(errors) @ stacked)
-        hessian.flat[:: self.model.nv + 1] += DAMPING + mu_total
+        hessian.flat[:: hessian.shape[0] + 1] += DAMPING + mu_total
         # The inequalities: the joint limits' (ConfigurationLimit), then the arms' clearance.
+        # (mink's mj_differentiatePos at dt = 1: for the robot's hinge and slide joints, a difference.)
         joint_limit, q, nv = self.limits[0], configuration.q, self.model.nv
-        to_upper, from_lower = np.empty(nv), np.empty(nv)
-        mujoco.mj_differentiatePos(m=self.model, qvel=to_upper, dt=1.0, qpos1=q, qpos2=joint_limit.upper)
-        mujoco.mj_differentiatePos(m=self.model, qvel=from_lower, dt=1.0, qpos1=joint_limit.lower, qpos2=q)
-        rows = self._limit_rows
-        bounds = np.hstack([joint_limit.gain * to_upper[joint_limit.indices], joint_limit.gain * from_lower[joint_limit.indices]])
+        limited = joint_limit.indices
+        upper = joint_limit.gain * (joint_limit.upper[limited] - q[limited])
+        lower = joint_limit.gain * (q[limited] - joint_limit.lower[limited])
+        if only is None:
+            rows, bounds = self._limit_rows, np.hstack([upper, lower])
+        else:
+            rows, bounds = limit_rows, np.hstack([upper[limit_mask], lower[limit_mask]])
         if guarded:
             clearance = self.arm_collision_limit.compute_qp_inequalities(configuration, self.dt)
-            rows, bounds = np.vstack([rows, clearance.G]), np.hstack([bounds, clearance.h])
-        step, _, exitflag, _ = daqp.solve(hessian, gradient, rows, bounds, np.full(bounds.size, NO_LOWER_BOUND),
-                                          np.zeros(bounds.size, dtype=np.intc), primal_start=None)
+            rows, bounds = np.vstack([rows, clearance.G[:, dofs]]), np.hstack([bounds, clearance.h])
+        no_lower, kinds = self._daqp_rows(bounds.size)
+        step, _, exitflag, _ = daqp.solve(hessian, gradient, rows, bounds, no_lower, kinds, primal_start=None)
         if exitflag <= 0:
             raise mink.NoSolutionFound("daqp")
-        return step / self.dt
+        if only is None:
+            return step / self.dt
+        velocity = np.zeros(nv)
+        velocity[dofs] = step / self.dt
+        return velocity
+
+    def _daqp_rows(self, count: int) -> tuple[np.ndarray, np.ndarray]:
+        """DAQP's lower bounds (none) and constraint kinds (plain inequalities) of ``count`` rows, built once per count."""
+        rows = self._daqp_rows_of.get(count)
+        if rows is None:
+            rows = self._daqp_rows_of[count] = (np.full(count, NO_LOWER_BOUND), np.zeros(count, dtype=np.intc))
+        return rows
 
     def whole_arm_clearance(self) -> float:
         """Smallest distance (m) between the two arms' proxies, the grippers' included even hand to hand."""
