@@ -131,11 +131,11 @@ class BimanualIK:
         self._posture_jacobian = self.posture.cost[:, None] * np.eye(nv)
         joint_limit = self.limits[0]
         self._limit_rows = np.vstack([joint_limit.projection_matrix, -joint_limit.projection_matrix])
-        # The same for one arm's QP: which joint-limit rows are its joints', those rows and the
-        # posture Jacobian on its columns.
         self._daqp_rows_of: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         # Every joint a hinge or a slide: mink's mj_differentiatePos of a joint limit is a difference.
         assert self.model.nq == nv and not np.isin(self.model.jnt_type, (mujoco.mjtJoint.mjJNT_FREE, mujoco.mjtJoint.mjJNT_BALL)).any()
+        # The same for one arm's QP: which joint-limit rows are its joints', those rows and the
+        # posture Jacobian on its columns.
         self._one_arm_qp = {}
         for arm, dofs in self._arm_dofs.items():
             mask = np.isin(joint_limit.indices, dofs)

@@ -105,8 +105,8 @@ class FoldTowel:
     BENDING = 1e5
     #: The towel's physics: a 4 ms step, the conjugate-gradient solver, and the noslip pass (what
     #: holds a pinch) only while a finger touches the cloth. Against a 2 ms step with Newton and
-    #: noslip always: 3.4x real time instead of 0.86x, the same folds on seeds 0-9, nominal and under
-    #: the real protocol (``benchmarks/bench_cloth_physics.py``).
+    #: noslip always: about 3.7x real time instead of 0.86x, with the same folds, nominal and under the
+    #: real protocol (``benchmarks/bench_cloth_physics.py --variants as-is,before``).
     TIMESTEP = 0.004
     SOLVER = "cg"
     NOSLIP_WHILE_TOUCHING = True
