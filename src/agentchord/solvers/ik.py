@@ -123,8 +123,6 @@ class BimanualIK:
             self.converged_step = LIVE_CONVERGED_STEP
         # Arms that held still at the last solve: their target unchanged and their joints unmoved by it.
         self._still: set[str] = set()
-        # The joints (velocity indices) of each arm: the columns of its part of the QP.
-        self._arm_dofs = {arm: adr.copy() for arm, adr in self._arm_qadr.items()}  # hinges: qpos = qvel layout
         # What every QP shares (see _qp_velocity): the posture task's weighted Jacobian (its Jacobian
         # is the identity) and the joint limits' constraint rows, built as mink builds them.
         nv = self.model.nv
@@ -137,7 +135,7 @@ class BimanualIK:
         # The same for one arm's QP: which joint-limit rows are its joints', those rows and the
         # posture Jacobian on its columns.
         self._one_arm_qp = {}
-        for arm, dofs in self._arm_dofs.items():
+        for arm, dofs in self._arm_qadr.items():  # hinges and slides: an arm's qpos indices are its QP columns
             mask = np.isin(joint_limit.indices, dofs)
             rows = joint_limit.projection_matrix[mask][:, dofs]
             self._one_arm_qp[arm] = (mask, np.vstack([rows, -rows]), self._posture_jacobian[np.ix_(dofs, dofs)])
@@ -296,7 +294,7 @@ class BimanualIK:
         if only is None:
             dofs, jacobians, errors = slice(None), [self._posture_jacobian], [error]
         else:
-            dofs = self._arm_dofs[only]
+            dofs = self._arm_qadr[only]
             limit_mask, limit_rows, posture_jacobian = self._one_arm_qp[only]
             jacobians, errors = [posture_jacobian], [error[dofs]]
         for task in tasks[1:]:
