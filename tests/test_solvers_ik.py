@@ -175,15 +175,33 @@ def test_an_arm_that_holds_still_is_left_out_of_the_qp_and_does_not_move():
     calls = _counting_qps(ik)
     hold = ik.tcp_pose("left")
     start = ik.tcp_pose("right")
-    goal = start.pos + np.array([-0.1, 0.05, -0.1])
+    goal = start.pos + np.array([0.1, 0.05, -0.1])  # away from the left arm: the clearance guard stays off
     for k in range(60):
         s = min(1.0, (k + 1) / 30)
         before = ik.arm_q("left")
         ik.solve({"left": hold, "right": PoseTarget(start.pos + s * (goal - start.pos), start.quat)})
+        assert not ik.arms_close()
         if k >= 2:
             assert np.array_equal(ik.arm_q("left"), before)
     assert np.linalg.norm(ik.tcp_pose("right").pos - goal) < 0.003
     assert calls[0] is None and set(calls[2:]) == {"right"}  # both at first, then the right arm's joints alone
+
+
+def test_a_still_arm_near_the_other_stays_in_the_qp_so_both_make_way():
+    ik = BimanualIK()
+    calls = _counting_qps(ik)
+    hold = ik.tcp_pose("left")
+    start = ik.tcp_pose("right")
+    goal = start.pos + np.array([-0.12, 0.05, -0.1])  # toward the left arm: tools within ARM_PROXIMITY
+    guarded_calls = []
+    for k in range(60):
+        s = min(1.0, (k + 1) / 30)
+        calls.clear()
+        close = ik.arms_close()
+        ik.solve({"left": hold, "right": PoseTarget(start.pos + s * (goal - start.pos), start.quat)})
+        if close:
+            guarded_calls += calls
+    assert guarded_calls and set(guarded_calls) == {None}  # the whole QP, both arms, on every guarded tick
 
 
 def test_the_one_arm_qp_moves_that_arm_as_the_whole_qp_does():

@@ -203,7 +203,7 @@ class BimanualIK:
         Returns:
             Joint targets (6 per arm) for every arm.
         """
-        tasks, moving = [self.posture], []
+        tasks, moving, still = [self.posture], [], []
         for arm, task in self.tasks.items():
             target = targets.get(arm)
             if target is None:
@@ -215,10 +215,16 @@ class BimanualIK:
             if changed or arm not in self._still or not self.lean:
                 tasks.append(task)
                 moving.append(arm)
+            else:
+                still.append(arm)
         if not moving:
             return {arm: self.arm_q(arm) for arm in ARM_PREFIX}
         self.posture.set_target(self.configuration.q)
         guarded = self.arm_collision_limit is not None and self.arms_close()
+        if guarded and still:
+            # Near the other arm a still arm stays in the QP: the clearance limit is shared, and
+            # both arms making way (as the full solve has them) keeps a grasp's approach as fast.
+            tasks, moving = [self.posture, *self.tasks.values()], list(self.tasks)
         # Both arms: the whole QP, every joint (the fingers' included, as mink solves it); one arm: its joints only.
         only = None if len(moving) == len(ARM_PREFIX) else moving[0]
         start = self.configuration.q.copy()
