@@ -32,8 +32,8 @@ def scene(task: str) -> Scene:
 
 
 def test_the_blind_set_is_large_and_labelled():
-    entries = corpus.load_blind(BLIND, "ABCDE")
-    assert len(entries) >= 270 and len({e["id"] for e in entries}) == len(entries)
+    entries = corpus.load_blind(BLIND, "ABCDEF")
+    assert len(entries) >= 330 and len({e["id"] for e in entries}) == len(entries)
     assert all("goal" in e or e.get("expect") == "refused" for e in entries)
 
 

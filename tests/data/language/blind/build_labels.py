@@ -1,6 +1,6 @@
 """Label the blind evaluation set (issue 59): the goal each instruction means, written to labels.yaml.
 
-The five writers' files (writer_A.yaml ... writer_E.yaml) hold 270 instructions, each with the
+The six writers' files (writer_A.yaml ... writer_F.yaml) hold 330 instructions, each with the
 writer's own ``meaning`` (the intended end state) and ``possible``. This script states, per id, the
 goal the instruction means as a goal spec's goals (``agentchord schema goal``), written with the
 label helpers of ../build_corpus.py and its conventions (docs/language.md): ``put X down``/``back``
@@ -445,6 +445,88 @@ LABELS: dict[str, object] = {
     # Each block's arm said; order unsaid: as named (blue first; as C-045).
     "E-059": [into("blue_block", "cup", "right"), into("red_block", "cup", "left")],
     "E-060": [nudge(B, "cup", "right"), into("blue_block", "cup")],  # "over a bit to the right": a nudge (as C-050)
+    # --- writer F ----------------------------------------------------------------------------
+    # "... using your right hand, then stand the bottle back up": the pour's arm; the bottle was not
+    # taken in a clause of its own (as D-001, E-002).
+    "F-001": [pour(arm="right"), put("bottle")],
+    "F-002": POUR1,  # "fill the cup up a bit": a vague amount, a pour (as A-004)
+    "F-003": [pour(arm="right"), put("bottle", "right")],  # "right arm:" heads grab, pour, put it back
+    "F-004": POUR1,  # "give water in the red cup": a pour; "put the bottle again on the table standing": back
+    "F-005": POUR1,  # "a little water, just a splash": a vague amount; "don't leave the bottle lying": put back upright
+    "F-006": POUR1,  # end state: water in the cup, the bottle standing about where it is now (as E-004)
+    # The left arm picks the cup up (said) and sets it down beside the bottle, on its left (the side it is on).
+    "F-007": [rel(P1, "cup", "bottle", "beside", "left")],
+    "F-008": REFUSE,
+    "F-009": REFUSE,
+    "F-010": POUR2_LR,  # "Left hand holds the cup up, right hand pours ..., then put both back down"
+    "F-011": POUR2_LR,
+    "F-012": POUR2,  # "pour ... while holding it up": hold_target, arms unsaid
+    "F-013": POUR2,  # "pick up the cup, ... pour ... with the other hand": held cup, no arm named
+    # "Only a little bit of water, maybe a third of a cup": the vague amount is then stated as a fraction,
+    # which poured cannot say (policy above; the held pour alone would be sayable, not the amount).
+    "F-014": REFUSE,
+    # Both taken by said arms ("cup in your left and bottle in your right"): the right arm pours with the
+    # cup held; "at once" is manner. Putting them down is not asked: by the convention each arm puts its
+    # own back (as C-011, C-013; the writer's end with both still held is not sayable).
+    "F-015": [pour(arm="right", hold=True), put("cup", "left"), put("bottle", "right")],
+    "F-016": [hand("cup", "left", "right"), rel(P2, "cup", "bottle", "beside", "right")],  # as B-011
+    "F-017": [rel(P2, "bottle", "cup", "left")],
+    "F-018": REFUSE,
+    "F-019": SETTING,  # "both pointing away from me": the setting convention (turned along y)
+    "F-020": SETTING_ARMS,  # "both should point forward": the setting convention
+    "F-021": SETTING,  # "like a proper place setting": fork left, spoon right
+    "F-022": [SPOON_R],  # "pointing straight ahead": the setting convention
+    # "a bit closer to the plate": the writer means near (left of) the plate: beside it (as B-020, the same
+    # words in the same scene).
+    "F-023": [FORK_L],
+    "F-024": SETTING,  # "lying up-and-down instead of sideways": turned along y, the setting convention
+    "F-025": [on("spoon", "plate")],
+    # No arm named: "pass it to your other hand", so the giver is the arm that picks it up, the left (the
+    # fork lies on the left; as A-024); the right arm, which receives it, lays it right of the plate.
+    "F-026": [hand("fork", "left", "right"), rel(T, "fork", "plate", "right", "right")],
+    "F-027": REFUSE,
+    "F-028": HANDOVER,
+    "F-029": TARGET,
+    "F-030": HANDOVER,  # "it": the block (the scene's only block)
+    "F-031": TARGET,  # "the marked spot on the right": the target region
+    # "from one hand to the other": left to right (the block is on the left, the target on the right; as
+    # A-024); "inside the circle": the target; "keep it standing up": placed stands it upright anyway.
+    "F-032": HANDOVER,
+    # "lift the block up a little and put it back down where it was": the put-back, no arm (as E-033).
+    "F-033": [put("block")],
+    # "right beside the target, not on it": a point just outside its radius, on the side the block is on (as B-027).
+    "F-034": [beside_region(H, "block", "target")],
+    "F-035": REFUSE,
+    "F-036": COFFEE_LEFT,  # "with your left hand", then "both hands ... a bit further forward": the forward spot
+    "F-037": COFFEE,  # "pod": the capsule; "a little farther away": the forward spot
+    "F-038": COFFEE,  # "pick the tray up by its handles and move it forward a bit": the forward spot
+    "F-039": COFFEE,  # "about ten centimetres forward": the forward spot (12 cm; as C-032)
+    "F-040": COFFEE,  # "the tray sitting a little further from you with the capsule in it" (as A-031)
+    "F-041": COFFEE_LEFT,  # "set it down further away": the forward spot
+    "F-042": COFFEE,  # "carry tray with two hand to the front": the forward spot
+    "F-043": TRAY_FWD,  # "leave the capsule where it is": no goal for the capsule
+    "F-044": REFUSE,
+    "F-045": FOLD,
+    "F-046": FOLD,
+    "F-047": FOLD,  # "bottom" corners (near) folded up to the "top" edge (far); each arm a near corner
+    "F-048": FOLD,  # the near edge onto the far edge
+    "F-049": FOLD,
+    "F-050": REFUSE,
+    "F-051": FOLD,  # "half as deep, with the fold nearest to you": near corners onto far corners, crease near (as E-046)
+    "F-052": REFUSE,
+    "F-053": [into("red_block", "cup")],
+    "F-054": [on("blue_block", "red_block")],
+    # "the white bowl": the bowl-like white cup (as C-048); "next to the bowl", side unsaid: the side the
+    # blue block is on (it stands almost straight in front of the cup, 1.5 cm to its right: right).
+    "F-055": [into("red_block", "cup"), rel(B, "blue_block", "cup")],
+    "F-056": [into("blue_block", "cup", "right"), into("red_block", "cup", "left")],  # "Right arm, ... Left arm, after that"
+    "F-057": [into("red_block", "cup"), into("blue_block", "cup")],  # "doesn't matter which one goes first": as D-055
+    # "side by side on the left of the cup": a row left of the cup (neither block is there now: the red one
+    # is left and in front of it), keeping their present order (red on the left of blue): the blue block
+    # just left of the cup, the red one just left of the blue one.
+    "F-058": [rel(B, "blue_block", "cup", "left"), rel(B, "red_block", "blue_block", "left")],
+    "F-059": [hand("red_block", "left", "right"), rel(B, "red_block", "cup", "right", "right")],
+    "F-060": REFUSE,
 }
 
 #: Why each refused entry is refused.
@@ -487,11 +569,21 @@ WHY = {
     "E-047": "a side fold (left edge onto right edge): folded is only near corners onto far corners",
     "E-048": "moving the whole towel to the right side: the cloth is only its corner points and folded; no goal moves a cloth",
     "E-050": "ironing the towel: no iron in the scene and ironing is not a goal (the fold alone would be sayable, not the whole)",
+    "F-008": "'pour about half of it into the cup': a stated fraction of the water; poured states no amount",
+    "F-009": "no blue cup in the scene (only the red cup)",
+    "F-014": "'maybe a third of a cup': a stated amount; poured states no amount",
+    "F-018": "'pick the cup up ... and hold it there': an end with the cup held in the air cannot be said (a goal spec ends at home, a held object is put back)",
+    "F-027": "no knife in the scene",
+    "F-035": "no cup in the handover scene",
+    "F-044": "no coffee machine in the scene; making an espresso is not a goal",
+    "F-050": "picking the folded towel up and putting it down to the right: the cloth is only its corner points and folded; no goal moves a cloth (the fold alone would be sayable, not the whole)",
+    "F-052": "no drawer in the scene",
+    "F-060": "no green block in the scene (only a red and a blue block)",
 }
 
 HEADER = """# Labels of the blind evaluation set (issue 59). Built by build_labels.py; do not edit by hand.
 #
-# For each instruction of writer_A.yaml ... writer_E.yaml (five writers, 270): its scene, and the goal it means
+# For each instruction of writer_A.yaml ... writer_F.yaml (six writers, 330): its scene, and the goal it means
 # as a goal spec's goals (`agentchord schema goal`), or expect: refused with why (the scene cannot
 # do it, or the goal language cannot say it). Written from the instruction and the writer's
 # `meaning` by a labeller who did not write them, following build_corpus.py's label conventions
@@ -507,10 +599,10 @@ def _scene_obs(task: str):
 
 def main() -> None:
     entries = []
-    for name in ("A", "B", "C", "D", "E"):
+    for name in ("A", "B", "C", "D", "E", "F"):
         entries += yaml.safe_load((HERE / f"writer_{name}.yaml").read_text(encoding="utf-8"))["entries"]
     ids = [e["id"] for e in entries]
-    assert len(ids) == len(set(ids)) == 270, len(ids)
+    assert len(ids) == len(set(ids)) == 330, len(ids)
     assert set(LABELS) == set(ids), (set(ids) - set(LABELS), set(LABELS) - set(ids))
     assert set(WHY) == {k for k, v in LABELS.items() if v == REFUSE}, set(WHY) ^ {k for k, v in LABELS.items() if v == REFUSE}
     scenes: dict = {}
@@ -534,7 +626,7 @@ def main() -> None:
         counts[eid[0], "labelled"] += 1
     text = yaml.dump({"labels": labels}, Dumper=_Dumper, sort_keys=False, width=200, allow_unicode=True)
     (HERE / "labels.yaml").write_text(HEADER + text, encoding="utf-8")
-    for name in "ABCDE":
+    for name in "ABCDEF":
         print(f"writer {name}: {counts[name, 'labelled']} labelled, {counts[name, 'refused']} refused")
     print(f"labels.yaml: {len(labels)} entries")
 
