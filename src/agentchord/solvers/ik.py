@@ -52,6 +52,8 @@ LIVE_CONVERGED_STEP = 1e-5
 #: the tool by microns.
 ARRIVED_POSITION = 1e-4
 ARRIVED_ROTATION = 1e-3
+#: A clearance row of the IK's QP is active (binds the solution) when its slack is under this (rad/s · s).
+CLEARANCE_ACTIVE = 1e-9
 #: DAQP's "no lower bound" on a constraint row (what qpsolvers passes for ``G x <= h``).
 NO_LOWER_BOUND = -1e30
 
@@ -123,6 +125,7 @@ class BimanualIK:
             self.converged_step = LIVE_CONVERGED_STEP
         # Arms that held still at the last solve: their target unchanged and their joints unmoved by it.
         self._still: set[str] = set()
+        self._clearance_binds = False  # whether the last QP's solution met the arms' clearance limit
         # What every QP shares (see _qp_velocity): the posture task's weighted Jacobian (its Jacobian
         # is the identity) and the joint limits' constraint rows, built as mink builds them.
         nv = self.model.nv
@@ -203,7 +206,7 @@ class BimanualIK:
         Returns:
             Joint targets (6 per arm) for every arm.
         """
-        tasks, moving, still = [self.posture], [], []
+        tasks, moving = [self.posture], []
         for arm, task in self.tasks.items():
             target = targets.get(arm)
             if target is None:
@@ -215,21 +218,20 @@ class BimanualIK:
             if changed or arm not in self._still or not self.lean:
                 tasks.append(task)
                 moving.append(arm)
-            else:
-                still.append(arm)
         if not moving:
             return {arm: self.arm_q(arm) for arm in ARM_PREFIX}
         self.posture.set_target(self.configuration.q)
         guarded = self.arm_collision_limit is not None and self.arms_close()
-        if guarded and still:
-            # Near the other arm a still arm stays in the QP: the clearance limit is shared, and
-            # both arms making way (as the full solve has them) keeps a grasp's approach as fast.
-            tasks, moving = [self.posture, *self.tasks.values()], list(self.tasks)
         # Both arms: the whole QP, every joint (the fingers' included, as mink solves it); one arm: its joints only.
         only = None if len(moving) == len(ARM_PREFIX) else moving[0]
         start = self.configuration.q.copy()
         for _ in range(self.iterations):
             velocity = self._qp_velocity(tasks, guarded, only)
+            if only is not None and self._clearance_binds:
+                # The arms' clearance stopped the moving arm: the still arm joins the QP so that both
+                # make way, as the whole QP has them (alone, the moving arm's approach is slower).
+                tasks, moving, only = [self.posture, *self.tasks.values()], list(self.tasks), None
+                velocity = self._qp_velocity(tasks, guarded, only)
             self.configuration.integrate_inplace(velocity, self.dt)
             if self.converged_step is not None and float(np.max(np.abs(velocity))) * self.dt < self.converged_step:
                 break
@@ -329,6 +331,11 @@ class BimanualIK:
         step, _, exitflag, _ = daqp.solve(hessian, gradient, rows, bounds, no_lower, kinds, primal_start=None)
         if exitflag <= 0:
             raise mink.NoSolutionFound("daqp")
+        # Whether a clearance row is active at the solution (the limit held an arm back).
+        self._clearance_binds = False
+        if guarded and clearance.h.size:
+            slack = bounds[-clearance.h.size :] - rows[-clearance.h.size :] @ step
+            self._clearance_binds = bool(np.min(slack) < CLEARANCE_ACTIVE)
         if only is None:
             return step / self.dt
         velocity = np.zeros(nv)
