@@ -97,12 +97,19 @@ def test_a_goal_said_twice_is_one_goal():
 
 
 @pytest.mark.parametrize(("task", "text"), [("blocks_and_cup", "move the red block to the shiny circle on the left"),
-                                            ("setup_coffee_tray", "carry the tray forward to the spot")])
+                                            ("blocks_and_cup", "carry the red block forward to the spot")])
 def test_a_place_the_grammar_would_pass_over_is_refused_not_lost(task, text):
-    """A word no rule knows and no part of the parse holds ("the shiny circle"): the grammar kept the other place
-    and the goal would have silently lost this one (a held-out writer's sentence was planned wrong so)."""
+    """A word no rule knows and no part of the parse holds ("the shiny circle"), or a bare spot where no region of
+    the scene is that way: the goal would have silently lost it (a held-out writer's sentence was planned wrong so)."""
     with pytest.raises(InstructionNotGroundedError):
         ground_instruction(text, scene(task))
+
+
+def test_a_spot_a_direction_leads_to_is_the_region_it_names():
+    """"Forward to the spot" in the coffee scene: the spot is its forward region (not the table, not a 10 cm nudge)."""
+    want = [{"kind": "placed", "obj": "tray", "region": "forward"}]
+    for text in ("slide the tray forward to the spot", "push the tray forward, to the forward position"):
+        assert goal("setup_coffee_tray", text) == want, text
 
 
 def test_a_word_for_another_container_names_only_a_bowl_shaped_one():
@@ -118,3 +125,32 @@ def test_an_explicit_then_keeps_the_order_said():
     """Only a hand-over said as the way (no "then") moves before the step it serves."""
     kinds = [g["kind"] for g in goal("handover_block", "put the block in the target region, then hand it over")]
     assert kinds == ["placed", "handed_over"]
+
+
+TALK_SAME = [
+    ("blocks_and_cup", "move the blue block left",
+     ["The blue one is in the way. Push it a bit to the left.", "The blue block is a bit too close to the cup. Slide it a little to the left."]),
+    ("rearrange_table", "put the fork next to the plate", ["The fork is too far away. Move it closer to the plate. Just the fork."]),
+    ("rearrange_table", "put the spoon on the plate", ["Can you put the spoon on the plate for now? We'll do the fork later."]),
+    ("single_arm_pour_water", "move the cup left", ["don't pour anything, just move the cup a bit to the left"]),
+    ("fold_towel", "fold the towel", ["I'm not sure how to put it, but could you fold the towel? Like so it's half the size.",
+                                      "Could you fold the towel for me? Bring the edge closest to you over to the edge farthest from you."]),
+    ("rearrange_table", "put the fork to the left of the plate, put the spoon to the right of the plate",
+     ["Can you make it look like a normal place setting? Fork left of the plate, spoon right of it."]),
+    ("setup_coffee_tray", "put the capsule into the tray, then move the tray forward",
+     ["Could you get the coffee tray ready? The capsule goes into the tray, then the tray goes a little further away."]),
+]
+
+
+@pytest.mark.parametrize(("task", "reference", "variants"), TALK_SAME)
+def test_a_remark_a_title_or_an_insistence_states_no_goal_of_its_own(task, reference, variants):
+    """A remark still says what a later "it" is; a title sentence is said by the sentences after it; "just the fork"
+    insists; "don't pour anything" and "we'll do the fork later" state no goal."""
+    want = goal(task, reference)
+    for text in variants:
+        assert goal(task, text) == want, text
+
+
+def test_dont_forget_is_not_a_negated_step():
+    with pytest.raises(InstructionNotGroundedError):
+        ground_instruction("don't forget to pour water into the cup", scene("single_arm_pour_water"))

@@ -88,3 +88,17 @@ def test_what_cannot_be_grounded_is_a_clear_error(instruction, words):
         ground_instruction(instruction, scene)
     assert words in str(info.value)
     assert "--reasoner llm" in str(info.value) and "--goal" in str(info.value)
+
+
+def test_a_put_down_given_a_place_later_is_that_place_first_in_the_put_downs():
+    """"Put them down, and the cup a bit to the left": the cup's put-down is its placement (said first of the run of
+    put-downs, which states no order), not a put-back and a move."""
+    scene = Scene(objects=[_obj("bottle", x=0.1), _obj("cup", x=-0.1)])
+    goal = ground_instruction("hold the cup and pour water into it from the bottle, then put them down, and the cup goes a bit to the left", scene)
+    assert goal.goals[1:] == [Placed(obj="cup", at=(-0.2, 0.5)), Placed(obj="bottle")]
+
+
+def test_the_other_side_is_opposite_the_side_an_object_was_just_put():
+    scene = Scene(objects=[_obj("plate"), _obj("fork", x=-0.2), _obj("spoon", x=0.2)])
+    goal = ground_instruction("put the spoon to the right of the plate, then put the fork on the other side of the plate", scene)
+    assert [g.offset[0] < 0 for g in goal.goals] == [False, True]

@@ -75,7 +75,21 @@ class Reading:
             # "carry the tray forward, then put it down": the put-down is the placement already said.
             return g in goals[:k] or (_put_down(g) and g.obj in placed)
 
-        return GoalSpec(goals=[g for k, g in enumerate(goals) if not said(k, g)])
+        # "put them down, and the cup a bit to the left": the cup's put-down is its placement, in the put-downs' turn
+        # (a run of put-downs states no order: the one with a place said goes first).
+        kept = [g for k, g in enumerate(goals) if not said(k, g)]
+        out: list[Goal] = []
+        for k, g in enumerate(goals):
+            if _put_down(g) and g.obj in placed and g not in goals[:k]:
+                later = next((p for p in goals[k + 1:] if isinstance(p, Placed) and p.obj == g.obj and not _put_down(p)), None)
+                if later is not None and later not in out:
+                    run = len(out)
+                    while run > 0 and _put_down(out[run - 1]):
+                        run -= 1
+                    out.insert(run, later)
+            elif g in kept and g not in out:
+                out.append(g)
+        return GoalSpec(goals=out)
 
 
 def _put_down(goal: Goal) -> bool:
@@ -83,10 +97,22 @@ def _put_down(goal: Goal) -> bool:
     return isinstance(goal, Placed) and goal.at is None and goal.region is None and goal.relative_to is None
 
 
-def _pour(c: Clause, ctx: Context) -> list[Goal]:
-    if c.target is None:
+def _poured_into(c: Clause, ctx: Context) -> str:
+    """What a pour pours into: the vessel said, else the one container in hand (or the scene's one) that is no vessel
+    to pour from ("grab the cup and the bottle and pour")."""
+    if c.target is not None:
+        return ctx.resolve(c.target)
+    held = [o for o in [*ctx.held_by, *ctx.in_hand] if kb.is_container(ctx.objects[o]) and not kb.is_pourable(ctx.objects[o])]
+    scene = [o.name for o in ctx.scene.objects if kb.is_container(o) and not kb.is_pourable(o)]
+    into = list(dict.fromkeys(held)) or scene
+    if len(into) != 1 or c.source is None and not any(kb.is_pourable(o) for o in ctx.scene.objects):
         raise ctx.error(c.text, "does not say what to pour into (say 'into the cup')")
-    target = ctx.resolve(c.target)
+    ctx.note(c.text, "object", f"poured into: {into[0]}")
+    return ctx.mention(into[0])
+
+
+def _pour(c: Clause, ctx: Context) -> list[Goal]:
+    target = _poured_into(c, ctx)
     if c.source is not None:
         source = ctx.resolve(c.source)
     else:
@@ -152,6 +178,8 @@ def _fold(c: Clause, ctx: Context) -> list[Goal]:
     cloth = next((w for w in reversed(words) if w in ctx.cloths), None)
     if cloth is None and len(ctx.cloths) == 1 and words and words[-1] == "towel":
         cloth = ctx.cloths[0]
+    if cloth is None and np.pronoun == "it" and ctx.cloth_taken:
+        cloth = ctx.cloth_taken  # "grab the near corners, fold it": the cloth whose part is in hand
     if cloth is None:
         raise ctx.error(np.text, f"is not a cloth of the scene (cloths: {', '.join(ctx.cloths) or 'none'})")
     for corner in kb.CLOTH_CORNERS:
@@ -160,6 +188,8 @@ def _fold(c: Clause, ctx: Context) -> list[Goal]:
 
 
 def _beside(obj: str, anchor: str, direction: tuple[float, float], ctx: Context, arm: str | None) -> Placed:
+    if direction[0]:
+        ctx.sides[anchor] = "left" if direction[0] < 0 else "right"  # "..., the spoon to the other side of the plate"
     o, a = ctx.objects[obj], ctx.objects[anchor]
     d = kb.beside_distance(o, a)
     long_flat = kb.is_flat(o) and max(o.extent[:2]) > 3 * min(o.extent[:2])
@@ -185,6 +215,12 @@ def _relation(where: Where | None, ctx: Context) -> Where | None:
         return Where("on_top", (np.of,))
     if last in ("side", "edge") and len(np.words) > 1 and np.words[-2] in ("left", "right"):
         return Where("side_of", (np.of,), side=np.words[-2])
+    if np.words in (("other", "side"), ("opposite", "side")):
+        # "the other side of the plate": the side an object was just put beside it is not this one.
+        anchor = ctx.resolve(np.of)
+        if anchor not in ctx.sides:
+            raise ctx.error(np.text, "says the other side, but nothing was put on one side of it before")
+        return Where("side_of", (np.of,), side="right" if ctx.sides[anchor] == "left" else "left")
     return where
 
 
@@ -196,7 +232,7 @@ def _place_at(names: list[str], where: Where | None, c: Clause, ctx: Context) ->
         where = Where("side_of", (NounPhrase(words=tuple(ctx.last_anchor.split("_"))),), side=where.phrases[0].words[0])
     arms = {n: ctx.arm_of(c.arm, n) for n in names}
     if where is None or where.relation == "back":
-        return [Placed(obj=n, arm=arms[n]) for n in names]
+        return _put_back(names, arms, ctx)
     if where.relation in ("next_to", "side_of", "front_of", "behind"):
         anchor_np = where.phrases[0]
         if where.relation == "side_of" and ctx.table_place(anchor_np) is not False:
@@ -220,6 +256,9 @@ def _place_at(names: list[str], where: Where | None, c: Clause, ctx: Context) ->
         if len(names) > 2 or len(set(directions)) < len(names):
             raise ctx.error(c.text, f"puts {len(names)} objects at one place beside the {anchor}")
         return [_beside(n, anchor, d, ctx, arms[n]) for n, d in zip(names, directions, strict=True)]
+    if where.relation == "spot_of":
+        other = ctx.objects[ctx.resolve(where.phrases[0], exclude=tuple(names))]
+        return [Placed(obj=n, at=(round(other.pos[0], 3), round(other.pos[1], 3)), arm=arms[n]) for n in names]
     if where.relation == "between":
         a, b = (ctx.objects[ctx.resolve(p, exclude=tuple(names))] for p in where.phrases)
         point = (round(0.5 * (a.pos[0] + b.pos[0]), 3), round(0.5 * (a.pos[1] + b.pos[1]), 3))
@@ -235,7 +274,7 @@ def _place_at(names: list[str], where: Where | None, c: Clause, ctx: Context) ->
         return [Placed(obj=n, region=named, arm=arms[n]) for n in names]
     table = ctx.table_place(np)
     if table is None:
-        return [Placed(obj=n, arm=arms[n]) for n in names]
+        return _put_back(names, arms, ctx)
     if table is not False:
         return [Placed(obj=n, at=table, arm=arms[n]) for n in names]
     region = ctx.region(np)
@@ -252,6 +291,13 @@ def _place_at(names: list[str], where: Where | None, c: Clause, ctx: Context) ->
     if where.prep == "on":
         return [On(obj=n, support=host, arm=arms[n]) for n in names]
     return [_beside(n, host, (-1.0 if ctx.objects[n].pos[0] < ctx.objects[host].pos[0] else 1.0, 0.0), ctx, arms[n]) for n in names]
+
+
+def _put_back(names: list[str], arms: dict[str, str | None], ctx: Context) -> list[Goal]:
+    """Each object put back where it was; one never taken, moved or placed is there already ("cup and bottle both on
+    the table" after a pour from the bottle: the bottle is put back, the cup never left)."""
+    back = [n for n in names if n in ctx.touched] if ctx.touched else names
+    return [Placed(obj=n, arm=arms[n]) for n in back]
 
 
 def _folds(c: Clause, ctx: Context) -> str | None:
@@ -274,7 +320,9 @@ def _place(c: Clause, ctx: Context) -> list[Goal]:
         return [Folded(cloth=cloth)]
     names = list(dict.fromkeys(n for np in c.objects for n in ctx.resolve_put_down(np)))
     ctx.in_hand = [n for n in ctx.in_hand if n not in names]
-    return _place_at(names, c.where, c, ctx)
+    goals = _place_at(names, c.where, c, ctx)
+    ctx.touched.update(names)
+    return goals
 
 
 def _move(c: Clause, ctx: Context) -> list[Goal]:
@@ -282,12 +330,20 @@ def _move(c: Clause, ctx: Context) -> list[Goal]:
         return [Folded(cloth=cloth)]
     names = [n for np in c.objects for n in ctx.resolve_put_down(np)]
     ctx.in_hand = [n for n in ctx.in_hand if n not in names]
+    ctx.touched.update(names)
+    if c.direction and c.where is not None and c.where.relation == "at" and c.where.phrases[0].of is None \
+            and set(c.where.phrases[0].words) <= _SPOT_WORDS:
+        # "carry it forward to the spot": the place the direction names, the scene's region of that name.
+        region = _direction_region(c.direction, ctx)
+        if region is None:
+            raise ctx.error(c.text, f"names a spot {c.direction} but the scene has no region there")
+        return [Placed(obj=n, region=region, arm=ctx.arm_of(c.arm, n)) for n in names]
     if c.where is not None or not c.direction:
         return _place_at(names, c.where, c, ctx)
     goals: list[Goal] = []
     for name in names:
         # A scene region the direction names ("forward" in the coffee scene) is where it goes.
-        region = next((r.name for r in ctx.scene.regions if c.direction == r.name.lower() or c.direction in r.description.lower().split()), None)
+        region = _direction_region(c.direction, ctx)
         if region is not None:
             goals.append(Placed(obj=name, region=region, arm=ctx.arm_of(c.arm, name)))
             continue
@@ -296,6 +352,15 @@ def _move(c: Clause, ctx: Context) -> list[Goal]:
         point = (round(obj.pos[0] + ux * kb.NUDGE, 3), round(obj.pos[1] + uy * kb.NUDGE, 3))
         goals.append(Placed(obj=name, at=point, arm=ctx.arm_of(c.arm, name)))
     return goals
+
+
+#: A place said only as a spot ("forward to the spot"): the words it may have.
+_SPOT_WORDS = frozenset({"spot", "region", "position", "area", "place", "zone", "mark", "forward"})
+
+
+def _direction_region(direction: str, ctx: Context) -> str | None:
+    """The scene region a direction names (``forward`` in the coffee scene), if any."""
+    return next((r.name for r in ctx.scene.regions if direction == r.name.lower() or direction in r.description.lower().split()), None)
 
 
 _BUILD = {"pour": _pour, "pick": _pick, "place": _place, "handover": _handover, "fold": _fold, "move": _move}

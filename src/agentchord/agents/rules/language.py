@@ -108,16 +108,22 @@ def normalise(instruction: str) -> str:
     text = re.sub(r"(?:^|(?<=\s))(?:step\s*)?\d+\s*[.):]\s+", " ; ", text)  # "1. pick ...", "step 2) ..."
     text = re.sub(r"'s\b", "", text)
     text = re.sub(r"\bcentre\b", "center", text)
-    text = re.sub(r",?\s*\b(?:bringing|laying|so that (?=the|its)|so (?=the|its)|matching|with its(?! (?:left|right|other|both) )|putting its)\b[^,;.]*", "", text)  # fold_towel's how
+    # fold_towel's how ("bringing its bottom corners onto ...", "so the near edge meets ..."): a purpose clause of a fold only.
+    text = re.sub(r",?\s*\b(?:bringing|laying|matching|with its(?! (?:left|right|other|both) )|putting its)\b[^,;.]*", "", text)
+    if re.search(r"\bfold", text):
+        text = re.sub(r",?\s*\b(?:so that (?=(?:the|its)\b)|so (?=(?:the|its)\b))[^,;.]*", "", text)
     # "Set the table: fork left of the plate, ...": the title is the verb of the steps that follow.
     text = re.sub(r"^(?:set|lay) the table\s*[:,;-]\s*(?=(\w+))", lambda m: "" if _VERB_FORMS.match(m[1] + "s") else "put ", text.strip())
     text = _VERB_FORMS.sub(r"\1", text)
     text = re.sub(r"^(?:could|can|would|will) you\s+|^(?:i want|i'd like|i would like) you to\s+|^(?:please\s+)", "", text.strip())
     # A heading names the arm of every step under it (read by agents.rules.discourse).
     text = re.sub(r"\b([lr])\s+(?=(?:arm|hand|gripper)s?\b)", lambda m: "left " if m[1] == "l" else "right ", text)  # "R arm:"
+    text = re.sub(r"(?:^|(?<=[;.]\s))([lr])\s*:", lambda m: "left :" if m[1] == "l" else "right :", text)  # "R: place it ..."
+    text = re.sub(r"\b(to|from|with) ([lr])\b(?=\s*(?:[,;.]|$|then\b|and\b))", lambda m: f"{m[1]} the {'left' if m[2] == 'l' else 'right'} arm", text)
     text = re.sub(r"(?:^|(?<=[;.]\s))(?:the\s+)?(left|right|both)(?:\s+(arm|hand|gripper)s?)?\s*:", r"armheading \1 ,", text)
     text = re.sub(r"\b(on|to|at) its (left|right)(?: hand)?(?: side)?\b", r"\1 the \2 of it", text)
     text = re.sub(r"\b(upright|steady|steadily|firmly|securely|safely|upside up)\b", " ", text)
+    text = re.sub(r",?\s*\bfor (?:now|the moment|the time being)\b", " ", text)
     text = re.sub(r"\b(please|carefully|gently|slowly|now|just|again)\b", " ", text)
     text = re.sub(r"\b(?:pick|take|lift) up\b", "pick up", text)
     text = re.sub(r"\bset down\b", "put down", text)
@@ -242,6 +248,10 @@ class _ToClauses(Transformer):
 
     def back_where(self, _):
         return Where("back")
+
+    def spot_of(self, items):
+        # "where the cup was": the spot another object stands on (at the start).
+        return Where("spot_of", (NounPhrase(words=tuple(w for w in items if isinstance(w, str))),))
 
     def held(self, items):
         arm = next((i[1] for i in items if isinstance(i, tuple)), None)

@@ -35,7 +35,7 @@ VERB_SYNONYMS = {
     "pop": "put", "stick": "put", "rest": "put", "toss": "put", "position": "put", "situate": "put", "plop": "put",
     "pile": "stack", "pile up": "stack", "stack up": "stack", "shove": "push", "relocate": "move", "reposition": "move",
     "double over": "fold", "double": "fold", "fold up": "fold", "halve": "fold", "collect": "pick up", "fetch": "pick up",
-    "swap": "switch",
+    "swap": "switch", "load": "put", "slot": "put", "tuck": "put", "lower": "put",
 }
 #: Verbs whose inflections are read (the grammar's verbs and the synonyms').
 VERBS = (
@@ -58,7 +58,8 @@ _WHERE_VERBS = ("put", "place", "set", "leave", "lay", "lie", "position", "sit",
 #: Words that start a place (the end of a noun phrase a state clause names).
 _PLACE = (r"(?:in|into|inside|on|onto|upon|to|at|next to|beside|by|near|behind|between|left of|right of|in front of|"
           r"in back of|on top of|back|forward|forwards|where|down)")
-_BE = (r"(?:is|are|was|be|should be|must be|needs? to be|has to be|will be|has been|have been|should|must|"
+_BE = (r"(?:should end up|must end up|needs? to end up|ends? up|to end up|to be|is|are|was|be|should be|must be|needs? to be|has to be|"
+       r"will be|has been|have been|should|must|"
        r"ends? up|should end up|gets?|goes|go|should go|needs? to go|sits?|stands?|lies|rests?|is left|should be left)")
 _CLAUSE_START = r"(?:^|(?<=; )|(?<=, )|(?<=\band )|(?<=\bthen ))"
 #: Frames around an instruction that add nothing to it.
@@ -67,7 +68,7 @@ _FRAMES = [
     r"^(?:i want|i need|i'd like|i would like|we want|we need) (?:you )?(?:to )?", r"^(?:you should|you need to|you must|you have to) ",
     r"^(?:your|the) (?:job|task|goal) is (?:to )?", r"^(?:your |the )?(?:task|goal|job|end state|final state|target state)(?: ,)? ",
     r"^(?:make sure|ensure|see to it) (?:that )?", r"^(?:in|at) the end(?: ,)? ", r"^get to a state (?:where|in which) ",
-    r"^kindly ", r"^please ", r"^be so kind as to ", r"^(?:your |the )?(?:task|goal|job|end state|final state|target state)$", r"^(?:the robot|robot) (?:should|must|will) ", r"^let's ", r"^first(?: ,)? (?=the )",
+    r"^(?:so )?what i (?:want|need|'d like|would like)(?: you to do)? is (?:for you )?(?:to )?(?=\w+ )", r"^kindly ", r"^please ", r"^be so kind as to ", r"^(?:your |the )?(?:task|goal|job|end state|final state|target state)$", r"^(?:the robot|robot) (?:should|must|will) ", r"^let's ", r"^first(?: ,)? (?=the )",
 ]
 _TAILS = [r"(?: ,)? (?:thanks|thank you)(?: very much)?$", r" (?:for me|when you get a chance|if you can|at the end|please)$", r"(?: ,)? please$"]
 
@@ -179,6 +180,21 @@ def correct(word: str, vocabulary: frozenset[str]) -> str | None:
     return close[0] if len(close) == 1 else None
 
 
+#: Verbs a real word where a clause's verb goes may be a slip for ("poor" -> pour).
+_SLIP_VERBS = ("pour", "put", "place", "pick", "grab", "hand", "pass", "give", "move", "push", "slide", "fold", "lift", "hold", "take",
+               "drop", "fill", "stack", "carry", "bring", "tip", "empty", "insert")
+#: Words a side (left, right) comes before: a word one edit from a side there is that side.
+_SIDED = frozenset({"arm", "hand", "gripper", "side", "half", "edge", "corner", "one", "arms", "hands"})
+#: Words that start what a verb acts on.
+_OBJECT_STARTS = frozenset({"the", "a", "an", "it", "them", "both", "water", "some", "all", "everything", "up", "down"})
+
+
+def _slip(word: str) -> str | None:
+    """The one action verb ``word`` (an English word where a verb goes) is one edit from, or ``None``."""
+    close = [v for v in _SLIP_VERBS if len(word) >= 3 and abs(len(v) - len(word)) <= 1 and _distance(word, v) == 1]
+    return close[0] if len(close) == 1 else None
+
+
 #: Nouns of the table itself, the place noun an English word after "the" may be a slip for.
 _PLACE_NOUNS = ("table", "tabletop")
 
@@ -214,7 +230,7 @@ def _first_object(text: str, objects: frozenset[str]) -> str | None:
 
 _VERB_WORDS = frozenset(VERBS) | {"up", "down"}
 #: Words that cannot begin the subject of a verbless clause.
-_NOT_SUBJECT = frozenset({"with", "using", "use", "by", "left", "right", "both", "it", "them", "then", "and", "first", "the", "there"})
+_NOT_SUBJECT = frozenset({"with", "using", "use", "by", "left", "right", "both", "it", "them", "then", "and", "first", "the", "there", "to"})
 
 
 def _gerund_clause(clause: str) -> str:
@@ -281,6 +297,12 @@ def rewrite(text: str, vocabulary: frozenset[str] = frozenset(), objects: frozen
                 # An English word heading a noun phrase may still be a slip for the one place noun it is
                 # an edit from ("of the tale" -> table): places are not objects, whose names stay exact.
                 fixed = correct_place(word)
+            if fixed is None and (i == 0 or words[i - 1] in (",", ";", "then", "and")) and i + 1 < len(words) \
+                    and words[i + 1] in _OBJECT_STARTS and word not in vocabulary and is_word(word):
+                fixed = _slip(word)  # "poor water into the cup": a real word where a verb goes, one edit from one
+            if fixed is None and i + 1 < len(words) and words[i + 1] in _SIDED and word not in ("left", "right"):
+                sides = [s for s in ("left", "right") if _distance(word, s) == 1]  # "the lift arm", "rite hand": a side
+                fixed = sides[0] if len(sides) == 1 and len(word) >= 3 else None
             if fixed is not None:
                 out.corrected[word] = fixed
                 words[i] = fixed
@@ -310,8 +332,9 @@ def _sentence(s: str, steps: list[str], objects: frozenset[str]) -> str:
     # Possessives before an arm or a side: "the robot's right arm", "the plate's left side".
     s = _sub(r"\b(?:the )?(?:robot|robot's) (?=(?:left|right|other) (?:arm|hand|gripper))", "the ", s, steps, "possessive")
     s = _sub(r"\b(?:by|beside|next to|on|at) the (\w+) (left|right) side\b", r"to the \2 of the \1", s, steps, "possessive")
-    s = _sub(r"\bon (?:either|each|both) sides? of\b", "beside", s, steps, "reference")
-    s = _sub(r"^bimanual(?:ly)? (?=pour|fold|handover)", "with both arms , ", s, steps, "arm")
+    s = _sub(r"\b(?:on |at |to )?(?:either|each|both) sides? of\b", "beside", s, steps, "reference")
+    s = _sub(r"^(?:bimanual(?:ly)?|two-?handed|two-?arm(?:ed)?|dual-?arm) (?=pour|fold|handover)", "with both arms , ", s, steps, "arm")
+    s = _sub(r"^(?:one-?handed|single-?arm(?:ed)?|one-?arm(?:ed)?) (?=pour|fold|handover)", "", s, steps, "arm")
     # Spatial selection: "the block on the left" -> "the left block" before another place.
     s = _sub(r"\bthe (\w+) (?:on|at|to) the (left|right|front|back)(?= (?:into|in|onto|on|next|beside|to|behind|near)\b)", r"the \2 \1", s, steps, "reference")
     s = _sub(r"\bthe (\w+) (?:nearer|closer to|nearest to|closest to) the (front|back)\b", r"the \2 \1", s, steps, "reference")
@@ -332,14 +355,16 @@ def _sentence(s: str, steps: list[str], objects: frozenset[str]) -> str:
         clause = _sub(r"^(?:leave|have|get|keep) (the .+?) (?:sitting|standing|lying|resting|placed|put|positioned|set|left|laid)\b ?(?:so (?:that )?it(?: is|'s)? (?:standing|lying|sitting|upright) )?", r"put \1 ", clause, steps, "state")
         clause = _sub(r"^(put|set|place|lay) (the .+?) down so (?:that )?it(?: is|'s)? (?:standing|lying|sitting|resting) ", r"\1 \2 ", clause, steps, "state")
         clause = _sub(r" (?:standing|sitting|lying|resting|upright)(?= (?:on|in|where|back|at|inside|next|beside)\b)", "", clause, steps, "state")
-        state = _state_to_imperative(clause, objects)
+        then = "then " if clause.startswith("then ") else ""  # "Then the tray goes forward."
+        state = then + _state_to_imperative(clause.removeprefix("then "), objects)
         if state != clause:
             steps.append("declarative")
             clause = state
         elif objects and not after_and and (head := re.match(rf"^(?:the )?((?:[a-z_]+ ){{0,2}}?([a-z_]+)) (?={_PLACE}\b|left of|right of)", clause)):
             # "red block on blue block": a scene without a verb.
             if head[2] in objects and not any(lemma(w) in _VERB_WORDS or w in _NOT_SUBJECT for w in head[1].split()):
-                clause = "put " + (clause if clause.startswith("the ") else "the " + clause)
+                verb = "move " if re.search(r" (?:forward|forwards|ahead|closer)$", clause) else "put "  # "the tray forward": a way
+                clause = verb + (clause if clause.startswith("the ") else "the " + clause)
                 steps.append("declarative")
         parts[i] = clause.strip()
     return "".join(parts)
@@ -349,6 +374,11 @@ def _temporal(s: str, steps: list[str], objects: frozenset[str]) -> str:
     s = _sub(r"(?: ,)? (?:and )?(?:once|when|after) (?:that(?: is|'s)?|this(?: is|'s)?|it(?: is|'s)?) (?:done|finished|complete)\b ,?|(?: ,)? (?:and )?,? (?:once|when) done ,?", " then ", s, steps, "temporal")
     s = re.sub(r"^(?:once|when|after) (?:that|this)(?: is|'s)? (?:done|finished|complete)(?: ,)? ", "", s)
     s = _sub(r"^first(?: ,)? (.+?)(?: ,)? (?:then|and then|afterwards) ", r"\1 then ", s, steps, "temporal")
+    # "put it on the target, but first pass it to the right arm": the step said "first" is done first.
+    m = re.match(r"^(.+?) , (?:but |and )?first(?: ,)? (\w+) (.+)$", s)
+    if m and lemma(m[2]) in VERBS:
+        steps.append("temporal")
+        return f"{_swap_pronoun(f'{lemma(m[2])} {m[3]}', m[1], objects)} then {m[1]}"
     # "A while the left arm holds B": the holding starts first.
     m = re.match(r"^(.+?)(?: ,)? while (the (?:left|right|other) (?:arm|hand|gripper) (?:hold|keep|grasp|grip)s? .+)$", s)
     if m:
@@ -401,6 +431,21 @@ def _once(clause: str, objects: frozenset[str]) -> str:
     return _gerund_clause(clause)
 
 
+#: "put the red one in (with the left arm)": into what was last put into.
+_IN_ALONE = re.compile(r"\b((?:put|place|drop|set|insert|pop|toss) (?:the [a-z]+(?: [a-z]+)?|it|them) (?:in|into|inside))(?= with\b| ,| ;| then\b|$)")
+
+
+def _container_again(s: str, steps: list[str]) -> str:
+    """``drop the blue block in the cup ; put the red one in`` -> ``... put the red one in the cup``."""
+    while (m := _IN_ALONE.search(s)) is not None:
+        hosts = re.findall(r"\b(?:in|into|inside) (the [a-z]+(?: (?!with\b|then\b|and\b)[a-z]+)?)\b", s[: m.start()])
+        if not hosts:
+            break
+        steps.append("ellipsis")
+        s = f"{s[: m.end()]} {hosts[-1]}{s[m.end():]}"
+    return s
+
+
 def _ellipsis(s: str, steps: list[str], objects: frozenset[str]) -> str:
     """``V the A WHERE , and the B too`` -> ``V the A WHERE , V the B WHERE``."""
     def previous_clause(head: str) -> tuple[str, str] | None:
@@ -424,10 +469,21 @@ def _ellipsis(s: str, steps: list[str], objects: frozenset[str]) -> str:
         verb, where = found
         return f"{m[1]} then {verb} {m[2]} {where}".rstrip()
 
-    s = re.sub(r"^(.+?)(?: ,| ;)? (?:and )?(?:do )?(?:the )?same (?:with|for) (the [a-z ]+?)$", again, s)
+    s = re.sub(r"^(.+?)(?: ,| ;)? (?:and )?(?:then )?(?:do )?(?:the )?same (?:with|for) (the [a-z ]+?)$", again, s)
+    s = _container_again(s, steps)
     s = re.sub(r"^(.+?)(?: ,)? (?:and )?(the [a-z ]+?) (?:too|as well|also)$", again, s)
+    m = re.match(r"^(.+?) , (?:and )?then (the [a-z ]+?)(?: (with the (?:left|right|other) arm))?$", s)
+    found = previous_clause(m[1]) if m and any(w in objects or w == "one" for w in m[2].split()[1:]) else None
+    if m and found is not None:  # "put the red block in the cup with the right arm, then the blue one with the left arm"
+        steps.append("ellipsis")
+        verb, where = found
+        where = re.sub(r"\s*\bwith the (?:left|right|other) arm\b", "", where)
+        s = f"{m[1]} then {verb} {m[2]} {where} {m[3] or ''}".strip()
     m = re.match(r"^(\w+) (the [a-z ]+?) , (?:and )?then (the [a-z ]+?) , (.+)$", s)
-    if m:
+    if m and (lemma(m[4].removeprefix("and ").split()[0]) in VERBS):  # "grab the fork, then the spoon, and line them up ...": a step of its own
+        steps.append("ellipsis")
+        s = f"{m[1]} {m[2]} then {m[1]} {m[3]} then {m[4].removeprefix('and ')}"
+    elif m:
         steps.append("ellipsis")
         s = f"{m[1]} {m[2]} {m[4]} then {m[1]} {m[3]} {m[4]}"
     return s

@@ -79,12 +79,16 @@ class Context:
         #: Objects picked up, poured from or handed over and not yet put down, last taken last:
         #: what ``put it down`` puts down.
         self.in_hand: list[str] = []
+        #: Objects taken, moved or placed so far: a put-back of any other is already done (it never left its place).
+        self.touched: set[str] = set()
         #: The head noun last named (``block``): what ``the big one`` is one of.
         self.last_kind: str | None = None
         #: How each phrase was read, for ``plan --explain``.
         self.read: list[tuple[str, str, str]] = []
         #: A cloth whose part was taken (``take the near corners of the towel``): a place of it on its other part folds it.
         self.cloth_taken: str | None = None
+        #: The side (``left``, ``right``) each anchor last had something put beside it: "the other side" is the other.
+        self.sides: dict[str, str] = {}
         #: The object last placed beside (``on the right`` later in the instruction is its right).
         self.last_anchor: str | None = None
 
@@ -96,6 +100,7 @@ class Context:
         return InstructionNotGroundedError(self.instruction, f"{words.strip()!r} {problem}")
 
     def take(self, name: str) -> None:
+        self.touched.add(name)
         if name in self.in_hand:
             self.in_hand.remove(name)
         self.in_hand.append(name)
@@ -223,6 +228,9 @@ class Context:
         region_words = set(words) & (kb.PART_WORDS | set(kb.DIRECTION_WORDS))
         if not of_table and not set(words) & (set(kb.DIRECTION_WORDS) | kb.TABLE_WORDS | {"center", "middle"}):
             return False  # "the spot", "the area": a part of nothing said; not the table
+        if of_table and set(np.words) - kb.PART_WORDS - set(kb.DIRECTION_WORDS) - kb.TABLE_WORDS - FILLER_WORDS - set(POSITION_WORDS) \
+                - {"center", "middle", "very", "far", "near", "top", "bottom", "other"}:
+            return False  # "the rite side of the table": a word that names no part of it (not the table itself)
         if of_table or (np.of is None and np.words and set(np.words) <= kb.PART_WORDS | set(kb.DIRECTION_WORDS) | kb.TABLE_WORDS and region_words):
             return kb.table_point(words) or (kb.TABLE_CENTER if set(words) & {"center", "middle"} else None)
         return False
