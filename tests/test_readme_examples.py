@@ -34,8 +34,8 @@ def _run_lines() -> list[str]:
 PROMISES = {
     "run single_arm_pour_water --strategy agentchord --p 0.1 --seed 10": (
         EpisodeSpec("single_arm_pour_water", seed=10, disturbances=DisturbanceSetting(p=0.1)), {"kinds": 1, "recoveries": 1}),
-    "run handover_block --protocol stress --seed 2": (
-        EpisodeSpec("handover_block", seed=2, disturbances=DisturbanceSetting.from_options(protocol="stress")),
+    "run handover_block --protocol stress --seed 6": (
+        EpisodeSpec("handover_block", seed=6, disturbances=DisturbanceSetting.from_options(protocol="stress")),
         {"kinds": 2, "recoveries": 1}),
     "run blocks_and_cup --instruction \"stack the red block on the blue block\" --seed 1": (None, {"success": True}),
     "run setup_coffee_tray --goal examples/goals/coffee_capsule_in_tray.yaml": (None, {"success": True}),
