@@ -572,11 +572,13 @@ WHY = {
     "F-008": "'pour about half of it into the cup': a stated fraction of the water; poured states no amount",
     "F-009": "no blue cup in the scene (only the red cup)",
     "F-014": "'maybe a third of a cup': a stated amount; poured states no amount",
-    "F-018": "'pick the cup up ... and hold it there': an end with the cup held in the air cannot be said (a goal spec ends at home, a held object is put back)",
+    "F-018": "'pick the cup up ... and hold it there': an end with the cup held in the air cannot be said "
+    "(a goal spec ends at home, a held object is put back)",
     "F-027": "no knife in the scene",
     "F-035": "no cup in the handover scene",
     "F-044": "no coffee machine in the scene; making an espresso is not a goal",
-    "F-050": "picking the folded towel up and putting it down to the right: the cloth is only its corner points and folded; no goal moves a cloth (the fold alone would be sayable, not the whole)",
+    "F-050": "picking the folded towel up and putting it down to the right: the cloth is only its corner points and folded; "
+    "no goal moves a cloth (the fold alone would be sayable, not the whole)",
     "F-052": "no drawer in the scene",
     "F-060": "no green block in the scene (only a red and a blue block)",
 }
