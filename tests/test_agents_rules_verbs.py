@@ -6,35 +6,12 @@ The sentences here are this file's own (not the blind evaluation set's, which is
 
 from __future__ import annotations
 
-from functools import cache
-
-import numpy as np
 import pytest
 
 from agentchord.agents.exceptions import InstructionNotGroundedError
-from agentchord.agents.observe import observe, task_regions
-from agentchord.agents.rules.corpus import canonical
 from agentchord.agents.rules.instructions import ground_instruction, read_instruction
-from agentchord.agents.scene import Scene
-from agentchord.sim.tasks import SIM_TASKS
-from agentchord.sim.world import SimWorld
+from grounding import goal, same, scene
 
-
-@cache
-def scene(task: str) -> Scene:
-    sim = SIM_TASKS[task]
-    return observe(SimWorld(sim.sample_scene(np.random.default_rng([0, 0x5CE7E]))), task_regions(sim))
-
-
-def goal(task: str, text: str) -> list[dict]:
-    return [g.model_dump(exclude_defaults=True) | {"kind": g.kind} for g in ground_instruction(text, scene(task)).goals]
-
-
-def same(task: str, reference: str, variants: list[str]) -> None:
-    """Each variant grounds to the reference's goal (a run of put-backs states no order)."""
-    want = canonical(ground_instruction(reference, scene(task)))
-    for text in variants:
-        assert canonical(ground_instruction(text, scene(task))) == want, text
 
 SAME = [
     ("blocks_and_cup", "put the red block into the cup",
