@@ -88,7 +88,7 @@ def test_a_fallen_grasp_stopped_above_the_bottle_by_the_other_arm_is_held_back(s
 
 
 @pytest.mark.parametrize("asks_the_arm_alone", [True, pytest.param(False, marks=pytest.mark.slow)])
-def test_an_arm_that_would_not_reach_the_grasp_alone_is_not_held_back(asks_the_arm_alone, monkeypatch):
+def test_an_arm_that_would_not_reach_the_grasp_alone_is_not_held_back(asks_the_arm_alone, monkeypatch, numerics_before_lean_solves):
     # Stress protocol, single-arm pour, seed 86: the bottle lies 23 cm left of the centre, beyond
     # the right arm; stretched towards it, the right arm comes near the idle left one. Not held back
     # (the right arm alone does not reach it), the grasp fails at once and the left arm takes the

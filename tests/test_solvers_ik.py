@@ -38,7 +38,7 @@ class _MinkStep(BimanualIK):
     def _qp_velocity(self, tasks, guarded, only=None):
         assert only is None
         limits = [*self.limits, self.arm_collision_limit] if guarded else self.limits
-        return mink.solve_ik(self.configuration, tasks, self.dt, solver="daqp", damping=DAMPING, limits=limits)
+        return mink.solve_ik(self.configuration, tasks, self.dt, solver="daqp", damping=DAMPING, limits=limits), False
 
 
 #: Every iteration, both arms in every QP: the solver as mink's own loop runs it.

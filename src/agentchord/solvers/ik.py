@@ -52,7 +52,8 @@ LIVE_CONVERGED_STEP = 1e-5
 #: the tool by microns.
 ARRIVED_POSITION = 1e-4
 ARRIVED_ROTATION = 1e-3
-#: A clearance row of the IK's QP is active (binds the solution) when its slack is under this (rad/s · s).
+#: A clearance row of the IK's QP binds the solution when its slack (its bound minus the row times the
+#: step, in the bound's units) is under this.
 CLEARANCE_ACTIVE = 1e-9
 #: DAQP's "no lower bound" on a constraint row (what qpsolvers passes for ``G x <= h``).
 NO_LOWER_BOUND = -1e30
@@ -125,7 +126,6 @@ class BimanualIK:
             self.converged_step = LIVE_CONVERGED_STEP
         # Arms that held still at the last solve: their target unchanged and their joints unmoved by it.
         self._still: set[str] = set()
-        self._clearance_binds = False  # whether the last QP's solution met the arms' clearance limit
         # What every QP shares (see _qp_velocity): the posture task's weighted Jacobian (its Jacobian
         # is the identity) and the joint limits' constraint rows, built as mink builds them.
         nv = self.model.nv
@@ -226,12 +226,12 @@ class BimanualIK:
         only = None if len(moving) == len(ARM_PREFIX) else moving[0]
         start = self.configuration.q.copy()
         for _ in range(self.iterations):
-            velocity = self._qp_velocity(tasks, guarded, only)
-            if only is not None and self._clearance_binds:
+            velocity, held_back = self._qp_velocity(tasks, guarded, only)
+            if held_back:
                 # The arms' clearance stopped the moving arm: the still arm joins the QP so that both
                 # make way, as the whole QP has them (alone, the moving arm's approach is slower).
                 tasks, moving, only = [self.posture, *self.tasks.values()], list(self.tasks), None
-                velocity = self._qp_velocity(tasks, guarded, only)
+                velocity, _ = self._qp_velocity(tasks, guarded, only)
             self.configuration.integrate_inplace(velocity, self.dt)
             if self.converged_step is not None and float(np.max(np.abs(velocity))) * self.dt < self.converged_step:
                 break
@@ -275,7 +275,7 @@ class BimanualIK:
         cosine = 0.5 * (float(self._target_rotation[arm] @ data.site_xmat[site]) - 1.0)
         return cosine > np.cos(ARRIVED_ROTATION)
 
-    def _qp_velocity(self, tasks: list[mink.Task], guarded: bool, only: str | None = None) -> np.ndarray:
+    def _qp_velocity(self, tasks: list[mink.Task], guarded: bool, only: str | None = None) -> tuple[np.ndarray, bool]:
         """One differential-IK step: what ``mink.solve_ik(configuration, tasks, dt, solver="daqp",
         damping=DAMPING, limits=...)`` returns, bit for bit.
 
@@ -291,6 +291,10 @@ class BimanualIK:
             only: Solve this arm's joints alone, every other joint held (its velocity 0): the same
                 QP with the other columns, their joint-limit rows and the still arm's frame task
                 taken out (``tasks`` then holds only this arm's frame task).
+
+        Returns:
+            The joint velocity, and whether the arms' clearance held the one arm ``only`` solves
+            back (a clearance row binds its solution; always False for the whole QP).
 
         Raises:
             mink.NoSolutionFound: DAQP found no solution.
@@ -331,16 +335,15 @@ class BimanualIK:
         step, _, exitflag, _ = daqp.solve(hessian, gradient, rows, bounds, no_lower, kinds, primal_start=None)
         if exitflag <= 0:
             raise mink.NoSolutionFound("daqp")
-        # Whether a clearance row is active at the solution (the limit held an arm back).
-        self._clearance_binds = False
-        if guarded and clearance.h.size:
-            slack = bounds[-clearance.h.size :] - rows[-clearance.h.size :] @ step
-            self._clearance_binds = bool(np.min(slack) < CLEARANCE_ACTIVE)
         if only is None:
-            return step / self.dt
+            return step / self.dt, False
         velocity = np.zeros(nv)
         velocity[dofs] = step / self.dt
-        return velocity
+        held_back = False
+        if guarded and clearance.h.size:
+            slack = bounds[-clearance.h.size :] - rows[-clearance.h.size :] @ step
+            held_back = bool(np.min(slack) < CLEARANCE_ACTIVE)
+        return velocity, held_back
 
     def _daqp_rows(self, count: int) -> tuple[np.ndarray, np.ndarray]:
         """DAQP's lower bounds (none) and constraint kinds (plain inequalities) of ``count`` rows, built once per count."""
