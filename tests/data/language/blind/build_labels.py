@@ -1,6 +1,6 @@
 """Label the blind evaluation set (issue 59): the goal each instruction means, written to labels.yaml.
 
-The six writers' files (writer_A.yaml ... writer_F.yaml) hold 330 instructions, each with the
+The seven writers' files (writer_A.yaml ... writer_F.yaml and writer_H.yaml) hold 390 instructions, each with the
 writer's own ``meaning`` (the intended end state) and ``possible``. This script states, per id, the
 goal the instruction means as a goal spec's goals (``agentchord schema goal``), written with the
 label helpers of ../build_corpus.py and its conventions (docs/language.md): ``put X down``/``back``
@@ -527,6 +527,97 @@ LABELS: dict[str, object] = {
     "F-058": [rel(B, "blue_block", "cup", "left"), rel(B, "red_block", "blue_block", "left")],
     "F-059": [hand("red_block", "left", "right"), rel(B, "red_block", "cup", "right", "right")],
     "F-060": REFUSE,
+    # --- writer H ----------------------------------------------------------------------------
+    "H-001": POUR1,
+    "H-002": POUR1,  # "a little water": a vague amount, a pour; "stand the bottle back up": put back
+    "H-003": [pour(arm="right"), put("bottle", "right")],  # "Right arm:" heads grasp, pour, return
+    "H-004": POUR1,  # end state: water in the cup, the bottle standing where it is now (as F-006)
+    # "Use your left hand to pick up the bottle and fill the cup with it, then put it back": the bottle is
+    # taken by the said arm, so the pour and the put-back are the left arm's (as A-007); "fill": no amount.
+    "H-005": [pour(arm="left"), put("bottle", "left")],
+    # The cup beside the bottle on its left (the side it is on), then the pour into it ("it": the cup) and
+    # the bottle back (as C-005).
+    "H-006": [rel(P1, "cup", "bottle"), pour(), put("bottle")],
+    "H-007": REFUSE,
+    "H-008": [pour(arm="right"), put("bottle", "right")],  # "Take the bottle with right hand": as E-005
+    "H-009": POUR1,  # "give the cup a drink from the bottle": a pour
+    # "Left arm, lift the cup. Right arm, pour ..., then put both back down": the address heads its
+    # sentence, so the put-down is said for the right arm (as C-001), which holds only the bottle; the
+    # cup goes down by the left arm that lifted it (each by the arm holding it, as C-009). Unlike D-009
+    # and F-010, the put-down is in the addressed sentence.
+    "H-010": [pour(arm="right", hold=True), put("cup", "left"), put("bottle", "right")],
+    "H-011": POUR2,  # "Hold the cup up ... a little water": held cup, a vague amount, arms unsaid
+    "H-012": POUR2,  # "grab the cup with one hand and pour ... with the other": no arm named (as B-013, F-013)
+    # Both taken by said arms (cup left, bottle right): the right arm pours with the cup held, each puts
+    # its own down (as C-013).
+    "H-013": [pour(arm="right", hold=True), put("cup", "left"), put("bottle", "right")],
+    "H-014": [hand("cup", "left", "right"), rel(P2, "cup", "bottle", "beside", "right")],  # as B-011
+    "H-015": REFUSE,
+    "H-016": POUR2_LR,  # "the cup you lift with left, and right hand pour ..., after both put on table" (as A-013)
+    "H-017": POUR2,  # end state and "pour while the cup's off the table": held cup, arms unsaid
+    "H-018": SETTING,  # "like a proper table setting" (as F-021)
+    "H-019": SETTING,  # "both pointing away from you": the setting convention (turned along y)
+    # "tines facing away", "same orientation": turned along y; which end is which is not sayable (as E-021).
+    "H-020": SETTING_ARMS,
+    "H-021": [SPOON_R],  # "next to the plate": on the side the spoon is on (its right)
+    "H-022": [on("spoon", "plate")],
+    # Swap the two places: absolute points, each the other's start (as B-012, E-016), in the order said
+    # (the spoon first); no yaw is said.
+    "H-023": [at_xy("spoon", *spot(T, "fork")), at_xy("fork", *spot(T, "spoon"))],
+    # No giver said: the arm that picks it up, the left (the fork lies on the left); the right arm, which
+    # receives it, lays it right of the plate (as F-026).
+    "H-024": [hand("fork", "left", "right"), rel(T, "fork", "plate", "right", "right")],
+    "H-025": REFUSE,
+    "H-026": SETTING,  # "tidy up the cutlery ... fork on the plate's left and the spoon on its right"
+    "H-027": HANDOVER,  # "with ur left hand, pass it to the right one and drop it on the target"
+    "H-028": TARGET,  # "standing up inside the marked target circle": placed stands it upright anyway
+    "H-029": HANDOVER,
+    # "don't use your left arm": with two arms, the right arm alone, no handover (as C-028 "use right arm only").
+    "H-030": [region("block", "target", "right")],
+    "H-031": HANDOVER,
+    "H-032": TARGET,  # "the circle thing": the scene's one region (as F-031)
+    "H-033": REFUSE,
+    # "lift the block up high" (manner), "switch it into your other hand": left to right (the block is on
+    # the left; as A-024, F-032); "set it down standing up in the target zone".
+    "H-034": HANDOVER,
+    "H-035": COFFEE,  # "carry the tray forward a bit with both hands": the forward spot
+    "H-036": [into("capsule", "tray")],  # "pod": the capsule; the tray stays
+    "H-037": TRAY_FWD,  # "scoot it back a little, away from you": the forward spot (as A-031)
+    "H-038": COFFEE,  # end state: capsule in the tray, the tray "a bit further away from me": the forward spot
+    # "Left hand:" heads the capsule step only; "about ten centimetres farther out": the forward spot (12 cm; as C-032).
+    "H-039": COFFEE_LEFT,
+    "H-040": COFFEE,  # "a touch further back" = away from the robot: the forward spot (as A-031, E-037)
+    # The order said: the tray carried to the forward spot first, then the capsule into it there.
+    "H-041": [region("tray", "forward"), into("capsule", "tray")],
+    "H-042": COFFEE_LEFT,  # capsule "with left arm"; "two arms take tray and bring more far": the forward spot (as E-039)
+    "H-043": FOLD,
+    # "half as deep, with the fold along the side furthest from me": the crease on the far side is the far
+    # half laid over onto the near half (near corners onto far corners leave the crease near: E-046, F-051).
+    # The writer's meaning says near corners onto far corners; the instruction's words decide: refused.
+    "H-044": REFUSE,
+    "H-045": FOLD,  # each arm a near corner, onto the far corners
+    "H-046": FOLD,  # "like a sandwich": in half, direction unsaid: the natural fold (as A-038)
+    "H-047": REFUSE,
+    "H-048": FOLD,  # "bring the bottom corners up to the top ones" (as F-047)
+    "H-049": FOLD,  # the two near corners onto the two far corners
+    "H-050": REFUSE,
+    "H-051": [into("red_block", "cup")],
+    "H-052": [on("red_block", "blue_block")],
+    # "the bigger block on top of the smaller one": blue (4.5 cm) on red (4 cm), the sizes the scene states.
+    "H-053": [on("blue_block", "red_block")],
+    "H-054": [hand("red_block"), into("red_block", "cup", "right")],  # as B-049
+    # "the block that's closest to me": the blue one (y 0.41; the red one is at 0.48).
+    "H-055": [rel(B, "blue_block", "cup", "right")],
+    "H-056": [into("blue_block", "cup"), rel(B, "red_block", "cup", "left")],
+    "H-057": [into("red_block", "cup")],  # "the bowl": the bowl-like white cup (as C-048)
+    # "a little closer to me": a 10 cm nudge towards the robot (as D-031); then the red block beside the cup
+    # where it now stands, side unsaid: the side the red block is on (its left).
+    "H-058": [nudge(B, "cup", "front"), rel(B, "red_block", "cup")],
+    # Into the cup and out again onto the blue block: the put-in is undone later (as D-056): refused.
+    "H-059": REFUSE,
+    # Each block taken by a said arm; swap: absolute points, each the other's start (as B-012), in the order
+    # named (red first), each put by the arm that holds it.
+    "H-060": [at_xy("red_block", *spot(B, "blue_block"), "left"), at_xy("blue_block", *spot(B, "red_block"), "right")],
 }
 
 #: Why each refused entry is refused.
@@ -581,11 +672,21 @@ WHY = {
     "no goal moves a cloth (the fold alone would be sayable, not the whole)",
     "F-052": "no drawer in the scene",
     "F-060": "no green block in the scene (only a red and a blue block)",
+    "H-007": "no orange juice in the scene (the only bottle holds water)",
+    "H-015": "the bottle (5 cm wide, 17 cm tall) does not fit inside the cup (5 cm wide, 9.5 cm tall)",
+    "H-025": "no knife in the scene",
+    "H-033": "no green block in the scene (the block on the target alone would be sayable, not the whole)",
+    "H-044": "a fold with the crease along the far side (the far half laid onto the near half): folded is only near corners "
+    "onto far corners, which leaves the crease near",
+    "H-047": "a side fold (left side onto right side): folded is only near corners onto far corners",
+    "H-050": "no cup in the towel scene (the fold alone would be sayable, not the whole)",
+    "H-059": "into the cup and then out onto the blue block: goals are kept once achieved, so a put-in undone later cannot be "
+    "said (the end state alone, red on blue, would be sayable, not the whole)",
 }
 
 HEADER = """# Labels of the blind evaluation set (issue 59). Built by build_labels.py; do not edit by hand.
 #
-# For each instruction of writer_A.yaml ... writer_F.yaml (six writers, 330): its scene, and the goal it means
+# For each instruction of writer_A.yaml ... writer_F.yaml and writer_H.yaml (seven writers, 390): its scene, and the goal it means
 # as a goal spec's goals (`agentchord schema goal`), or expect: refused with why (the scene cannot
 # do it, or the goal language cannot say it). Written from the instruction and the writer's
 # `meaning` by a labeller who did not write them, following build_corpus.py's label conventions
@@ -601,10 +702,10 @@ def _scene_obs(task: str):
 
 def main() -> None:
     entries = []
-    for name in ("A", "B", "C", "D", "E", "F"):
+    for name in ("A", "B", "C", "D", "E", "F", "H"):
         entries += yaml.safe_load((HERE / f"writer_{name}.yaml").read_text(encoding="utf-8"))["entries"]
     ids = [e["id"] for e in entries]
-    assert len(ids) == len(set(ids)) == 330, len(ids)
+    assert len(ids) == len(set(ids)) == 390, len(ids)
     assert set(LABELS) == set(ids), (set(ids) - set(LABELS), set(LABELS) - set(ids))
     assert set(WHY) == {k for k, v in LABELS.items() if v == REFUSE}, set(WHY) ^ {k for k, v in LABELS.items() if v == REFUSE}
     scenes: dict = {}
@@ -628,7 +729,7 @@ def main() -> None:
         counts[eid[0], "labelled"] += 1
     text = yaml.dump({"labels": labels}, Dumper=_Dumper, sort_keys=False, width=200, allow_unicode=True)
     (HERE / "labels.yaml").write_text(HEADER + text, encoding="utf-8")
-    for name in "ABCDEF":
+    for name in "ABCDEFH":
         print(f"writer {name}: {counts[name, 'labelled']} labelled, {counts[name, 'refused']} refused")
     print(f"labels.yaml: {len(labels)} entries")
 
