@@ -48,13 +48,13 @@ def _percentile(values: list[float], q: float) -> float:
 def main() -> None:
     args_parser = argparse.ArgumentParser(description=__doc__)
     args_parser.add_argument("--part", choices=("test", "dev", "all", "blind", "blind-final"), default="test",
-                             help="blind: the blind set's writers A-E (read for kinds of failure); blind-final: its held-out writer F")
+                             help="blind: the blind set's development writers (read for kinds of failure); blind-final: its held-out writer H")
     args_parser.add_argument("--repeats", type=int, default=3, help="timed passes after the warm-up (best of)")
     args_parser.add_argument("-v", "--verbose", action="store_true", help="list what is refused or wrong")
     args = args_parser.parse_args()
     parts = ("test", "dev") if args.part == "all" else (args.part,)
     if args.part.startswith("blind"):
-        entries = corpus.load_blind(DATA / "blind", "F" if args.part == "blind-final" else "ABCDE")
+        entries = corpus.load_blind(DATA / "blind", corpus.BLIND_FINAL if args.part == "blind-final" else corpus.BLIND_DEVELOPMENT)
     else:
         entries = [e for part in parts for e in corpus.load(DATA / f"corpus_{part}.yaml")]
     outcomes = [corpus.evaluate(e, scene(e["task"])) for e in entries]  # warm-up: grammar, scenes, vocabularies

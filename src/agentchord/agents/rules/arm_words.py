@@ -32,6 +32,15 @@ from agentchord.agents.rules.rewrite_steps import Note, sub
 _PART = r"(?:arm|hand|gripper|of|side|half|edge|corner|corners|end|part|area|region)s?"
 #: An arm named by its side alone, after a hand-over or "with": "to your right", "with the other".
 _ARM_ELLIPSIS = [
+    # "move the block from one hand to the other": whatever the verb, the object goes from arm to arm: a hand-over.
+    (re.compile(r"\b(?:move|shift|bring|transfer|switch|swap|carry|take|pass|hand|give) (it|them|the [a-z]+(?: [a-z]+)?) "
+                r"(?:from one (?:arm|hand|gripper|side) (?:to|into) the other(?: one| arm| hand| gripper| side)?|"
+                r"from (?:hand|arm|gripper) to (?:hand|arm|gripper))\b"), r"hand \1 over"),
+    # "pass it from one hand to the other", "from hand to hand": a hand-over, the giver the planner's to choose.
+    (re.compile(r"\b(?:from one (?:arm|hand|gripper|side) (?:to|into) the other(?: one| arm| hand| gripper| side)?|"
+                r"from (?:hand|arm|gripper) to (?:hand|arm|gripper)|between (?:the |your |its )?(?:two )?(?:hands|arms|grippers))\b"), "over"),
+    # "give it to right arm", "with left hand": an arm said without its determiner.
+    (re.compile(r"\b(to|with|using|from|by|into|over to) (left|right) (arm|hand|gripper)\b"), r"\1 the \2 \3"),
     # "pass to right", "hand over to the left one": the object is the one in hand.
     (re.compile(r"(?:^|(?<= , )|(?<=\band )|(?<=\bthen ))(hand|pass|give|transfer)(e?s?) (?:over |across )?to "
                 r"(?=(?:the |your )?(?:left|right|other)(?: one| arm| hand| gripper)?\b(?! (?:side|of|half|edge|corner)))"), r"\1\2 it over to "),
@@ -83,8 +92,23 @@ def each_arm(s: str, note: Note) -> str:
     return sub(_EACH_ARM, lambda m: f"{m[5]} {m[2]} {m[6]} with the {m[1]} arm , {m[5]} {m[4]} {m[6]} with the {m[3]} arm", s, note, "arm")
 
 
+#: "..., then use both hands to carry the tray": an arm asked for inside a sentence, for the step after it.
+_USE_TO = re.compile(r"(?:(?<= , )|(?<=\bthen )|(?<=\band ))(?:use|using) (?:your |the )?(left|right|both|two) (?:arm|hand|gripper)s? "
+                     r"(?:to|and) (\w+)\b([^,]*?)(?= ,|$| then\b)")
+
+
+#: "pick up both of them, the cup in your left and the bottle in your right": the pronoun is the list after it.
+_EACH_NAMED = re.compile(r"\b(pick up|pick|take|grab|grasp|hold|lift)(?: up)? (?:both|them|them both|the two|both of them)(?: up)? , "
+                         r"(?:the )?([a-z]+) with the (left|right) arm(?: ,)? and (?:the )?([a-z]+) with the (left|right) arm\b")
+
+
+def _with(arm: str) -> str:
+    return "with both arms" if arm in ("both", "two") else f"with the {arm} arm"
+
+
 def read_arms(s: str, note: Note) -> str:
     """``s`` (one sentence) with the arms it names in the grammar's words (see the module)."""
+    s = sub(_USE_TO, lambda m: f"{m[2]}{m[3]} {_with(m[1])}", s, note, "arm")
     s = sub(_SECOND_SUBJECT, " , ", s, note, "arm")
     s = sub(_ARM_THEN, r"then \1 ", s, note, "order")
     s = sub(_TAKE_FROM[0], r"hand \2 over to the \1 arm", s, note, "arm")
@@ -96,6 +120,7 @@ def read_arms(s: str, note: Note) -> str:
         note("order")
     for pattern, repl in _ARM_ELLIPSIS:
         s = sub(pattern, repl, s, note, "arm")
+    s = sub(_EACH_NAMED, r"\1 the \2 with the \3 arm and the \4 with the \5 arm", s, note, "arm")
     while (again := _ARM_AGAIN.search(s)) is not None:
         arms = _LAST_ARM.findall(s[: again.start()])
         if not arms:

@@ -27,7 +27,12 @@ _FOLD_WAY = re.compile(r"(?:^|(?: ,)? )(?:towards? |to )(?:the )?(?:top|far|back
                        r"(?:^|(?: ,)? )(?:from )?(?:near|front|bottom)(?: edge| side)?(?: to| onto| over)? (?:far|back|top)(?: edge| side)?(?= ,|$)")
 #: A cloth's parts, as the rules name them (bottom = near the robot, top = far).
 _CLOTH_PARTS = [
-    (re.compile(r"\b(?:the )?(?:two )?corners? (?:closest|nearest|nearer|closer) to (?:you|me|the robot)\b"), "the bottom corners"),
+    (re.compile(r"\b(?:the )?(?:two )?corners?(?: of (?:the (?:towel|cloth|napkin)|it))? (?:closest|nearest|nearer|closer) to (?:you|me|the robot)\b"),
+     "the bottom corners"),
+    (re.compile(r"\b(?:the )?(?:two )?corners?(?: of (?:the (?:towel|cloth|napkin)|it))? (?:farthest|furthest) (?:from|away from) (?:you|me|the robot)\b"),
+     "the top corners"),
+    # "bring them over to the other side": of a cloth whose near part is moved, the far side.
+    (re.compile(r"\b(?:to|onto|over to|across to) the (?:other|opposite) (side|edge|end)\b"), r"onto the top \1"),
     (re.compile(r"\b(?:the )?(?:two )?(?:far|farthest|furthest) ones\b"), "the top corners"),
     (re.compile(r"\b(?:near|front|bottom)[- ](left|right) corner\b"), r"bottom \1 corner"),
     (re.compile(r"\b(?:far|back|top)[- ](left|right) corner\b"), r"top \1 corner"),
@@ -44,8 +49,25 @@ _FOLD_BY_PARTS = re.compile(r"\bbottom (?:corners|edge|side|half|end)\b.*\b(?:to
                             r"\bthem\b.*\btop (?:corners|edge|side|half)\b")
 
 
+#: The two near corners named one at a time: "the bottom left corner ..., the bottom right one".
+_BOTTOM_PAIR = re.compile(r"\bbottom (left|right) corner\b.*\bbottom (?!\1)(?:left|right) (?:corner|one)\b")
+#: Where the near corners go in the fold: the far corners, edge or side.
+_ONTO_TOP = re.compile(r"\btop (?:corners|edge|side|end)\b|\bonto (?:them|the top)\b")
+#: "like folding a napkin", "the way you'd fold a towel": how, said by likeness.
+_LIKE_FOLDING = re.compile(r"(?: ,)? (?:like|as if|the way you(?:'d| would)?) (?:folding|you(?:'d| would)? fold|when you fold|you fold) "
+                           r"(?:a|an|the) [a-z]+(?= ,|$)")
+
+
+#: The fold's crease said to end away from the robot: the far half laid onto the near one, the other fold.
+_FAR_CREASE = re.compile(r"\b(?:fold|crease|folded edge|fold line|folded side) (?:on the side |at the side )?"
+                         r"(?:farthest|furthest|far|farther|further) (?:from|away from) (?:you|me|the robot)\b")
+
+
 def refuse_fold_across(s: str) -> None:
-    """Raise :class:`NotAGoalError` where ``s`` folds a cloth across (left onto right), which no rule makes."""
+    """Raise :class:`NotAGoalError` where ``s`` folds a cloth across (left onto right) or far half onto near half,
+    which no rule makes."""
+    if re.search(r"\bfold", s) and (far := _FAR_CREASE.search(s)) is not None:
+        raise NotAGoalError(f"'{far[0]}': the rules fold a cloth near edge onto far edge only (its crease nearest to you)")
     if re.search(r"\bfold", s) and (across := _ACROSS.search(s)) is not None:
         raise NotAGoalError(f"'{across[0].strip()}': the rules fold a cloth in half near edge onto far edge only, "
                             "not across it (left onto right)")
@@ -57,6 +79,10 @@ def read_cloth_parts(s: str, objects: frozenset[str], note: Note) -> str:
         return s
     for pattern, repl in [*_CLOTH_PARTS, *(_EDGE_FROM_YOU if "folded edge" not in s else [])]:
         s = sub(pattern, repl, s, note, "cloth part")
+    s = drop(_LIKE_FOLDING, s, note, "how")
+    if (pair := _BOTTOM_PAIR.search(s)) is not None and _ONTO_TOP.search(s[pair.end():]):
+        note("cloth part")
+        return FOLD  # each near corner taken (by its own arm, say), then brought to the far edge: the fold
     corners = s.replace("bottom left corner", "").replace("bottom right corner", "").replace("top left corner", "").replace("top right corner", "")
     if _FOLD_BY_PARTS.search(s) and not re.search(r"\b(?:left|right) (?:corner|half|side|edge)\b(?!s)", corners):
         note("cloth part")

@@ -57,6 +57,11 @@ def load(path: Path) -> list[dict]:
     return yaml.safe_load(path.read_text(encoding="utf-8"))["entries"]
 
 
+#: The blind set's writers read while the rules grow (their failures read by kind), and the one held out for the final measurement.
+BLIND_DEVELOPMENT = "ABCDEF"
+BLIND_FINAL = "H"
+
+
 def load_blind(folder: Path, writers: Iterable[str]) -> list[dict]:
     """The blind evaluation set's entries of ``writers`` (``A`` ...), as corpus entries: each writer's
     instructions (``writer_X.yaml``) with the goal ``labels.yaml`` says it means (or ``expect: refused``),

@@ -39,9 +39,9 @@ from collections.abc import Callable
 from agentchord.agents.rules.arm_words import each_arm, read_arms
 from agentchord.agents.rules.cloth_parts import FOLD, drop_fold_way, read_cloth_parts, refuse_fold_across
 from agentchord.agents.rules.end_states import END_STATE, read_end_state
-from agentchord.agents.rules.ordinals import each_in_order, each_of_list, first_before, first_of_both
+from agentchord.agents.rules.ordinals import ANY_ORDER, each_in_order, each_of_list, first_before, first_of_both
 from agentchord.agents.rules.held_pour import hold_before_pour, take_conditions
-from agentchord.agents.rules.places import read_places, restates
+from agentchord.agents.rules.places import read_places, restates, there_is_last_place
 from agentchord.agents.rules.talk import (
     CLOSERS,
     OPENERS,
@@ -72,17 +72,24 @@ _LEFT_AS_IS_INSIDE = re.compile(
     r"in place|untouched)|(?:do not|don't|dont) (?:touch|move) (?:the |that |this )?[a-z ]+?)(?= ,|$)")
 #: How the arms share the work, when the goal says what: the planner chooses it.
 _HOW = [
-    re.compile(r"\b(?:at (?:the )?same time|simultaneously|together|in one go|in parallel)\b"),
+    re.compile(r"\b(?:at (?:the )?same time|simultaneously|together|in one go|in parallel|(?:both |all )?at once)\b"),
+    # "fold it once": one time, the adverb (not "once S", a condition: that has a clause after it).
+    re.compile(r"(?<=[a-z]) (?:just )?once(?= ,|$| so\b| with\b| and\b| then\b| in half\b| only\b)"),
     re.compile(r"(?: ,)? (?:just )?(?:like|as|the way) (?:it|they) (?:is|are|was|were|stands?|stand)(?: now| right now| at the moment)?(?= ,|$)"),
     re.compile(r"(?: ,)? (?:one (?:in|with|per) (?:each|every) (?:hand|arm|gripper)|one per (?:hand|arm|gripper)|"
                r"one (?:for|with) each (?:hand|arm)|one (?:on|at|to) (?:each|either) side(?: of (?:it|them|the [a-z]+))?)\b"),
     re.compile(r"(?:^|(?: ,)? )(?:you'll|you will|you'd|you) (?:probably )?need (?:both|two) (?:hands?|arms?)(?: for (?:that|this|it))?$"),
+    # "try to keep it standing (up)": how it is carried (a placed object stands anyway); the manner word may be gone already.
+    re.compile(r"(?:^|(?: ,)? )(?:and )?try (?:to|and) keep (?:it|them|the [a-z]+)(?: (?:standing|upright|steady|level|vertical|straight)(?: up)?)?"
+               r"(?: (?:if you can|if possible))?$"),
 ]
 #: Arm words a subject may be.
 _ARM_SUBJECT = re.compile(
     r"^(?:and )?(?:(?:can|could|will|would|should|let|have|make) )?(?:the |your )?(left|right)(?: (?:arm|hand|gripper|one|side))?"
     r"(?: ,| :)? (?!(?:arm|hand|gripper)\b)(\w+)\b(.*)$")
-_BOTH_SUBJECT = re.compile(r"^(?:and )?(?:then )?(?:both (?:of you|arms|hands|grippers)|both|the two arms|the arms) (\w+)\b(.*)$")
+_BOTH_SUBJECT = re.compile(r"^(?:and )?(?:then )?(?:both (?:of you|arms|hands|grippers)|both|the two arms|the arms|"
+                           r"(?:the )?left and (?:the )?right(?: (?:arms?|hands?|grippers?|ones?))?|"
+                           r"(?:the )?right and (?:the )?left(?: (?:arms?|hands?|grippers?|ones?))?) (\w+)\b(.*)$")
 #: Ordinal words that open a step.
 _ORDINAL = re.compile(r"^(?:and )?(?:first(?:ly)?|second(?:ly)?|third(?:ly)?|fourth|next|after that|afterwards|after this|"
                       r"after(?= (?:put|set|place|lay|stand|move|give|hand|pour|take|grab|pick|carry|bring|fold)\b)|"
@@ -106,9 +113,18 @@ _POINTING = re.compile(r"(?: ,)? (?:and )?(?:both |each )?(?:of them )?"
                        r"(?: \( ?tips away from (?:me|you) ?\))?)\b")
 
 
+#: "both lying up-and-down instead of sideways (like they are now)": pointing away from the robot, how a utensil beside a
+#: plate is laid anyway (never "sideways" or "across": those stay, and are not read).
+_UP_AND_DOWN = re.compile(r"(?: ,)? (?:and )?(?:both |each |all )?(?:of them )?(?:lying|pointing|facing|oriented|turned|laid|placed|set) "
+                          r"(?:up-and-down|up and down|front-to-back|front to back|vertically|vertical)"
+                          r"(?: instead of (?:sideways|across|left-right|left to right|horizontally|horizontal)"
+                          r"(?: like (?:they|it) (?:are|is|were|was)(?: now| right now)?)?)?(?= ,|$)")
+
+
 #: Shorthand people type -> the word.
 _SHORTHAND = [(re.compile(r"\b(?:pls|plz|plse)\b"), ""), (re.compile(r"\bw/ ?|\bw (?=the |your |my |both |left |right )"), "with "),
-              (re.compile(r"\bur\b"), "your"), (re.compile(r"\bu\b"), "you"), (re.compile(r"\bthx\b"), "thanks"), (re.compile(r"\bfwd\b"), "forward"),
+              (re.compile(r"\bur\b"), "your"), (re.compile(r"\bu\b"), "you"), (re.compile(r"\bthx\b"), "thanks"),
+              (re.compile(r"\bem\b"), "them"), (re.compile(r"\bfwd\b"), "forward"),
               (re.compile(r"\bl (?=arm|hand|gripper)\b"), "left "), (re.compile(r"\br (?=arm|hand|gripper)\b"), "right ")]
 #: Vague amounts and distances: the goal has none (a pour is a pour; a nudge is the rules' nudge).
 _AMOUNT = re.compile(r"(?: ,)? (?:just |only |maybe )?(?:like )?(?:a (?:little|tiny|small|wee) (?:bit )?(?:of )?|a bit(?: more)?(?: of)? |"
@@ -127,6 +143,8 @@ _PARTICLES = [
     (re.compile(r"\b(stand|set|put) (it|them|the [a-z]+(?: [a-z]+)?) back up\b"), r"\1 \2 back"),
     (re.compile(r"\bleave (the \w+|it) standing up\b"), r"leave \1 standing"),  # put back, below
     (re.compile(r"\b(?:standing|sitting|stood) up\b"), ""),
+    # "keep it in the air" (the place dropped already), "keep the cup up": holding it, as a step.
+    (re.compile(r"\bkeep (it|them|the [a-z]+(?: [a-z]+)?)(?: (?:held|lifted|raised|up|aloft))*(?= ,|$| and\b| then\b| while\b)"), r"hold \1"),
 ]
 #: Where a pour happens, said beside it: the goal is the pour (holding the cup is said by "hold").
 _IN_THE_AIR = re.compile(r"(?: ,)? (?:in (?:the )?(?:mid-? ?air|air)|up in the air|off the table|above the table|over the table)\b")
@@ -143,8 +161,8 @@ _LAST = [
     (re.compile(r"\bgive (?:some )?water (?:from (?:the )?(\w+) )?(?=into|in|to)\b"), r"pour water from the \1 ", "verb"),
     (re.compile(r"\b(hold|lift|take|pick) ([^,]+?) , (?:then )?pour(?= with| ,|$)"), r"\1 \2 , pour into it", "ellipsis"),
     (re.compile(r"^(?:set|lay) (?:up )?the table(?: properly)?(?: for me)? , "), "", "talk"),
-    (re.compile(r"(?: ,)? with the folded edge (?:on the side |at the side |on the edge )?(?:nearest|closest|near|towards?|facing)(?: to)? (?:me|you)"),
-     "", "cloth part"),
+    (re.compile(r"(?: ,)? with the (?:folded edge|fold|crease|fold line|folded side) (?:on the side |at the side |on the edge )?"
+                r"(?:nearest|closest|near|nearer|closer|towards?|facing)(?: to)? (?:me|you|the robot)"), "", "cloth part"),
     (re.compile(r"(?: ,)? lying on the (?:top|far) half(?: of where it is(?: now)?)?"), "", "cloth part"),
     (re.compile(r" (?:standing up|sitting up|standing|sitting|lying|upright)(?= ,|$)"), "", "how"),
     (re.compile(r" while it(?:'s| is)?(?= ,|$)"), "", "how"),
@@ -158,6 +176,8 @@ _USE_ARM = re.compile(r"^(?:please )?(?:use|using) (?:your |the )?(left|right|bo
 #: The tray's handles are how it is carried: "by both handles", "using the two handles", "grab both handles" (the tray).
 _HANDLES = [
     (re.compile(r"(?: ,)? (?:by|using|with|at) (?:both|its|the two|the|its two|both of its|the) handles?\b"), ""),
+    # "lift the tray by the two ends", "hold it at both sides": where it is gripped, not where it goes.
+    (re.compile(r"(?: ,)? (?:by|at|from) (?:both|the two|its two|both of its|either|each|its|the) (?:ends?|sides?)(?= ,|$| and\b| then\b)"), ""),
     (re.compile(r"\b(grab|take|hold|grasp|pick up) (?:both|the two|the|its) handles?\b"), r"\1 the tray"),
 ]
 
@@ -187,6 +207,7 @@ def read_sentences(sentences: list[str], objects: frozenset[str], note: Callable
     """Each sentence read (:func:`read_sentence`); a sentence that only names an arm ("use the right arm only")
     names the arm of every step after it."""
     sentences = each_of_list(sentences, note)
+    sentences = there_is_last_place(sentences, note)
     sentences = _titled(sentences, note)
     if len(sentences) > 1 and _ARM_ALONE.fullmatch(sentences[-1].strip()):
         sentences = [sentences[-1], *sentences[:-1]]  # "Put the block in the cup. Use your left hand.": the arm of the steps before
@@ -293,7 +314,7 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
     s = _drop(OPENERS, s, note, "talk")
     s = _drop(CLOSERS, s, note, "talk")
     s = _drop(re.compile(r"\b(?:for me|for you|if you can|if possible|if that's ok|if that's easier(?: for you)?|though)\b"), s, note, "talk")
-    s = _drop(re.compile(r"(?: ,)? (?:is|would be|'s|will be) (?:fine|good|ok|okay|enough|great|perfect|all)$"), s, note, "talk")
+    s = _drop(re.compile(r"(?: ,)? (?:is|would be|'s|will be) (?:fine|good|ok|okay|enough|great|perfect|all)(?= ,|$)"), s, note, "talk")
     if re.fullmatch(r"(?:go|do it|start|begin|go ahead|that's all|that is all|done)", s) or any(t.fullmatch(s) for t in TALK_SENTENCES):
         note("talk")
         return ""
@@ -301,6 +322,7 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
         s = _drop(re.compile(r"(?:^|(?: ,)? )(?:(?:use|using|with) )?(?:both|two|the two) (?:of your )?(?:hands?|arms?|grippers?)"
                              r"(?: for (?:that|this|it|the [a-z]+))?(?: at the same time)?$"), s, note, "how")
     s = _drop(_LEFT_AS_IS_INSIDE, s, note, "left as is")
+    s = _drop(ANY_ORDER, s, note, "order")
     stated = _drop(END_STATE, s, note, "end state")
     if stated != s:  # "I want water in the cup and the bottle where it was": two end states
         stated = re.sub(r" and (?=(?:the|my|both) )", " , ", stated)
@@ -332,6 +354,7 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
     for how in _HOW:
         s = _drop(how, s, note, "how")
     s = _sub(_POINTING, "", s, note, "how")
+    s = _sub(_UP_AND_DOWN, "", s, note, "how")
     s = _drop(_LIKE_A_SETTING, s, note, "how")
     s = read_places(s, note)
     s = _drop(re.compile(r" (?:standing|sitting|lying|upright|up)(?= ,|$)"), s, note, "how")

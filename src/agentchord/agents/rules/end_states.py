@@ -29,6 +29,7 @@ from agentchord.agents.rules.rewrite_steps import Note, sub
 END_STATE = re.compile(r"^(?:(?:the )?end result|result|the goal|goal|in the end|at the end|by the end|when you're done|"
                         r"what i(?:'d| would) like (?:in the end |at the end )?is|what i want (?:in the end |at the end )?is|"
                         r"(?:at the end |in the end )?i(?: just| really)?(?: want| need| would like|'d like)|"
+                        r"what i(?:'d| would)? (?:want|like|need|hope) to see is|i(?:'d| would)? (?:want|like|need) to see|"
                         r"want|i'd like)(?: ,| :)? (?=the |a |an |there |both |my |water |some water )")
 
 #: "there to be water in the cup", "the cup with water in it", "cup has water in it": a pour into the cup.
@@ -67,6 +68,11 @@ _LEAVE_STANDING = re.compile(r"^(?:and )?(?:then )?leave (the \w+|it) (?:standin
 _VERBLESS = re.compile(r"^(?:and )?(then )?((?:the |both |both the |the two )?[a-z]+(?: one)?) "
                        r"(into|inside|in|onto|on top of|next to|beside|to the (?:left|right) of|behind|in front of|where(?= the)) (.+)$")
 
+#: "the tray sitting a little further from you" (the distance read as ``forward`` already): a move that way.
+_SITTING_WAY = re.compile(r"^(?:and )?(then )?((?:the )?[a-z]+(?: [a-z]+)?) (?:(?:is|should be|to be|must be|ends? up|should end up) )?"
+                          r"(?:sitting|standing|lying|resting|placed|set|moved|pushed|positioned) (forward|closer|left|right)$")
+
+
 def _put_back(m: re.Match[str]) -> str:
     first = "put it back" if m[1] == "it" else "put them back" if m[1] in ("they", "them", "both") else f"put the {m[1]} back"
     return first if m[2] is None else f"{first} , put the {m[2]} back"
@@ -76,6 +82,23 @@ def _put_back(m: re.Match[str]) -> str:
 _BOTH_ON_TABLE = re.compile(r"^(?:and )?(?:both )?(?:the )?(\w+) and (?:the )?(\w+)(?: both)?(?: back)? (?:on|onto) (?:the )?table$")
 #: "... with the capsule (sitting) in it": the thing inside, in first.
 _WITH_IN_IT = re.compile(r"^(.+?)(?: ,)? with (the [a-z]+(?: [a-z]+)?) (?:sitting |lying |resting |standing |placed |put )?(in|inside|on) (?:it|there)$")
+
+
+#: A place said of "it", the host of a ``with`` phrase: "the fork on the left of it", "the cup next to it".
+_OF_IT = (r"(?:on|to|at) the (?:left|right) of it|next to it|beside it|behind it|in front of it|in it|inside it|on it|on top of it")
+#: "the plate with the fork on its left and the spoon on its right": each thing placed so, the host staying where it is.
+_WITH_AROUND = re.compile(rf"^(the [a-z]+) with (the [a-z]+(?: [a-z]+)?) ({_OF_IT})(?:(?: ,)? and (the [a-z]+(?: [a-z]+)?) ({_OF_IT}))?$")
+
+
+def _with_around(clause: str, objects: frozenset[str], note: Note) -> str:
+    """``the plate with the fork on the left of it and the spoon on the right of it`` -> ``put the fork on the left of
+    the plate , put the spoon on the right of the plate``."""
+    m = _WITH_AROUND.match(clause)
+    if m is None or m[1].split()[-1] not in objects:
+        return clause
+    note("end state")
+    places = [(m[2], m[3]), *([(m[4], m[5])] if m[4] else [])]
+    return " , ".join(f"put {thing} {re.sub(r'it$', m[1], place)}" for thing, place in places)
 
 
 def _with_in_it(clause: str, objects: frozenset[str], note: Note) -> str:
@@ -93,6 +116,7 @@ def _with_in_it(clause: str, objects: frozenset[str], note: Note) -> str:
 
 def read_end_state(clause: str, objects: frozenset[str], note: Note, verb: Callable[[str], str | None]) -> str:
     """One clause's end state or verbless step as the imperative that brings it about (see the module)."""
+    clause = _with_around(clause, objects, note)
     clause = _with_in_it(clause, objects, note)
     if " , " in clause:  # two steps now: each read on its own
         return " , ".join(read_end_state(c, objects, note, verb) for c in clause.split(" , "))
@@ -101,6 +125,7 @@ def read_end_state(clause: str, objects: frozenset[str], note: Note, verb: Calla
     clause = sub(_BACK_AS_IT_WAS, _put_back, clause, note, "end state")
     clause = sub(_BOTH_ON_TABLE, r"put the \1 back , put the \2 back", clause, note, "end state")
     clause = sub(_LEAVE_STANDING, r"put \1 back", clause, note, "end state")
+    clause = sub(_SITTING_WAY, lambda m: f"{m[1] or ''}move {m[2] if m[2].startswith('the ') else 'the ' + m[2]} {m[3]}", clause, note, "end state")
     verbless = _VERBLESS.match(clause)
     if verbless is not None and verb(verbless[2].split()[-1]) is None and verbless[2].split()[-1] not in ("it", "them", "they"):
         thing = verbless[2] if verbless[2].startswith(("the ", "both ")) else f"the {verbless[2]}"

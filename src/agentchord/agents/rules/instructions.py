@@ -238,8 +238,12 @@ def _place_at(names: list[str], where: Where | None, c: Clause, ctx: Context) ->
         if where.relation == "side_of" and ctx.table_place(anchor_np) is not False:
             point = kb.table_point([where.side])
             return [Placed(obj=n, at=point, arm=arms[n]) for n in names]
+        if (beside := _beside_region(names, anchor_np, where, ctx)) is not None:
+            return [Placed(obj=n, at=point, arm=arms[n]) for n, point in beside]
         anchor = ctx.resolve(anchor_np, exclude=tuple(names))
         ctx.last_anchor = anchor
+        if where.relation == "side_of" and len(names) == 2:
+            return _row(names, anchor, where.side, ctx, arms)
         if where.relation == "side_of":
             directions = [kb.DIRECTION_WORDS[where.side]] * len(names)
         elif where.relation == "front_of":
@@ -293,6 +297,36 @@ def _place_at(names: list[str], where: Where | None, c: Clause, ctx: Context) ->
     return [_beside(n, host, (-1.0 if ctx.objects[n].pos[0] < ctx.objects[host].pos[0] else 1.0, 0.0), ctx, arms[n]) for n in names]
 
 
+def _row(names: list[str], anchor: str, side: str, ctx: Context, arms: dict[str, str | None]) -> list[Goal]:
+    """Two objects to one side of an anchor ("the two blocks side by side on the left of the cup"): a row on that
+    side, keeping their present left-to-right order: the one nearer that side of the anchor beside it, the other beside that one."""
+    sign = kb.DIRECTION_WORDS[side][0]
+    near, far = sorted(names, key=lambda n: sign * ctx.objects[n].pos[0])
+    first = _beside(near, anchor, (sign, 0.0), ctx, arms[near])
+    return [first, _beside(far, near, (sign, 0.0), ctx, arms[far])]
+
+
+def _beside_region(names: list[str], np: NounPhrase, where: Where, ctx: Context) -> list[tuple[str, tuple[float, float]]] | None:
+    """Beside a scene region (``next to the target, not on it``): a point just outside it, on the side said or else
+    the side the object is on (the region's radius, the object's half-size and a 4 cm gap); None where ``np`` names
+    an object, or no region."""
+    if any(w in kb.words(o) for o in ctx.scene.objects for w in np.words) or (region := ctx.region(np)) is None:
+        return None
+    if where.relation not in ("next_to", "side_of", "front_of", "behind"):
+        return None
+    area = next(r for r in ctx.scene.regions if r.name == region)
+    out = []
+    for n in names:
+        o = ctx.objects[n]
+        d = area.radius + 0.5 * max(o.extent[:2]) + kb.NEXT_TO_GAP
+        if where.relation == "next_to":
+            ux, uy = (-1.0 if o.pos[0] < area.center[0] else 1.0, 0.0)
+        else:
+            ux, uy = kb.DIRECTION_WORDS[where.side] if where.relation == "side_of" else (0.0, -1.0 if where.relation == "front_of" else 1.0)
+        out.append((n, (round(area.center[0] + ux * d, 3), round(area.center[1] + uy * d, 3))))
+    return out
+
+
 def _put_back(names: list[str], arms: dict[str, str | None], ctx: Context) -> list[Goal]:
     """Each object put back where it was; one never taken, moved or placed is there already ("cup and bottle both on
     the table" after a pour from the bottle: the bottle is put back, the cup never left)."""
@@ -311,6 +345,15 @@ def _folds(c: Clause, ctx: Context) -> str | None:
     cloth = moved[0] if moved and len(set(moved)) == 1 else None
     if cloth is None or _cloth_of(target, ctx) != cloth:
         return None
+    # The one fold the rules make lays the near part (both near corners, the near edge or half) on the far one;
+    # a single corner laid on another, or a side on the other side, is another fold: refused, not read as this one.
+    moved_words = {kb.SYNONYMS.get(w, w) for np in c.objects if not np.pronoun for w in np.words}
+    target_words = {kb.SYNONYMS.get(w, w) for w in target.words}
+    sides = {"left", "right"}
+    if moved_words & sides or target_words & sides or "top" in moved_words or "top" not in target_words \
+            or (moved_words and "bottom" not in moved_words):
+        raise ctx.error(c.text, f"lays a part of the {cloth} on another part, not its near edge on its far edge "
+                                "(both near corners onto the far ones): the only fold the rules make")
     return cloth
 
 
@@ -347,6 +390,11 @@ def _move(c: Clause, ctx: Context) -> list[Goal]:
         if region is not None:
             goals.append(Placed(obj=name, region=region, arm=ctx.arm_of(c.arm, name)))
             continue
+        if c.direction == "front":
+            # "to the front" is the table's near edge to the robot, and forward to whoever faces it: only a scene region
+            # called the front says which.
+            raise ctx.error(c.text, "says 'to the front': towards you (the table's near edge) or away from you? "
+                                    "say 'forward' or 'to the front edge of the table'")
         obj = ctx.objects[name]
         ux, uy = kb.DIRECTION_WORDS[c.direction]
         point = (round(obj.pos[0] + ux * kb.NUDGE, 3), round(obj.pos[1] + uy * kb.NUDGE, 3))

@@ -219,6 +219,10 @@ class _ToClauses(Transformer):
     def backward(self, _):
         return ("direction", "backward")
 
+    def front_way(self, _):
+        # "carry it to the front": towards the table's front edge, or (as people say it) forward: which is decided at grounding.
+        return ("direction", "front")
+
     def to_side(self, items):
         return ("direction", items[0])
 

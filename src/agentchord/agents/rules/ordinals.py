@@ -35,6 +35,15 @@ _LIST = re.compile(r"(?:first )?(?:the )?([a-z]+(?: (?!first\b)[a-z]+)?)(?: firs
 _EACH = re.compile(r"(\w+) (?:each(?: one| of them)?|them(?: each| both)?|both(?: of them)?|the two) (.+)")
 
 
+#: "doesn't matter which one goes first", "in any order", "order doesn't matter": the order is free (the rules do
+#: them in the order named), so the remark states no goal.
+ANY_ORDER = re.compile(
+    r"(?:^|(?: ,)? )(?:and |but )?(?:(?:it |the order )?(?:doesn't|does not|dont|don't|won't|will not) matter"
+    r"(?: (?:which|what|who|in what order|the order|what order|which order|which way)\b[a-z ']*)?|"
+    r"(?:the )?order (?:doesn't|does not|dont|don't) matter|(?:in )?(?:any|either|whatever|whichever) order(?: you (?:like|want|prefer))?|"
+    r"in no (?:particular )?order|whichever (?:one )?(?:goes )?first|either (?:one )?(?:can go |goes )?first)(?= ,|$)")
+
+
 def each_of_list(sentences: list[str], note: Note) -> list[str]:
     """``first the fork , then the spoon ; place each one next to the plate`` -> the step for each, in that order."""
     out: list[str] = []

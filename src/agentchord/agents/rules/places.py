@@ -35,6 +35,8 @@ _MOVES = r"(?:move|slide|shift|push|nudge|bring|carry|drag|scoot)"
 #: How far, said before a direction or a place: dropped (the rules' nudge, or the place itself).
 _HOW_FAR = (r"(?:(?:a (?:little |tiny |wee )?bit|a little|slightly|somewhat|way|just|a tad|"
             r"(?:about |roughly |around )?(?:a few|a couple of|\d+|one|two|three|five|ten) ?(?:cm|centimet(?:er|re)s|inch(?:es)?|mm))(?: more)? )")
+#: Words that start an amount (never the last word of the object before it: "carry the tray about ten cm forward").
+_AMOUNT_WORD = r"(?:about|roughly|around|a|just|slightly|way|one|two|three|five|ten|\d+)\b"
 #: Direction phrases that mean "away from the robot".
 _AWAY = re.compile(rf"\b{_HOW_FAR}?(?:further|farther|more far)(?: away)?(?: back)?(?: from (?:me|you|the robot))?"
                    r"(?: than (?:it is|it does|it was|they are)(?: now| right now| at the moment)?)?\b|\baway from (?:me|you|the robot)\b|"
@@ -63,7 +65,7 @@ _NEAR_TO = re.compile(r"\b(?:near|close)(?: to)? (?=the |it\b|them\b)")
 #: "a bit closer to the bottle": next to it.
 _CLOSER = re.compile(rf"\b{_HOW_FAR}?(?:closer|nearer) to\b")
 #: "move the cup over a bit to the right", "slide it a little forward": how far a move goes (the rules' nudge).
-_HOW_FAR_BEFORE = re.compile(rf"\b({_MOVES} (?:it|them|the [a-z]+(?: [a-z]+)?))(?: over)? {_HOW_FAR}(?:over )?"
+_HOW_FAR_BEFORE = re.compile(rf"\b({_MOVES} (?:it|them|the [a-z]+(?: (?!{_AMOUNT_WORD})[a-z]+)?))(?: over)? {_HOW_FAR}(?:over )?"
                              r"(?=(?:to the (?:left|right)|forward|closer|left|right)\b)")
 #: "the cup goes a bit more to the left": said as a state, how far makes it a move that way (not the table's left side).
 _GOES_A_BIT = re.compile(rf"^(?:and )?(?:then )?((?:the )?[a-z]+(?: [a-z]+)?) (?:goes|should go|needs to go|moves|should move|should be) "
@@ -88,6 +90,40 @@ _BESIDE = re.compile(r"\b(?:next to|beside|by|near|to the (?:left|right) of)\b")
 _WHERE_FOUND = re.compile(r"\bwhere (?:you|i|we) (?:found|got|took|picked up|picked) (it|them)(?: from| up)?\b")
 
 
+#: "right next to", "just behind", "directly in front of": how exactly, not which side ("right" is no side here:
+#: it is not "the right", "to the right", "your right", and a place follows it).
+_EXACTLY = re.compile(r"(?<!the )(?<!to )(?<!your )(?<!its )(?<!on )\b(?:right|directly|exactly|immediately|just|squarely) "
+                      r"(?=(?:next to|beside|behind|in front of|on top of|between|by|near|against|into|inside|onto|over|under|"
+                      r"where|back (?:where|in|on|to))\b)")
+#: "side by side to the left of the cup", "next to each other in front of it": a row at that place (read at grounding).
+_ROW = re.compile(r"\b(?:side by side|next to each other|beside each other|alongside each other|in a row|together) "
+                  r"(?=(?:on|to|at|in front of|behind|left of|right of)\b)")
+#: "beside the target , not on it": the place said, then what it is not (no other place).
+_NOT_ON = re.compile(r"(\b(?:next to|beside|by|near|to the (?:left|right) of|in front of|behind) [a-z ]+?)"
+                     r"(?: ,)? (?:but )?not (?:on|in|inside|into|onto|on top of) (?:it|them|the [a-z]+)(?= ,|$| then\b| and\b)")
+#: "in there", "on there": the place last said (what a container or support was last named as).
+_THERE = re.compile(r"\b(in|into|inside|on|onto) there\b")
+_HOSTS = re.compile(r"\b(?:in|into|inside|on|onto|on top of) (the [a-z]+(?: (?!with\b|then\b|and\b|too\b|there\b)[a-z]+)?)\b")
+#: "... in there too", "... as well": the step is said whole, so the word adds nothing.
+_TOO_AFTER_PLACE = re.compile(r"(\b(?:in|into|inside|on|onto|on top of) the [a-z]+(?: [a-z]+)?)(?: ,)? (?:too|as well|also)(?= ,|$| then\b)")
+
+
+def there_is_last_place(sentences: list[str], note: Note) -> list[str]:
+    """``put the blue block in the cup ; put the red block in there too`` -> ``... put the red block in the cup``:
+    ``there`` after a preposition is the container or support named last, in this sentence or an earlier one."""
+    out: list[str] = []
+    for sentence in sentences:
+        while (m := _THERE.search(sentence)) is not None:
+            hosts = _HOSTS.findall(" ; ".join([*out, sentence[: m.start()]]))
+            if not hosts:
+                break
+            sentence = f"{sentence[: m.start()]}{m[1]} {hosts[-1]}{sentence[m.end():]}"
+            sentence = sub(_TOO_AFTER_PLACE, r"\1", sentence, note, "place")
+            note("place")
+        out.append(sentence)
+    return out
+
+
 def restates(clause: str, before: str) -> bool:
     """Whether ``clause`` only says again that the step ``before`` it puts something beside something."""
     return _RESTATED.fullmatch(clause.strip()) is not None and _BESIDE.search(before) is not None
@@ -95,7 +131,12 @@ def restates(clause: str, before: str) -> bool:
 
 def read_places(s: str, note: Note) -> str:
     """``s`` (one sentence) with its place and direction phrases in the grammar's words (see the module)."""
+    s = sub(_EXACTLY, "", s, note, "place")
+    s = sub(_ROW, "", s, note, "place")
+    s = sub(_NOT_ON, r"\1", s, note, "place")
+    s = sub(_TOO_AFTER_PLACE, r"\1", s, note, "place")
     s = sub(_AWAY, "forward", s, note, "direction")
+    s = sub(re.compile(r"\bforward(?: ,)? forwards?\b"), "forward", s, note, "direction")  # "a bit further forward": one way
     s = sub(_TOWARD_YOU, "closer", s, note, "direction")
     s = sub(_BACK_THEN_AWAY, "forward", s, note, "direction")
     s = sub(_THAN_NOW, r"\1", s, note, "direction")

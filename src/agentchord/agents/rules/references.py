@@ -153,8 +153,15 @@ class Context:
             if np.pronoun in ("all", "them", "they"):
                 raise self.error(np.text, "names several objects where one is wanted")
             earlier = [m for m in self.mentioned if m not in exclude]
+            only = [o.name for o in self.scene.objects if o.name not in self.corners and o.name not in exclude]
+            if not earlier and len(only) == 1:
+                # "grab it, give it to the right arm" in a scene with one object: "it" can only be that one.
+                earlier = only
             if not earlier:
                 raise self.error(np.text, "has nothing to refer to (no object was named before it)")
+            if earlier[-1] in self.corners:
+                # After a fold, "pick it up" is the whole cloth, which no skill moves (not the corner named last).
+                raise self.error(np.text, "is the cloth: the rules fold a cloth, they do not move it")
             self.note(np.text, "object", earlier[-1])
             return earlier[-1]
         if len(np.words) > 1 and np.words[-1] in ("back", "down"):  # "put the bottle back" read as one phrase
@@ -198,7 +205,8 @@ class Context:
                 # "The bowl" for the scene's one bowl-shaped container: open, about as deep as it is wide
                 # (an open cup, not a tall drinking cup or a flat tray).
                 head = [o for o in pool if kb.is_container(o) and BOWL_DEPTH[0] <= o.extent[2] / max(o.extent[:2]) <= BOWL_DEPTH[1]]
-            if len(head) == 1 and not set(plain[:-1]) & set(COLOURS):
+            # A colour the one object of that kind has ("the white bowl" for the white cup) still describes it.
+            if len(head) == 1 and all(c in kb.words(head[0]) for c in set(plain[:-1]) & set(COLOURS)):
                 candidates = head
         for word in sizes:
             if len(candidates) > 1:

@@ -71,11 +71,18 @@ def _lemma_like(word: str) -> bool:
 
 
 _ENDINGS = frozenset({"s", "es", "ed", "d", "ing", "ping", "ped", "ting", "ted", "ling", "led", "ies", "ied", "y", "e", "en", "t"})
+#: A remark about the speaker: "i'm so thirsty", "we were busy all day", "i feel tired".
+_REMARK = re.compile(r"^(?:and |but |so )?(?:i|we)(?:'m| am|'re| are| was| were| feel| felt|'ve been| have been| had)\b")
+
+
 def is_talk(clause: str, objects: frozenset[str]) -> bool:
     """Whether a clause names nothing the task is about (no object, colour, arm, place or action verb)."""
     words = clause.replace("'", " ").split()
     if not words:
         return True
+    if _REMARK.match(clause):
+        # "i'm so thirsty after that meeting": about the speaker; only an object, a colour or an action makes it a task.
+        return not any(w in objects or w.rstrip("s") in objects or w in _COLOUR_WORDS or _lemma_like(w) for w in words)
     for word in words:
         if word in objects or word in CONTENT_WORDS or word in kb.DIRECTION_WORDS or word in kb.TABLE_WORDS:
             return False

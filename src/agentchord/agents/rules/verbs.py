@@ -89,6 +89,17 @@ _SWAP = re.compile(r"^(?:(?:would you mind|could you|can you|please|mind) )*(?:s
                    r"(?: (?:places|positions|are|is))?(?:(?: ,)? (?:so(?: that)?|,) (.+))?$")
 
 
+#: "give water in the cup", "add some water to the mug", "put water from the bottle into the cup": water is what moves,
+#: the cup where it goes: a pour (the verb of giving or putting says nothing else here).
+_WATER_TO = re.compile(r"\b(?:give|add|put|get|bring|serve|provide|transfer|move) (?:some |a little |a bit of |a splash of |more |a little bit of )?"
+                       r"water(?: from (the [a-z]+))? (?:into|in|to|inside)\b")
+#: "pour me a little water", "could you get us some water into the cup": who it is for is no part of the goal.
+_FOR_ME = re.compile(r"\b(pour|fill|get|fetch|make) (?:me|us|him|her|yourself|myself) (?=(?:a |an |some |water\b|the |just ))")
+#: "a splash in the cup", "a little into the mug" (a pour said before): the amount poured, and where.
+_AMOUNT_INTO = re.compile(r"(?:^|(?<= , ))(?:and )?(?:then )?(?:just |only )?(?:a (?:little|splash|drop|bit|dash|touch|little bit)|some)"
+                          r"(?: more)? (?=(?:into|in)\b)")
+
+
 def read_swap(s: str, note: Note) -> str:
     """``swap the X and the Y`` -> ``put the X where the Y was , put the Y where the X was``; where the sentence goes on
     to say where each goes ("so the cup ends up where ...", "- I want the fork on the right ..."), that is read instead."""
@@ -117,6 +128,10 @@ def read_verbs(s: str, note: Note, verb: Callable[[str], str | None]) -> str:
     s = sub(_TIP_OVER, r"pour \1 into \2", s, note, "verb")
     s = sub(_SOME_OF_IT, r"\1 water ", s, note, "amount")
     s = sub(_WATER_INTO, "pour water ", s, note, "amount")
+    s = sub(_WATER_TO, lambda m: f"pour water {'from ' + m[1] + ' ' if m[1] else ''}into", s, note, "verb")
+    s = sub(_FOR_ME, r"\1 ", s, note, "verb")
+    if re.search(r"\b(?:pour|water)\b", s):
+        s = sub(_AMOUNT_INTO, "pour water ", s, note, "amount")
     s = sub(_YOU, lambda m: m[0] if verb(m[2]) is None else m[1] + m[2], s, note, "verb")
     s = sub(_IT_DOES, lambda m: m[0] if verb(m[2]) is None else m[1] + m[2], s, note, "verb")
     s = sub(_LETS, lambda m: "" if verb(m[1]) is not None else m[0], s, note, "verb")
