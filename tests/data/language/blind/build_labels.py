@@ -1,21 +1,22 @@
 """Label the blind evaluation set (issue 59): the goal each instruction means, written to labels.yaml.
 
-The seven writers' files (writer_A.yaml ... writer_F.yaml and writer_H.yaml) hold 390 instructions, each with the
-writer's own ``meaning`` (the intended end state) and ``possible``. This script states, per id, the
-goal the instruction means as a goal spec's goals (``agentchord schema goal``), written with the
-label helpers of ../build_corpus.py and its conventions (docs/language.md): ``put X down``/``back``
-is ``placed`` with no place; ``beside``/``next to`` is ``rel()`` (the side the object is on; a flat
-utensil beside a flat anchor at 17 cm, turned along y); ``move X left|right|nearer`` a bit is
-``nudge()`` (10 cm), and ``forward`` for the coffee tray is its ``forward`` region; an object still
-held when the instruction ends is put back where it was, by the arm that holds it (``complete()``);
-an arm is in a goal only when it is said for that clause (an arm addressed as a heading, ``Right
-arm: a, b, c``, is said for every step under it) or the object was taken or handed over by a
-said arm. ``refused`` where the scene cannot do what is asked (an object, place or action it lacks)
-or the goal language cannot say it (the reason is in ``WHY``).
+The nine writers' files (writer_A.yaml ... writer_F.yaml, writer_H.yaml, writer_I.yaml and
+writer_J.yaml) hold 510 instructions, each with the writer's own ``meaning`` (the intended end
+state) and ``possible``. This script states, per id, the goal the instruction means as a goal spec's
+goals (``agentchord schema goal``), written with the label helpers of ../build_corpus.py and its
+conventions (docs/language.md): ``put X down``/``back`` is ``placed`` with no place;
+``beside``/``next to`` is ``rel()`` (the side the object is on; a flat utensil beside a flat anchor
+at 17 cm, turned along y); ``move X left|right|nearer`` a bit is ``nudge()`` (10 cm), and
+``forward`` for the coffee tray is its ``forward`` region; an object still held when the instruction
+ends is put back where it was, by the arm that holds it (``complete()``); an arm is in a goal only
+when it is said for that clause (an arm addressed as a heading, ``Right arm: a, b, c``, is said for
+every step under it) or the object was taken or handed over by a said arm. ``refused`` where the
+scene cannot do what is asked (an object, place or action it lacks) or the goal language cannot say
+it (the reason is in ``WHY``).
 
 Labelling policy for amounts: ``poured`` states no amount, so a vague amount (``some``, ``a
 little``, ``a splash``, ``fill it up``) is a pour; a stated fraction (``about half``, ``till it's
-half full``) cannot be said and is refused.
+half full``) or quantity (``approx. 50 mL``) cannot be said and is refused.
 
 The labels were written from the instructions and the writers' meanings only: no composer, planner
 or benchmark was run on the instructions. Where an instruction and its writer's meaning disagree, the
@@ -618,6 +619,179 @@ LABELS: dict[str, object] = {
     # Each block taken by a said arm; swap: absolute points, each the other's start (as B-012), in the order
     # named (red first), each put by the arm that holds it.
     "H-060": [at_xy("red_block", *spot(B, "blue_block"), "left"), at_xy("blue_block", *spot(B, "red_block"), "right")],
+    # --- writer I ----------------------------------------------------------------------------
+    "I-001": POUR1,  # "some water": a vague amount, a pour; "put the bottle back": placed with no place
+    # "use your right hand to pick up the grey bottle and pour a little water": the bottle is taken by the
+    # said arm, so the pour and the put-back are the right arm's (as H-005); "a little": a vague amount.
+    "I-002": [pour(arm="right"), put("bottle", "right")],
+    "I-003": REFUSE,
+    "I-004": POUR1,  # "put it back down where it was": placed with no place
+    # "take the bottle with right hand and fill the cup": taken by a said arm (as E-005); "fill": no amount.
+    "I-005": [pour(arm="right"), put("bottle", "right")],
+    "I-006": POUR1,  # end state: water in the cup, the bottle standing where it was (as E-004)
+    # "Use the left arm to pour — no wait, the right one — pour ...": the words correct themselves, the
+    # right arm pours (a reader hears the correction; as E-049 settles on its last words). The put-down is
+    # unsaid and the bottle was not taken in a clause of its own: no arm (as E-002).
+    "I-007": [pour(arm="right"), put("bottle")],
+    "I-008": REFUSE,
+    "I-009": REFUSE,
+    # "Left arm: ... hold it up. Right arm: pour ... Then both of you put things back down": each arm its
+    # own object (as C-009).
+    "I-010": [pour(arm="right", hold=True), put("cup", "left"), put("bottle", "right")],
+    "I-011": POUR2,  # "hold the cup up and pour into it": held cup, arms unsaid
+    # "the cup to have water in it and both ... standing on the table again": no hold said (as C-015, E-013):
+    # the plain pour, the bottle back.
+    "I-012": POUR1,
+    # Cup taken by the said left hand; "pour the bottle into it with the other one": the right arm pours; the
+    # bottle was not taken in a clause of its own (as A-013, F-011).
+    "I-013": POUR2_LR,
+    # Both taken by said arms ("lift the red cup ... with the left arm", "take the bottle in the right arm");
+    # the put-downs in the order said: the bottle first, then the cup.
+    "I-014": [pour(arm="right", hold=True), put("bottle", "right"), put("cup", "left")],
+    "I-015": POUR2,  # "Pick the cup up, fill it up from the bottle": held cup, arms unsaid (as A-012)
+    "I-016": POUR2_LR,  # "Left hand lift cup in the air, right hand pour ..., then both put down" (as A-013, B-009)
+    # "Hold the bottle in the left hand and — sorry, I mean hold the cup in the left hand — and pour with the
+    # right": the correction decides: the cup held by the left, the right arm pours. Nothing said about
+    # putting down: each goes back by the convention (the cup by the left that holds it; as C-011).
+    "I-017": POUR2_LR,
+    "I-018": SETTING,
+    "I-019": SETTING_ARMS,  # "Left arm, ... Right arm, do the same with the spoon": pointing away is the setting convention
+    "I-020": SETTING,  # "oriented perpendicular to the table edge": turned along y, the setting convention
+    "I-021": SETTING,  # "on either side like a normal place setting": fork left, spoon right
+    "I-022": SETTING,  # "plate in the middle" is already so: no goal for the plate
+    # The swapped setting, in the order said (the spoon first): each beside the plate on the side named.
+    "I-023": [rel(T, "spoon", "plate", "left"), rel(T, "fork", "plate", "right")],
+    "I-024": [on("fork", "plate")],  # "leave the spoon": no goal for it
+    "I-025": REFUSE,
+    "I-026": SETTING,  # "both straight, pointing to far side": the setting convention
+    "I-027": HANDOVER,
+    "I-028": TARGET,  # "the marked circle": the scene's one region; "standing": placed stands it upright anyway
+    "I-029": HANDOVER,
+    "I-030": HANDOVER,  # "give it to the other one, and have it drop it off on the target": left to right
+    "I-031": HANDOVER,  # "handing it over to your right hand": the giver is the other, the left
+    # "Put the block on the target with your right hand — actually, pick it up with the left first and hand
+    # it across, then the right one puts it down": the correction decides: the hand-over, left to right.
+    "I-032": HANDOVER,
+    # "swap hands": left to right (the block is on the left; as A-024); "the mark on the right": the target (as F-031).
+    "I-033": HANDOVER,
+    "I-034": REFUSE,
+    # "shove the tray back a bit": back = away from the robot (the writer's meaning; as A-031, H-037): the forward spot.
+    "I-035": COFFEE,
+    # "Left arm:" heads the capsule step only (both arms carry the tray); "forward about 10 cm": the forward
+    # spot (12 cm; as A-034, H-039).
+    "I-036": COFFEE_LEFT,
+    "I-037": COFFEE,  # "set it down a little farther away": the forward spot
+    "I-038": COFFEE,  # end state: the tray "a bit further from you than it is now": the forward spot
+    "I-039": COFFEE_LEFT,  # capsule "with left hand"; "two hands take tray ... and bring more far" (as E-039, H-042)
+    "I-040": COFFEE,  # "the little coffee pod thing": the capsule; "move it forward a bit": the forward spot
+    "I-041": TRAY_FWD,  # "don't touch the capsule": a negation states no goal
+    "I-042": COFFEE,  # "lift that up by the handles": the tray; "a bit further out": the forward spot
+    "I-043": FOLD,
+    "I-044": FOLD,
+    "I-045": FOLD,  # bottom (near) corners onto the top (far) ones, one arm each (as F-047)
+    "I-046": FOLD,  # "front to back"
+    "I-047": FOLD,  # "half as deep, with the fold on the side closest to you": crease near (as E-046, F-051)
+    # "Fold the towel left to right — no, sorry, fold it front to back, near corners onto the far ones": the
+    # correction decides (as E-049): the fold.
+    "I-048": FOLD,
+    "I-049": FOLD,  # "take the corners near you and put on the corners far"
+    "I-050": FOLD,
+    "I-051": REFUSE,
+    "I-052": [into("red_block", "cup")],
+    "I-053": [on("blue_block", "red_block")],
+    "I-054": [into("red_block", "cup"), into("blue_block", "cup")],  # "the bowl": the white cup; order unsaid: as D-055
+    # "put the red cube into the white cup, then put the blue cube on top of it": "it" is the red cube (the
+    # object of the clause before; the writer's meaning agrees): the blue cube stacked on it, in the cup.
+    "I-055": [into("red_block", "cup"), on("blue_block", "red_block")],
+    # "side by side in front of the cup", order unsaid: the blue block already stands in front of the cup, so
+    # the red one beside it on the side it is on (its left) makes the pair, keeping their order (as D-058).
+    "I-056": [rel(B, "red_block", "blue_block")],
+    # Each block taken by a said arm; "Drop them both in the cup": each by its arm, in the order named (as C-045).
+    "I-057": [into("red_block", "cup", "left"), into("blue_block", "cup", "right")],
+    "I-058": [hand("blue_block", "right", "left"), rel(B, "blue_block", "cup", "left", "left")],
+    # "Put the blue block in the cup, no, the red one": the correction decides; "leave the other one": no goal.
+    "I-059": [into("red_block", "cup")],
+    "I-060": REFUSE,
+    # --- writer J ----------------------------------------------------------------------------
+    "J-001": [pour(arm="right"), put("bottle", "right")],  # "Right arm:" heads grab, pour, stand it back up
+    "J-002": POUR1,  # "pour me some water into the cup": the bottle goes back by the convention
+    "J-003": POUR1,  # "a little water": a vague amount; "put the bottle back upright"
+    "J-004": REFUSE,
+    # "Use your left hand to pour ...": the pour's arm; the bottle was not taken in a clause of its own, and
+    # its put-down is unsaid: no arm (as C-004, E-002; the writer's meaning has the left arm put it back).
+    # "not the right one": a negation states no goal.
+    "J-005": [pour(arm="left"), put("bottle")],
+    "J-006": [rel(P1, "cup", "bottle")],  # next to the bottle, on its left (where the cup is; as D-007); "Don't pour": no goal
+    # "on the other side of the cup": the bottle is on the cup's right, so beside it on its left (as B-007).
+    "J-007": [rel(P1, "bottle", "cup", "left")],
+    "J-008": REFUSE,
+    "J-009": POUR1,  # "tip it over the cup till there's a bit of water in it": a vague amount, a pour
+    "J-010": [pour(arm="right", hold=True), put("cup", "left"), put("bottle", "right")],  # "both of you put your things back": as C-009
+    "J-011": POUR2,  # held cup, arms unsaid
+    # "left hand holding and right hand pouring": the cup held by the said left arm, the right pours; "both
+    # ... standing back on the table" (as A-013).
+    "J-012": POUR2_LR,
+    "J-013": POUR1,  # "Don't lift the cup": no hold; the bottle back by the convention
+    # "Take the cup with your left and lift it up, then pour ... with your right": putting down unsaid, each
+    # goes back by the convention (as C-011).
+    "J-014": POUR2_LR,
+    "J-015": [rel(P2, "bottle", "cup", "right")],  # "right up against its right side": beside it, on its right
+    "J-016": POUR2_LR,  # "take the cup up with left hand, ... pour ... with right hand, after put down both" (as A-013)
+    # Swap the two places: absolute points, each the other's start (as B-012), in the order said (the bottle first).
+    "J-017": [at_xy("bottle", *spot(P2, "cup")), at_xy("cup", *spot(P2, "bottle"))],
+    "J-018": REFUSE,
+    "J-019": SETTING,  # "both pointing away from you": the setting convention
+    "J-020": SETTING_ARMS,  # "Both should point forward, away from the robot": the setting convention
+    "J-021": SETTING,  # "by the plate like a normal table setting": fork left, spoon right
+    "J-022": [on("spoon", "plate")],
+    "J-023": [FORK_L],  # "pointed toward the far end": the setting convention; "Leave the spoon alone": no goal
+    # "bring the cutlery in closer to the plate": each beside it on its own side (as B-020, F-023).
+    "J-024": SETTING,
+    # "First the spoon, then the fork": in the order said; "turned so the handle is toward you": turned along y
+    # (which end is the handle is not sayable; as E-021).
+    "J-025": [SPOON_R, FORK_L],
+    "J-026": [hand("spoon", "right", "left"), rel(T, "spoon", "plate", "left", "left")],  # as D-023
+    "J-027": REFUSE,
+    "J-028": HANDOVER,
+    # "the orange thing": the block; "use both arms, pass it across mid air": left to right (the block is on
+    # the left; as A-024).
+    "J-029": HANDOVER,
+    "J-030": TARGET,  # "standing in the target area": placed stands it upright anyway; method open
+    "J-031": HANDOVER,  # "from one gripper to the other": left to right (as F-032); "the marked spot": the target
+    "J-032": REFUSE,
+    # "a bit closer to the target, but not onto it": a nudge towards it (the target lies to the block's right;
+    # as C-005), which leaves it well outside the target.
+    "J-033": [nudge(H, "block", "right")],
+    "J-034": [region("block", "target", "right")],  # "only the right arm": no handover (as C-028)
+    "J-035": REFUSE,
+    "J-036": COFFEE,  # "carry the tray forward with both hands": the forward spot
+    "J-037": COFFEE_LEFT,  # "left arm:" heads the capsule step only; "a bit further away": the forward spot (as I-036)
+    "J-038": COFFEE,  # "move the tray back a little so I've got room in front": away from the robot (as A-031)
+    "J-039": [into("capsule", "tray")],  # "the brown pod": the capsule; "Don't move the tray": no goal
+    "J-040": TRAY_FWD,  # "forward to the marked spot": the forward region; the capsule stays
+    "J-041": [region("tray", "forward"), into("capsule", "tray")],  # the order said: the tray first (as H-041)
+    "J-042": COFFEE,  # "both hand take the tray and move to far": the forward spot
+    "J-043": REFUSE,
+    "J-044": FOLD,
+    "J-045": FOLD,  # direction unsaid: the natural fold (as A-038)
+    "J-046": FOLD,  # bottom (near) corners onto the top (far) ones, one arm each (as F-047)
+    "J-047": FOLD,  # "with the fold closest to the robot": crease near (as E-046, F-051)
+    "J-048": REFUSE,
+    "J-049": FOLD,
+    "J-050": REFUSE,
+    "J-051": REFUSE,
+    "J-052": REFUSE,
+    "J-053": [into("red_block", "cup")],
+    "J-054": [on("blue_block", "red_block")],
+    "J-055": [into("blue_block", "cup"), into("red_block", "cup")],  # "the blue one first and then the red one"
+    "J-056": [hand("red_block", "left", "right"), rel(B, "red_block", "blue_block", "right", "right")],
+    # The red cube on the blue one, then the cup beside the stack (anchored on its base, the blue cube); side
+    # unsaid: the side the cup is on (it stands almost straight behind the blue cube, 1 cm to its left: left;
+    # as F-055).
+    "J-057": [on("red_block", "blue_block"), rel(B, "cup", "blue_block")],
+    "J-058": REFUSE,
+    "J-059": [into("blue_block", "cup")],  # "the bowl": the white cup; "don't touch the red one": no goal
+    "J-060": REFUSE,
 }
 
 #: Why each refused entry is refused.
@@ -682,16 +856,39 @@ WHY = {
     "H-050": "no cup in the towel scene (the fold alone would be sayable, not the whole)",
     "H-059": "into the cup and then out onto the blue block: goals are kept once achieved, so a put-in undone later cannot be "
     "said (the end state alone, red on blue, would be sayable, not the whole)",
+    "I-003": "'approx. 50 mL': a stated amount of water; poured states no amount",
+    "I-008": "'fill it about halfway': a stated amount; poured states no amount (the cup beside the bottle alone would be sayable, not the whole)",
+    "I-009": "no kettle in the scene (only a bottle of water)",
+    "I-025": "no knife in the scene",
+    "I-034": "no green block in the scene",
+    "I-051": "no sink in the scene, and hanging a cloth is not a goal (the fold alone would be sayable, not the whole)",
+    "I-060": "no yellow block in the scene (only a red and a blue block)",
+    "J-004": "'fill the cup about halfway': a stated amount; poured states no amount",
+    "J-008": "no kettle in the scene, and switching an appliance on is not a goal",
+    "J-018": "heating the water: nothing in the scene heats and heating is not a goal (the pour alone would be sayable, not the whole)",
+    "J-027": "no knife in the scene",
+    "J-032": "'just hold it up in the air. Don't put it anywhere': an end with the block held cannot be said (a goal spec "
+    "ends at home, a held object is put back)",
+    "J-035": "onto the target and then back where it was: goals are kept once achieved, so a placement undone later cannot "
+    "be said (the end state is the start)",
+    "J-043": "no coffee machine or water in the scene; making an espresso is not a goal",
+    "J-048": "a side fold (left half onto right half): folded is only near corners onto far corners",
+    "J-050": "one corner laid diagonally on the opposite one by one arm (a triangle): folded is both near corners onto the far corners",
+    "J-051": "folding twice (in half and in half again): folded is one fold, near corners onto far corners",
+    "J-052": "sliding the whole towel flat to the left: the cloth is only its corner points and folded; no goal moves a cloth",
+    "J-058": "no green block in the scene (only a red and a blue block)",
+    "J-060": "turning the cup upside down over the red block: no goal turns an object over or covers one with another (placed stands it upright)",
 }
 
 HEADER = """# Labels of the blind evaluation set (issue 59). Built by build_labels.py; do not edit by hand.
 #
-# For each instruction of writer_A.yaml ... writer_F.yaml and writer_H.yaml (seven writers, 390): its scene, and the goal it means
-# as a goal spec's goals (`agentchord schema goal`), or expect: refused with why (the scene cannot
-# do it, or the goal language cannot say it). Written from the instruction and the writer's
-# `meaning` by a labeller who did not write them, following build_corpus.py's label conventions
-# (docs/language.md), without running the composer on them. Each goal is a valid GoalSpec and
-# names only its scene's objects and regions (the seed-0 scene).
+# For each instruction of writer_A.yaml ... writer_F.yaml, writer_H.yaml, writer_I.yaml and
+# writer_J.yaml (nine writers, 510): its scene, and the goal it means as a goal spec's goals
+# (`agentchord schema goal`), or expect: refused with why (the scene cannot do it, or the goal
+# language cannot say it). Written from the instruction and the writer's `meaning` by a labeller who
+# did not write them, following build_corpus.py's label conventions (docs/language.md), without
+# running the composer on them. Each goal is a valid GoalSpec and names only its scene's objects and
+# regions (the seed-0 scene).
 """
 
 
@@ -702,10 +899,10 @@ def _scene_obs(task: str):
 
 def main() -> None:
     entries = []
-    for name in ("A", "B", "C", "D", "E", "F", "H"):
+    for name in ("A", "B", "C", "D", "E", "F", "H", "I", "J"):
         entries += yaml.safe_load((HERE / f"writer_{name}.yaml").read_text(encoding="utf-8"))["entries"]
     ids = [e["id"] for e in entries]
-    assert len(ids) == len(set(ids)) == 390, len(ids)
+    assert len(ids) == len(set(ids)) == 510, len(ids)
     assert set(LABELS) == set(ids), (set(ids) - set(LABELS), set(LABELS) - set(ids))
     assert set(WHY) == {k for k, v in LABELS.items() if v == REFUSE}, set(WHY) ^ {k for k, v in LABELS.items() if v == REFUSE}
     scenes: dict = {}
@@ -729,7 +926,7 @@ def main() -> None:
         counts[eid[0], "labelled"] += 1
     text = yaml.dump({"labels": labels}, Dumper=_Dumper, sort_keys=False, width=200, allow_unicode=True)
     (HERE / "labels.yaml").write_text(HEADER + text, encoding="utf-8")
-    for name in "ABCDEFH":
+    for name in "ABCDEFHIJ":
         print(f"writer {name}: {counts[name, 'labelled']} labelled, {counts[name, 'refused']} refused")
     print(f"labels.yaml: {len(labels)} entries")
 
