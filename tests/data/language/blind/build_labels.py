@@ -1,10 +1,10 @@
 """Label the blind evaluation set (issue 59): the goal each instruction means, written to labels.yaml.
 
-The nine writers' files (writer_A.yaml ... writer_F.yaml, writer_H.yaml, writer_I.yaml and
-writer_J.yaml) hold 510 instructions, each with the writer's own ``meaning`` (the intended end
-state) and ``possible``. This script states, per id, the goal the instruction means as a goal spec's
-goals (``agentchord schema goal``), written with the label helpers of ../build_corpus.py and its
-conventions (docs/language.md): ``put X down``/``back`` is ``placed`` with no place;
+The eleven writers' files (writer_A.yaml ... writer_K.yaml) hold 630 instructions, each with the
+writer's own ``meaning`` (the intended end state) and ``possible``. This script states, per id, the
+goal the instruction means as a goal spec's goals (``agentchord schema goal``), written with the
+label helpers of ../build_corpus.py and its conventions (docs/language.md): ``put X down``/``back``
+is ``placed`` with no place;
 ``beside``/``next to`` is ``rel()`` (the side the object is on; a flat utensil beside a flat anchor
 at 17 cm, turned along y); ``move X left|right|nearer`` a bit is ``nudge()`` (10 cm), and
 ``forward`` for the coffee tray is its ``forward`` region; an object still held when the instruction
@@ -528,6 +528,111 @@ LABELS: dict[str, object] = {
     "F-058": [rel(B, "blue_block", "cup", "left"), rel(B, "red_block", "blue_block", "left")],
     "F-059": [hand("red_block", "left", "right"), rel(B, "red_block", "cup", "right", "right")],
     "F-060": REFUSE,
+    # --- writer G ----------------------------------------------------------------------------
+    # "pour water into cup w/ right arm, bottle back upright after": the pour's arm; the bottle was not taken
+    # in a clause of its own and its put-back names no arm (as D-001, E-002).
+    "G-001": [pour(arm="right"), put("bottle")],
+    # "use your right hand to pour some water into the red cup": the pour's arm; "some": a vague amount; the
+    # put-down is unsaid and the bottle was not taken in a clause of its own: no arm (as E-002, J-005).
+    "G-002": [pour(arm="right"), put("bottle")],
+    "G-003": REFUSE,
+    # "take the bottle with the right arm and pour ..., after put the bottle back standing": taken by a said
+    # arm, so the pour and the put-back are the right arm's (as E-005).
+    "G-004": [pour(arm="right"), put("bottle", "right")],
+    "G-005": POUR1,  # end state: water in the red cup, the bottle still standing (as E-004)
+    "G-006": POUR1,  # "pour a little into the cup, then set it back down": a vague amount; "it": the bottle
+    # "First grab the bottle with your right arm. Second, tip it over the cup ... Third, stand the bottle back
+    # up": taken by a said arm, so the pour and the put-back are the right arm's (as E-005).
+    "G-007": [pour(arm="right"), put("bottle", "right")],
+    # "use your left hand to pick up the cup and put it down right next to the bottle": the left arm takes it
+    # and sets it beside the bottle, on its left (the side it is on; as F-007).
+    "G-008": [rel(P1, "cup", "bottle", "beside", "left")],
+    "G-009": REFUSE,
+    # "Left arm lift the cup. Right arm pour into it. Then put both down.": the put-down is a sentence of its
+    # own with no arm; the cup was taken by the said left arm, the bottle not in a clause of its own (as D-009).
+    "G-010": POUR2_LR,
+    "G-011": POUR2_LR,  # "hold the cup up with your left hand while your right hand pours ... Afterwards, set them both back"
+    "G-012": POUR2,  # "hold the cup up in the air while u do it ... put everything back after": held cup, arms unsaid
+    # "Left hand take the cup up, right hand take the bottle and pour ...": both taken by said arms; the right
+    # arm pours with the cup held, each puts its own down (as C-013).
+    "G-013": [pour(arm="right", hold=True), put("cup", "left"), put("bottle", "right")],
+    # "Just a splash": a vague amount; "Keep the cup off the table with one arm while you pour with the other
+    # one": held cup, no arm named (as B-013, F-013).
+    "G-014": POUR2,
+    # "Pick the cup up with your left hand and pass it over to the right one": nothing said about putting it
+    # down, so by the convention the right arm that holds it puts it back (as E-015; the writer's meaning,
+    # the cup still held at the end, is not sayable, and the instruction does not ask for it).
+    "G-015": [hand("cup", "left", "right"), put("cup", "right")],
+    # "right in front of the bottle": directly in front, nearer the robot (as E-058).
+    "G-016": [rel(P2, "cup", "bottle", "front")],
+    # End state and "Do the pouring with the cup held up, not on the table": held cup, arms unsaid; both back
+    # "roughly where they started": put back.
+    "G-017": POUR2,
+    "G-018": SETTING,  # "set the table - fork and spoon next to the plate": each on the side it is on
+    "G-019": SETTING,  # "Both pointing away from you": the setting convention (turned along y)
+    # "Left arm: move the fork next to the plate, facing forward. Right arm: same thing with the spoon on the
+    # other side": each heading said for its step; "facing forward": the setting convention.
+    "G-020": SETTING_ARMS,
+    "G-021": SETTING,  # "near the plate, like when we are eating dinner": a place setting, fork left, spoon right
+    "G-022": SETTING,  # "a proper place setting ... both pointing straight out away from you" (as F-021)
+    "G-023": [on("spoon", "plate")],
+    # "right next to the fork": beside it on the side the spoon is on (its right; as B-019), 17 cm and turned
+    # along y by the helper's flat-anchor rule (still on the table's left, as the writer's meaning says).
+    "G-024": [rel(T, "spoon", "fork")],
+    # Swap the two places: absolute points, each the other's start (as B-012), in the order said (the fork first).
+    "G-025": [at_xy("fork", *spot(T, "spoon")), at_xy("spoon", *spot(T, "fork"))],
+    "G-026": REFUSE,
+    "G-027": HANDOVER,  # "block left to right hand, then onto the target"
+    "G-028": HANDOVER,  # "the target circle": the target region
+    "G-029": TARGET,  # "standing inside the marked area on the right": the target; placed stands it upright anyway
+    "G-030": TARGET,
+    # "Take the orange block, give it to the other hand": no giver said, the arm that picks it up, the left
+    # (the block is on the left; as A-024, F-026).
+    "G-031": HANDOVER,
+    # "you'll probably have to pass it between your hands": the speaker says how it is to be done (a
+    # hand-over, left to right: the block is on the left, the target on the right), not an optional offer
+    # like B-010's "you can ... if that's easier"; the writer's meaning agrees.
+    "G-032": HANDOVER,
+    "G-033": HANDOVER,
+    "G-034": REFUSE,
+    "G-035": COFFEE,  # "carry tray forward w both hands": the forward spot
+    "G-036": COFFEE,  # "moving the tray a little further away from you using both arms": the forward spot
+    "G-037": COFFEE_LEFT,  # "Left arm," heads the capsule sentence only; "move the tray forward a bit": the forward spot
+    # End state: "the tray pushed back a little on the table, still centred": back = away from the robot (as
+    # A-031); the forward spot is centred (x 0.00).
+    "G-038": COFFEE,
+    "G-039": COFFEE,  # "then lift it with both hands and move it forward": "it" is the tray
+    # "shift the tray back a few centimetres, away from you": the forward spot (the direction names the region;
+    # as A-034); "Leave the capsule where it is": no goal for it.
+    "G-040": TRAY_FWD,
+    "G-041": [into("capsule", "tray", "left")],  # "coffee pod": the capsule; "with your left hand"; the tray stays
+    "G-042": REFUSE,
+    "G-043": FOLD,
+    "G-044": FOLD,  # "the edge closest to you lines up with the far edge": the near edge onto the far edge (as F-048)
+    "G-045": FOLD,  # each arm a near corner, onto the far corners
+    "G-046": FOLD,  # "fold it over once, bottom to top": near onto far (as F-047)
+    "G-047": FOLD,  # "take the two corners near you and put them on the two corners far away"
+    "G-048": FOLD,  # "with the folded edge closest to me": crease near (as E-046, F-051)
+    "G-049": REFUSE,
+    "G-050": REFUSE,
+    "G-051": [into("red_block", "cup")],
+    "G-052": [into("blue_block", "cup")],
+    "G-053": [on("red_block", "blue_block")],
+    "G-054": [into("red_block", "cup"), into("blue_block", "cup")],  # "both blocks", order unsaid: as D-055
+    # "next of the blue cube", side unsaid: the side the red cube is on (its left; as E-054).
+    "G-055": [rel(B, "red_block", "blue_block")],
+    # "a little bit to the left, just a few cm": a vague distance, the convention's nudge (as B-047).
+    "G-056": [nudge(B, "blue_block", "left")],
+    # "Use your left hand for the red block and your right hand for the blue one, and put them both in the
+    # bowl": each by its arm, in the order named (red first; as C-045); "the bowl": the white cup (as C-048).
+    "G-057": [into("red_block", "cup", "left"), into("blue_block", "cup", "right")],
+    "G-058": [into("blue_block", "cup"), into("red_block", "cup")],  # "First ... the blue block ..., then ... the red one"
+    # Left to right, then the right arm that holds it puts it just right of the cup (as F-059).
+    "G-059": [hand("red_block", "left", "right"), rel(B, "red_block", "cup", "right", "right")],
+    # End state: the blue block on the red one; "the cup moved over to the far right side": "far" is how far
+    # over (the writer's meaning: the table's right side), not away from the robot: the table's right side
+    # point (as A-050).
+    "G-060": [on("blue_block", "red_block"), at("cup", "right")],
     # --- writer H ----------------------------------------------------------------------------
     "H-001": POUR1,
     "H-002": POUR1,  # "a little water": a vague amount, a pour; "stand the bottle back up": put back
@@ -792,6 +897,94 @@ LABELS: dict[str, object] = {
     "J-058": REFUSE,
     "J-059": [into("blue_block", "cup")],  # "the bowl": the white cup; "don't touch the red one": no goal
     "J-060": REFUSE,
+    # --- writer K ----------------------------------------------------------------------------
+    # "pour some water ... with the right arm then put the bottle back": the pour's arm; the put-back names
+    # no arm and the bottle was not taken in a clause of its own (as D-001, G-001).
+    "K-001": [pour(arm="right"), put("bottle")],
+    "K-002": POUR1,  # "fill up the cup with a bit of water": a vague amount, a pour
+    "K-003": [pour(arm="right"), put("bottle", "right")],  # "right hand:" heads grab, pour, set it back upright
+    "K-004": POUR1,  # end state: water in the cup, the bottle standing where it was (as E-004)
+    "K-005": POUR1,  # "after put it down again": the bottle back
+    "K-006": POUR1,  # "tip a little into the cup, and then stand it back up": a vague amount; "it": the bottle
+    "K-007": [rel(P1, "cup", "bottle")],  # "Slide the cup over so it's right next to the bottle": on its left (as D-007)
+    "K-008": REFUSE,
+    # "Left arm, ... hold it up. Right arm, pour ... Then put both of them down.": the put-down is a sentence of
+    # its own with no arm (as D-009, the same words).
+    "K-009": POUR2_LR,
+    # "hold the cup up ... with your left hand while the right one pours water in, then set them both back
+    # down": the cup by the left that holds it, the right arm pours; the put-down names no arm (as F-010).
+    "K-010": POUR2_LR,
+    # "a cup with water in it, but don't pour while the cup's sitting on the table, lift it up first": held
+    # cup, arms unsaid; "put everything back upright".
+    "K-011": POUR2,
+    "K-012": POUR2_LR,  # "lift cup w/ left, pour w/ right, put both down"
+    "K-013": POUR2,  # "pour water in the cup while you are holding it": held cup, arms unsaid; "place them on the table"
+    # "First pick up the cup, second grab the bottle, third pour into the cup, and last set them both down":
+    # the cup is not put down before the pour: held (as A-012, I-015), arms unsaid.
+    "K-014": POUR2,
+    "K-015": [rel(P2, "bottle", "cup")],  # "right beside the cup": on its right, the side the bottle is on (as D-016)
+    # "Use your right hand to pick up the cup, then pass it over to your left hand": nothing said about putting
+    # it down, so the left arm that holds it puts it back (as E-015; the writer's meaning, the cup still held
+    # at the end, is not sayable, and the instruction does not ask for it).
+    "K-016": [hand("cup", "right", "left"), put("cup", "left")],
+    "K-017": SETTING,  # "both pointing away from you": the setting convention
+    # "left arm take the fork, right arm the spoon, put them next to the plate facing forward": each taken by
+    # a said arm, each on its own side.
+    "K-018": SETTING_ARMS,
+    "K-019": SETTING,  # "tidy up the cutlery ... either side of the plate, like a proper place setting"
+    "K-020": SETTING,  # "fork L of plate, spoon R, tips pointing to the far end": the setting convention
+    "K-021": [on("spoon", "plate")],
+    "K-022": SETTING,  # "the fork next to the plate, and then ... the spoon on the other side": fork first, on its own side
+    "K-023": REFUSE,
+    "K-024": [rel(T, "spoon", "fork")],  # "next to the fork": on its right, the side the spoon is on (as B-019, G-024)
+    "K-025": HANDOVER,
+    "K-026": HANDOVER,  # "hand it across between arms, don't just drag it": left to right (the block is on the left)
+    "K-027": HANDOVER,  # "left grabs block -> handover -> right drops it on the mark": "the mark": the target
+    "K-028": TARGET,  # "the target spot on the right": the target; method open
+    "K-029": TARGET,  # "standing up inside the target circle": placed stands it upright anyway
+    "K-030": REFUSE,
+    "K-031": REFUSE,
+    "K-032": [region("block", "target", "right")],  # "Just use your right arm ..., no need to pass it": as C-028
+    "K-033": COFFEE,
+    "K-034": COFFEE,  # "pod": the capsule; "a bit further away": the forward spot
+    # "Left hand:" heads the capsule step only; "both hands on the handles and take it forward to the spot":
+    # the forward region (as J-040).
+    "K-035": COFFEE_LEFT,
+    "K-036": COFFEE,  # end state: "capsule in and the tray a little further away from me": the forward spot
+    "K-037": COFFEE,  # "after that both arm lift tray and bring forward"
+    "K-038": TRAY_FWD,  # "Leave the capsule where it is": no goal for it
+    "K-039": [into("capsule", "tray")],  # the tray stays
+    "K-040": REFUSE,
+    "K-041": FOLD,  # "bottom edge up to the top edge" (as F-047)
+    "K-042": FOLD,
+    "K-043": FOLD,  # "in half ..., away from you": the near half laid away, onto the far half
+    "K-044": FOLD,  # each arm a near corner, onto the far corners
+    "K-045": FOLD,  # "with the fold on my side": crease near (as E-046, F-051)
+    "K-046": FOLD,  # "fold it": the towel, the scene's only object; direction unsaid: the natural fold (as A-038)
+    "K-047": REFUSE,
+    "K-048": REFUSE,
+    "K-049": [into("red_block", "cup")],
+    "K-050": [into("red_block", "cup"), into("blue_block", "cup")],  # "both blocks", order unsaid: as D-055
+    "K-051": [on("red_block", "blue_block")],
+    "K-052": [on("blue_block", "red_block")],  # "blue on red"
+    "K-053": [into("blue_block", "cup"), into("red_block", "cup")],  # "the blue block ... first, and then the red one"
+    # Taken by the said left arm, handed to the right, which puts it in the cup (as B-049).
+    "K-054": [hand("red_block", "left", "right"), into("red_block", "cup", "right")],
+    "K-055": [rel(B, "red_block", "blue_block")],  # side unsaid: the side the red block is on (its left; as E-054)
+    # End state: the blue block in the cup, the red one "just beside the cup", side unsaid: the side it is on
+    # (its left; as E-055).
+    "K-056": [into("blue_block", "cup"), rel(B, "red_block", "cup")],
+    # "put it on top of... actually no, just put it next to the cup": the correction decides (as I-059); side
+    # unsaid: the side the blue block is on (1.5 cm right of the cup: right; as F-055).
+    "K-057": [into("red_block", "cup"), rel(B, "blue_block", "cup")],
+    # "the blue cube put it beside of the red one": the red cube is then in the cup, so beside it is beside the
+    # cup that holds it (anchored on the container, as J-057 anchors on a stack's base; the writer's meaning
+    # says so); side unsaid: the side the blue cube is on (right, as K-057).
+    "K-058": [into("red_block", "cup"), rel(B, "blue_block", "cup")],
+    "K-059": REFUSE,
+    # "right arm, grab the blue block and set it down to the left of the red block": the address heads the
+    # sentence, said for both steps.
+    "K-060": [rel(B, "blue_block", "red_block", "left", "right")],
 }
 
 #: Why each refused entry is refused.
@@ -846,6 +1039,13 @@ WHY = {
     "no goal moves a cloth (the fold alone would be sayable, not the whole)",
     "F-052": "no drawer in the scene",
     "F-060": "no green block in the scene (only a red and a blue block)",
+    "G-003": "'fill the cup up about halfway': a stated amount; poured states no amount (the bottle put back alone would be sayable, not the whole)",
+    "G-009": "no bowl in the pouring scene (only the bottle and the red cup)",
+    "G-026": "no knife in the scene",
+    "G-034": "no green block in the scene (only the orange block)",
+    "G-042": "no coffee machine in the scene; making an espresso is not a goal",
+    "G-049": "one corner laid on another by one arm, the rest left flat (a partial fold): folded is both near corners onto the far corners",
+    "G-050": "ironing the towel: no iron in the scene and ironing is not a goal (the fold alone would be sayable, not the whole)",
     "H-007": "no orange juice in the scene (the only bottle holds water)",
     "H-015": "the bottle (5 cm wide, 17 cm tall) does not fit inside the cup (5 cm wide, 9.5 cm tall)",
     "H-025": "no knife in the scene",
@@ -878,14 +1078,23 @@ WHY = {
     "J-052": "sliding the whole towel flat to the left: the cloth is only its corner points and folded; no goal moves a cloth",
     "J-058": "no green block in the scene (only a red and a blue block)",
     "J-060": "turning the cup upside down over the red block: no goal turns an object over or covers one with another (placed stands it upright)",
+    "K-008": "no milk carton in the scene (only a bottle of water)",
+    "K-023": "no knife in the scene",
+    "K-030": "'then just hold it there': an end with the block held in the air cannot be said (a goal spec ends at home, "
+    "a held object is put back)",
+    "K-031": "no green block in the scene (only the orange block)",
+    "K-040": "brewing coffee: no coffee machine, not a goal",
+    "K-047": "lifting the towel by its near corners and holding it there: no goal lifts a cloth (folded is its only goal), "
+    "and an end with something held in the air cannot be said",
+    "K-048": "one corner laid on another by one arm (a partial fold): folded is both near corners onto the far corners",
+    "K-059": "no yellow block in the scene (only a red and a blue block)",
 }
 
 HEADER = """# Labels of the blind evaluation set (issue 59). Built by build_labels.py; do not edit by hand.
 #
-# For each instruction of writer_A.yaml ... writer_F.yaml, writer_H.yaml, writer_I.yaml and
-# writer_J.yaml (nine writers, 510): its scene, and the goal it means as a goal spec's goals
-# (`agentchord schema goal`), or expect: refused with why (the scene cannot do it, or the goal
-# language cannot say it). Written from the instruction and the writer's `meaning` by a labeller who
+# For each instruction of writer_A.yaml ... writer_K.yaml (eleven writers, 630): its scene, and the
+# goal it means as a goal spec's goals (`agentchord schema goal`), or expect: refused with why (the
+# scene cannot do it, or the goal language cannot say it). Written from the instruction and the writer's `meaning` by a labeller who
 # did not write them, following build_corpus.py's label conventions (docs/language.md), without
 # running the composer on them. Each goal is a valid GoalSpec and names only its scene's objects and
 # regions (the seed-0 scene).
@@ -899,10 +1108,10 @@ def _scene_obs(task: str):
 
 def main() -> None:
     entries = []
-    for name in ("A", "B", "C", "D", "E", "F", "H", "I", "J"):
+    for name in ("A", "B", "C", "D", "E", "F", "G", "H", "I", "J", "K"):
         entries += yaml.safe_load((HERE / f"writer_{name}.yaml").read_text(encoding="utf-8"))["entries"]
     ids = [e["id"] for e in entries]
-    assert len(ids) == len(set(ids)) == 510, len(ids)
+    assert len(ids) == len(set(ids)) == 630, len(ids)
     assert set(LABELS) == set(ids), (set(ids) - set(LABELS), set(LABELS) - set(ids))
     assert set(WHY) == {k for k, v in LABELS.items() if v == REFUSE}, set(WHY) ^ {k for k, v in LABELS.items() if v == REFUSE}
     scenes: dict = {}
@@ -926,7 +1135,7 @@ def main() -> None:
         counts[eid[0], "labelled"] += 1
     text = yaml.dump({"labels": labels}, Dumper=_Dumper, sort_keys=False, width=200, allow_unicode=True)
     (HERE / "labels.yaml").write_text(HEADER + text, encoding="utf-8")
-    for name in "ABCDEFHIJ":
+    for name in "ABCDEFGHIJK":
         print(f"writer {name}: {counts[name, 'labelled']} labelled, {counts[name, 'refused']} refused")
     print(f"labels.yaml: {len(labels)} entries")
 
