@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import re
 
-from agentchord.agents.rules.rewrite_steps import Note, sub
+from agentchord.agents.rules.rewrite_steps import Note, NotAGoalError, sub
 
 #: Words after a side that make it a part of something, not an arm.
 _PART = r"(?:arm|hand|gripper|of|side|half|edge|corner|corners|end|part|area|region)s?"
@@ -128,3 +128,26 @@ def read_arms(s: str, note: Note) -> str:
         s = s[: again.start()] + f"{again[1]}{again[2].rstrip()} with the {arms[-1]} arm" + s[again.end():]
         note("arm")
     return s
+
+
+#: "..., not the right one", "but not with your left hand": the arm the step is not done with.
+_NOT_ARM = re.compile(r"(?: ,)? (?:and |but )?not (?:with |using )?(?:the |your )?(left|right)(?: one| arm| hand| gripper)?(?= ,|$)")
+_ARM_NAMED = re.compile(r"\b(left|right) (?:arm|hand|gripper)\b")
+
+
+def not_this_arm(s: str, note: Note) -> str:
+    """``s`` (one sentence) with an arm it says not to use read: said beside the other arm, it adds nothing (dropped);
+    alone, the step is the other arm's.
+
+    Raises:
+        NotAGoalError: The arm not to use is the one the sentence names for the step.
+    """
+    m = _NOT_ARM.search(s)
+    if m is None:
+        return s
+    named = set(_ARM_NAMED.findall(s[: m.start()] + s[m.end():]))
+    if m[1] in named:
+        raise NotAGoalError(f"says to use the {m[1]} arm and not to use it")
+    note("arm")
+    other = "" if named else f" with the {'right' if m[1] == 'left' else 'left'} arm"
+    return (s[: m.start()] + other + s[m.end():]).strip()

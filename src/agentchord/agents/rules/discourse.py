@@ -36,7 +36,7 @@ from __future__ import annotations
 import re
 from collections.abc import Callable
 
-from agentchord.agents.rules.arm_words import each_arm, read_arms
+from agentchord.agents.rules.arm_words import each_arm, not_this_arm, read_arms
 from agentchord.agents.rules.cloth_parts import FOLD, drop_fold_way, read_cloth_parts, refuse_fold_across
 from agentchord.agents.rules.end_states import END_STATE, read_end_state
 from agentchord.agents.rules.ordinals import ANY_ORDER, each_in_order, each_of_list, first_before, first_of_both
@@ -44,6 +44,7 @@ from agentchord.agents.rules.held_pour import hold_before_pour, take_conditions
 from agentchord.agents.rules.places import read_places, restates, there_is_last_place
 from agentchord.agents.rules.talk import (
     CLOSERS,
+    HEDGES,
     OPENERS,
     SETTING_MANNER,
     TALK_SENTENCES,
@@ -313,6 +314,8 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
     refuse_fold_across(s)
     s = _drop(OPENERS, s, note, "talk")
     s = _drop(CLOSERS, s, note, "talk")
+    s = _drop(HEDGES, s, note, "talk")
+    s = not_this_arm(s, note)
     s = _drop(re.compile(r"\b(?:for me|for you|if you can|if possible|if that's ok|if that's easier(?: for you)?|though)\b"), s, note, "talk")
     s = _drop(re.compile(r"(?: ,)? (?:is|would be|'s|will be) (?:fine|good|ok|okay|enough|great|perfect|all)(?= ,|$)"), s, note, "talk")
     if re.fullmatch(r"(?:go|do it|start|begin|go ahead|that's all|that is all|done)", s) or any(t.fullmatch(s) for t in TALK_SENTENCES):

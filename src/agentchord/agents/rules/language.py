@@ -82,8 +82,9 @@ class Clause:
     back: bool = False
 
 
-#: A direction word that ends a noun phrase of a move -> the direction.
-_DIRECTIONS = {"forward": "forward", "forwards": "forward", "ahead": "forward", "left": "left", "right": "right", "back": "backward"}
+#: A direction word that ends a noun phrase of a move -> the direction ("push it back": away from whoever stands
+#: where the robot is, towards the table's back, as "the back of the table" is).
+_DIRECTIONS = {"forward": "forward", "forwards": "forward", "ahead": "forward", "left": "left", "right": "right", "back": "forward"}
 
 
 class ParseError(ValueError):
@@ -106,7 +107,11 @@ def normalise(instruction: str) -> str:
     """Lower case, numbered steps and punctuation as separators, the possessive ``'s`` dropped."""
     text = instruction.lower().replace("\u2019", "'").replace("\n", " ; ")
     text = re.sub(r"(?:^|(?<=\s))(?:step\s*)?\d+\s*[.):]\s+", " ; ", text)  # "1. pick ...", "step 2) ..."
+    # "fork n spoon", "cup & bottle", "fork + spoon", "rock 'n' roll": shorthand for "and" between two words.
+    text = re.sub(r"(?<=\w)\s+(?:n|&|\+|'n'?|'n)\s+(?=\w)", " and ", text)
     text = re.sub(r"'s\b", "", text)
+    # "put your things back down", "the stuff": the objects already named, as "them".
+    text = re.sub(r"\b(?:your|the|those|these|all the|both) (?:things|stuff|objects|items)\b", "them", text)
     text = re.sub(r"\bcentre\b", "center", text)
     # fold_towel's how ("bringing its bottom corners onto ...", "so the near edge meets ..."): a purpose clause of a fold only.
     text = re.sub(r",?\s*\b(?:bringing|laying|matching|with its(?! (?:left|right|other|both) )|putting its)\b[^,;.]*", "", text)

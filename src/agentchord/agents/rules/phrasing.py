@@ -26,6 +26,7 @@ import re
 from dataclasses import dataclass, field
 from functools import lru_cache
 
+from agentchord.agents.rules.corrections import read_corrections
 from agentchord.agents.rules.discourse import read_sentences
 from agentchord.agents.rules.english import is_word
 
@@ -307,6 +308,7 @@ def rewrite(text: str, vocabulary: frozenset[str] = frozenset(), objects: frozen
                 out.corrected[word] = fixed
                 words[i] = fixed
         text = " ".join(words)
+    text = read_corrections(text, objects, _verb, steps.append)
     read = read_sentences(text.split(" ; "), objects, steps.append, _verb)
     sentences = [_sentence(sentence, steps, objects) for sentence in read if sentence]
     out.text = _ellipsis(" ; ".join(s for s in sentences if s).replace(" , ; ", " , "), steps, objects)

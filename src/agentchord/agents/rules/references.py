@@ -208,6 +208,12 @@ class Context:
             # A colour the one object of that kind has ("the white bowl" for the white cup) still describes it.
             if len(head) == 1 and all(c in kb.words(head[0]) for c in set(plain[:-1]) & set(COLOURS)):
                 candidates = head
+            # Another object's word before the head ("the fork n spoon", "the cup bottle") is a second object the
+            # phrase names: reading the head alone would silently drop it.
+            others = sorted({o.name for o in pool for w in plain[:-1] if w in kb.words(o) and o not in candidates})
+            if candidates and others:
+                raise self.error(np.text, f"names {', '.join(others)} as well as the {candidates[0].name}: "
+                                          "join two objects with 'and' (the fork and the spoon)")
         for word in sizes:
             if len(candidates) > 1:
                 measure, largest = SIZE_WORDS[word]
@@ -260,11 +266,28 @@ class Context:
                 return region.name
         return None
 
+    def other_arm(self, obj: str | None) -> str | None:
+        """The arm ``the other one|arm|hand`` names: not the one holding ``obj``, else not the one holding what else
+        is in hand ("pick up the cup with the left hand, pour the bottle into it with the other one": the right); None
+        where what else is in hand has no arm said (the planner gives the free arm).
+
+        Raises:
+            InstructionNotGroundedError: Nothing says which arm the other one is not (it is never dropped).
+        """
+        if obj in self.held_by:
+            return other_arm(self.held_by[obj])
+        busy = {self.held_by[n] for n in self.in_hand if n != obj and n in self.held_by}
+        if len(busy) == 1:
+            return other_arm(busy.pop())
+        if any(n != obj for n in self.in_hand):
+            return None  # what else is in hand is held by an arm the planner chooses: it uses the free one
+        raise self.error("the other arm", "says which arm only by the other one, and no arm holds anything yet (say left or right)")
+
     def arm_of(self, said: str | None, obj: str | None = None) -> str | None:
         if said in ("left", "right"):
             return said
-        if said == "other" and obj in self.held_by:
-            return other_arm(self.held_by[obj])
+        if said == "other":
+            return self.other_arm(obj)
         if said == "both" and obj:  # "both of you set them down": each arm what it holds
             return self.held_by.get(obj) or self.pour_arms.get(obj)
         return self.held_by.get(obj) if obj else None

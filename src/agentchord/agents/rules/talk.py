@@ -33,10 +33,16 @@ _ACTION_STEMS = ("pour", "empt", "fill", "pick", "grab", "grasp", "take", "took"
                  "pop", "stick", "nudge", "drag", "turn", "rotate", "spread", "line", "pile", "collect", "fetch",
                  "deposit", "toss", "plop", "release", "let", "pinch", "clean", "tidy", "clear")
 #: Interjections and courtesies that open or close a sentence.
-OPENERS = re.compile(r"^(?:(?:hi|hello|hey|hiya|yo|ok|okay|alright|so|um+|uh+|hmm+|oh|ah|well|sorry|excuse me|"
+OPENERS = re.compile(r"^(?:(?:hi|hello|hey|hiya|yo|ok|okay|alright|so|actually|um+|uh+|hmm+|oh|ah|well|sorry|excuse me|"
                       r"good (?:morning|afternoon|evening)|dear robot|robot|hey robot|hi robot|hello robot)(?: ,)? )+")
 CLOSERS = re.compile(r"(?:^|(?: ,)? )(?:thanks|thank you|thx|ty|cheers)(?: (?:so|very) much| a lot| in advance)?(?: ,)?"
                       r"(?: (?:robot|buddy|friend))?$")
+#: Hesitations anywhere ("and uh pour it") and tags that end a clause ("... a bit yeah", "... lol", "and that's it").
+HEDGES = re.compile(r"\b(?:uh+|um+|uhm+|erm+|er)\b(?: ,)?|(?: ,)? (?:yeah|yep|yup|lol|haha|you know|ok\?|and that(?:'s| is) (?:it|all)|"
+                    r"that(?:'s| is) (?:it|all)|and that (?:it|all)|if you would|this time)(?= ,|$)|"
+                    # "then you can just put it back": a permission or a question that is the step itself.
+                    r"(?:(?<=then )|(?<=and )|(?<=, ))(?:you can|you could|can you|could you|would you) "
+                    r"(?!(?:hold|do|use|take)\b)(?=[a-z]+ (?:the|it|them|both|your)\b)")  # "you can hold ...": permission (TALK_SENTENCES)
 #: How a table setting is meant ("like for dinner", "like a proper place setting", "like at a restaurant").
 SETTING_MANNER = (r"(?:just )?like (?:for (?:dinner|lunch|breakfast|a meal)|(?:a |an )?(?:proper |normal |usual |formal |nice )?"
                    r"(?:place|table|dinner) setting|(?:they do |you'd see |you see |you would see )?(?:at|in) a restaurant)")

@@ -1,0 +1,58 @@
+"""General guards against wrong goals: what a reader cannot account for is refused, never planned without it.
+
+- a word that names a scene object is never dropped from a noun phrase (``the fork n spoon`` read as the spoon);
+- a direction said after a move verb (``push it back``) is a way to move, the same way as the table's back,
+  never a put-back or the way towards the robot;
+- an arm said as ``the other one`` is the arm not holding what is in hand, or refused.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from agentchord.agents.exceptions import InstructionNotGroundedError
+from agentchord.agents.rules.instructions import ground_instruction
+from grounding import goal, same, scene
+
+P2, T, C, B = "dual_arm_pour_water", "rearrange_table", "setup_coffee_tray", "blocks_and_cup"
+
+
+def refused(task: str, text: str) -> None:
+    with pytest.raises(InstructionNotGroundedError):
+        ground_instruction(text, scene(task))
+
+
+def test_an_object_word_inside_a_noun_phrase_is_never_dropped() -> None:
+    # Two objects run together with no "and": refused, not read as the last one.
+    refused(T, "put the fork spoon next to the plate")
+    refused(B, "put the red block cup on the left side of the table")
+    refused(P2, "pick up the bottle cup")
+    # A word of the object's own description still describes it.
+    assert goal(C, "put the coffee capsule in the tray")[0]["obj"] == "capsule"
+
+
+def test_shorthand_for_and_joins_two_objects() -> None:
+    same(T, "put the fork and the spoon by the plate", ["put the fork n spoon by the plate", "put the fork & spoon by the plate",
+                                                        "put the fork + the spoon by the plate"])
+    same(B, "put the red block and the blue block in the cup", ["put the red block n the blue block in the cup"])
+
+
+def test_back_after_a_move_verb_is_away_from_the_robot() -> None:
+    # The coffee scene's forward spot is where "back" goes, as "further away" does.
+    same(C, "move the tray forward", ["push the tray back a bit", "shove the tray back", "slide the tray back a little"])
+    # With no region that way: a nudge away from the robot (y grows), never towards it.
+    moved = goal(B, "push the cup back")[0]
+    start = next(o for o in scene(B).objects if o.name == "cup").pos
+    assert moved["at"][1] > start[1]
+    # "back where it was" is still a put-back, and "closer" still comes towards the robot.
+    assert "at" not in goal(B, "move the red block back where it was")[0]
+    assert goal(B, "push the cup closer")[0]["at"][1] < start[1]
+
+
+def test_the_other_arm_is_the_one_not_holding_what_is_in_hand() -> None:
+    pour = goal(P2, "pick up the cup with your left hand, and pour the bottle into it with the other one")[0]
+    assert pour["kind"] == "poured" and pour["arm"] == "right"
+    pour = goal(P2, "hold the cup in the right hand, then pour water from the bottle into it using the other hand")[0]
+    assert pour["arm"] == "left"
+    # Nothing in hand: no arm to be the other of; refused, not left to the planner.
+    refused(B, "put the red block in the cup with the other hand")
