@@ -54,8 +54,11 @@ _BOTTOM_PAIR = re.compile(r"\bbottom (left|right) corner\b.*\bbottom (?!\1)(?:le
 #: Where the near corners go in the fold: the far corners, edge or side.
 _ONTO_TOP = re.compile(r"\btop (?:corners|edge|side|end)\b|\bonto (?:them|the top)\b")
 #: "like folding a napkin", "the way you'd fold a towel": how, said by likeness.
-_LIKE_FOLDING = re.compile(r"(?: ,)? (?:like|as if|the way you(?:'d| would)?) (?:folding|you(?:'d| would)? fold|when you fold|you fold) "
-                           r"(?:a|an|the) [a-z]+(?= ,|$)")
+_LIKE_FOLDING = re.compile(r"(?: ,)? (?:like|as if|the way(?: you(?:'d| would)?)?)(?: when)? (?:(?:you|we|i|people)(?:'re|'d|'m| are| am| would| do)? )?"
+                           r"(?:folding|fold)(?: (?:a|an|the|some))? [a-z]+(?= ,|$)")
+#: "with the fold on my side", "fold nearest you": the crease at the near side, where the rules' fold puts it.
+_NEAR_CREASE = re.compile(r"(?: ,)? with the (?:fold|crease|folded edge|fold line|folded side) (?:on|at|towards?|facing) (?:my|your|the robot's) "
+                          r"(?:side|end|edge)\b")
 
 
 #: The fold's crease said to end away from the robot: the far half laid onto the near one, the other fold.
@@ -80,6 +83,7 @@ def read_cloth_parts(s: str, objects: frozenset[str], note: Note) -> str:
     for pattern, repl in [*_CLOTH_PARTS, *(_EDGE_FROM_YOU if "folded edge" not in s else [])]:
         s = sub(pattern, repl, s, note, "cloth part")
     s = drop(_LIKE_FOLDING, s, note, "how")
+    s = drop(_NEAR_CREASE, s, note, "cloth part")
     if (pair := _BOTTOM_PAIR.search(s)) is not None and _ONTO_TOP.search(s[pair.end():]):
         note("cloth part")
         return FOLD  # each near corner taken (by its own arm, say), then brought to the far edge: the fold

@@ -4,7 +4,8 @@ Read a clause at a time by :mod:`~agentchord.agents.rules.discourse` (after its 
 normalised text. People describe the end state instead of the steps; each kind maps to the step that
 brings it about:
 
-- **a frame** that says "the end state is" ("End result:", "I'd like", "what I want is"): dropped
+- **a frame** that says "the end state is" ("End result:", "I'd like", "what I want is", "what I'm after is",
+  after a time clause: "when you're done I want", "when I come back I want", "by the time I'm back"): dropped
   (:data:`END_STATE`), the state after it read as usual;
 - **water in a vessel**: "water in the cup", "the cup with water in it", "cup has water", "the cup
   full of water" -> ``pour water into the cup``;
@@ -26,7 +27,14 @@ from collections.abc import Callable
 from agentchord.agents.rules.rewrite_steps import Note, sub
 
 #: Frames that say "the end state is": dropped, the state that follows is read as usual.
-END_STATE = re.compile(r"^(?:(?:the )?end result|result|the goal|goal|in the end|at the end|by the end|when you're done|"
+#: When the state is to hold, said before the frame: "when you're done", "when I come back", "by the time I'm back",
+#: "once you've finished", "at the end".
+_WHEN_DONE = (r"(?:(?:when|once|by the time|after) (?:you(?:'re| are|'ve| have)?|ur|i(?:'m| am)?) (?:all )?(?:done|finished|through|back)|"
+              r"(?:when|once|by the time|after) i (?:come|get|am|'m) back|in the end|at the end|by the end|afterwards)(?: ,)? ")
+END_STATE = re.compile(r"^(?:" + _WHEN_DONE + r")?(?:(?:the )?end result|result|the goal|goal|in the end|at the end|by the end|when you're done|"
+                        r"(?:it |everything |things )?(?:should|must) (?:look|be) like|"
+                        r"what i(?:'m| am) (?:after|going for|looking for|hoping for)(?: here)? is|"
+                        r"what i (?:want|need|'d like|would like) (?:to end up with|to see|to have)(?: at the end| in the end)? is|"
                         r"what i(?:'d| would) like (?:in the end |at the end )?is|what i want (?:in the end |at the end )?is|"
                         r"(?:at the end |in the end )?i(?: just| really)?(?: want| need| would like|'d like)|"
                         r"what i(?:'d| would)? (?:want|like|need|hope) to see is|i(?:'d| would)? (?:want|like|need) to see|"
@@ -34,7 +42,8 @@ END_STATE = re.compile(r"^(?:(?:the )?end result|result|the goal|goal|in the end
 
 #: "there to be water in the cup", "the cup with water in it", "cup has water in it": a pour into the cup.
 _WATER_IN = [
-    (re.compile(r"^(?:there (?:to be|is|should be) )?(?:some )?water in (?:the |my )?(\w+)(?: (?:at the end|in the end))?$"), r"pour water into the \1"),
+    (re.compile(r"^(?:there (?:to be|is|should be) )?(?:some )?water in (?:the |my )?(\w+(?: \w+)?)(?: (?:at the end|in the end))?$"),
+     r"pour water into the \1"),
     (re.compile(r"^(?:the |my )?(\w+(?: \w+)?) (?:with|has|should have|to have|having|ends up with|to end up with) (?:some )?water(?: in it)?"
                 r"(?: (?:at the end|in the end))?$"), r"pour water into the \1"),
     (re.compile(r"^(?:the |my )?(\w+(?: \w+)?) (?:is |should be |to be )?(?:full of|filled with) water(?: (?:at the end|in the end))?$"),
@@ -50,7 +59,7 @@ _BACK_AS_IT_WAS = re.compile(r"^(?:and )?(?:then )?(?:the )?(\w+)(?: of them)?(?
 
 #: "the capsule should end up in the tray", "the blue one goes in the cup", "the block to end up inside the target".
 _SHOULD_BE = re.compile(r"^(?:and )?((?:the |my )?[a-z]+(?: (?!should|must|needs?|has|is|will|to|shall)[a-z]+)?(?: and (?:the |my )?[a-z]+)?) "
-                        r"(?:should|must|needs? to|has to|is to|will|to|shall)? ?"
+                        r"(?:should|must|needs? to|has to|is to|will|to|shall)? ?(?:still )?"
                         r"(?:end up|be|go|goes|sit|sits|stay|get|gets|belong|belongs|land|lands)(?: back)? "
                         r"(in|inside|into|on|onto|at|next to|beside|on top of|where) ")
 

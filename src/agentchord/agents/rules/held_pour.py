@@ -7,7 +7,8 @@ the same sentence or another:
 - "pour water into the cup while holding it up";
 - "hold it up off the table while you pour", "keep the cup in the air while pouring";
 - "the cup should be held up off the table while you pour, not sitting on it";
-- "do the pour with the cup held up, not on the table".
+- "do the pour with the cup held up, not on the table";
+- "pour me some water but hold the cup up while you do it" (what is done, in a sentence with a pour, is the pour).
 
 :func:`take_conditions` removes such a condition from a sentence and returns what is held (a noun
 phrase, or ``it``); :func:`hold_before_pour` then puts ``hold X , then`` before the instruction's
@@ -23,12 +24,15 @@ from agentchord.agents.rules.rewrite_steps import Note
 
 _NP = r"(?:it|them|(?:the )?[a-z]+(?: (?!held|lifted|kept|up|should|must|needs?|has|will|while)[a-z]+)?)"
 _UP = r"(?: up)?(?: (?:in the air|in mid-? ?air|off the table|above the table|in (?:your|the) hand))?(?: up)?"
-_WHILE_POUR = r"(?:while|as|when) (?:you(?:'re| are)? )?(?:pour|pouring|fill|filling|tip|tipping)(?: it| into it| in)?(?: though)?"
+#: "while you pour", and "while you do it" said in the sentence of a pour (the pour is what is done).
+_WHILE_POUR = (r"(?:while|as|when) (?:you(?:'re| are)? |u )?(?:pour|pouring|fill|filling|tip|tipping|do it|do that|are doing it|'re doing it)"
+               r"(?: it| into it| in)?(?: though)?(?: (?:lol|haha|yeah|ok|okay|pls|please))*")
 _NOT_ON = r"(?: , not (?:sitting |standing |resting )?on (?:the table|it|the surface))?"
 _ARM = r"(?P<arm> with (?:the |your )?(?:left|right) (?:arm|hand|gripper))?"
 #: A condition on a pour that the vessel poured into is held (group ``np``: what is held).
 _CONDITIONS = [
-    re.compile(rf"(?:^|(?<= , ))(?:and |but )?(?:please )?(?:hold|lift|keep|have) (?P<np>{_NP})(?: held| lifted| raised)?{_UP}{_ARM} {_WHILE_POUR}"
+    re.compile(rf"(?:^|(?<= , )|(?<= )(?=but ))(?:and |but )?(?:please )?(?:hold|lift|keep|have) (?P<np>{_NP})(?: held| lifted| raised)?{_UP}{_ARM} "
+               rf"{_WHILE_POUR}"
                rf"{_NOT_ON}(?= ,|$)"),
     re.compile(rf"(?:^|(?<= , ))(?:and |but )?(?P<np>{_NP}) (?:should|must|needs? to|has to|will) be (?:held|lifted|kept){_UP} "
                rf"{_WHILE_POUR}{_NOT_ON}(?= ,|$)"),

@@ -180,6 +180,8 @@ def _fold(c: Clause, ctx: Context) -> list[Goal]:
         cloth = ctx.cloths[0]
     if cloth is None and np.pronoun == "it" and ctx.cloth_taken:
         cloth = ctx.cloth_taken  # "grab the near corners, fold it": the cloth whose part is in hand
+    if cloth is None and np.pronoun == "it" and not ctx.mentioned and len(ctx.cloths) == 1:
+        cloth = ctx.cloths[0]  # "fold it" with nothing named before: the scene's one cloth is all a fold can mean
     if cloth is None:
         raise ctx.error(np.text, f"is not a cloth of the scene (cloths: {', '.join(ctx.cloths) or 'none'})")
     for corner in kb.CLOTH_CORNERS:
@@ -241,6 +243,7 @@ def _place_at(names: list[str], where: Where | None, c: Clause, ctx: Context) ->
         if (beside := _beside_region(names, anchor_np, where, ctx)) is not None:
             return [Placed(obj=n, at=point, arm=arms[n]) for n, point in beside]
         anchor = ctx.resolve(anchor_np, exclude=tuple(names))
+        anchor = ctx.inside.get(anchor, anchor)
         ctx.last_anchor = anchor
         if where.relation == "side_of" and len(names) == 2:
             return _row(names, anchor, where.side, ctx, arms)
@@ -288,9 +291,9 @@ def _place_at(names: list[str], where: Where | None, c: Clause, ctx: Context) ->
         regions = ", ".join(r.name for r in ctx.scene.regions) or "none"
         raise ctx.error(np.text, f"names no region of the scene (regions: {regions}; or a part of the table: its left side, front right corner, centre)")
     host = ctx.resolve(np, exclude=tuple(names))
-    if where.prep == "in" or (where.prep == "at" and kb.is_container(ctx.objects[host])):
-        return [Inside(obj=n, container=host, arm=arms[n]) for n in names]
-    if where.prep == "on" and kb.is_container(ctx.objects[host]) and not kb.is_flat(ctx.objects[host]):
+    if where.prep == "in" or (where.prep == "at" and kb.is_container(ctx.objects[host])) \
+            or (where.prep == "on" and kb.is_container(ctx.objects[host]) and not kb.is_flat(ctx.objects[host])):
+        ctx.inside.update(dict.fromkeys(names, host))
         return [Inside(obj=n, container=host, arm=arms[n]) for n in names]
     if where.prep == "on":
         return [On(obj=n, support=host, arm=arms[n]) for n in names]

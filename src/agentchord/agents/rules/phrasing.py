@@ -29,6 +29,7 @@ from functools import lru_cache
 from agentchord.agents.rules.corrections import read_corrections
 from agentchord.agents.rules.discourse import read_sentences
 from agentchord.agents.rules.english import is_word
+from agentchord.agents.rules.talk import drop_likeness
 
 #: Verbs people use -> the verb the grammar reads (only where a clause starts with them).
 VERB_SYNONYMS = {
@@ -309,10 +310,30 @@ def rewrite(text: str, vocabulary: frozenset[str] = frozenset(), objects: frozen
                 words[i] = fixed
         text = " ".join(words)
     text = read_corrections(text, objects, _verb, steps.append)
+    text = " ; ".join(_mind(sentence, steps) for sentence in text.split(" ; "))
+    text = drop_likeness(text, objects, steps.append)
+    if objects:
+        # "move that orange block", "this cup": a demonstrative before what names an object is its determiner.
+        names = "|".join(sorted(map(re.escape, objects), key=len, reverse=True))
+        text = _sub(rf"(?<!\bso )(?<!\bsure )(?<!\bafter )(?<!\bbefore )\b(?:that|this)( (?:[a-z]+ )?)(?=(?:{names})\b)",
+                    lambda m: m[0] if _verb(m[1].strip() or "-") else f"the{m[1]}", text, steps, "pronoun")
     read = read_sentences(text.split(" ; "), objects, steps.append, _verb)
     sentences = [_sentence(sentence, steps, objects) for sentence in read if sentence]
     out.text = _ellipsis(" ; ".join(s for s in sentences if s).replace(" , ; ", " , "), steps, objects)
     return out
+
+
+_MIND = r"^(?:(?:hey|hi|hello|ok|okay|so)(?: there)?(?: ,)? )*(?:(?:would|could|do) you )?(?:please )?mind (\w+ing)\b"
+
+
+def _mind(s: str, steps: list[str]) -> str:
+    """``would you mind dropping X, and then moving Y`` -> ``drop X , and then move Y``: each step the frame governs
+    is an -ing form."""
+    if not re.match(_MIND, s.strip()):
+        return s
+    s = _sub(_MIND, lambda m: lemma(m[1]), s.strip(), steps, "politeness")
+    return _sub(r"(?<= , )(?:and |then |and then )*(\w+ing)\b(?= (?:the|it|them|both|that|this|your|my)\b)",
+                lambda m: m[0].replace(m[1], lemma(m[1])) if lemma(m[1]) in _VERB_WORDS else m[0], s, steps, "politeness")
 
 
 def _sentence(s: str, steps: list[str], objects: frozenset[str]) -> str:
@@ -321,7 +342,6 @@ def _sentence(s: str, steps: list[str], objects: frozenset[str]) -> str:
             s = _sub(frame, "", s, steps, "frame")
     for tail in _TAILS:
         s = _sub(tail, "", s, steps, "frame")
-    s = _sub(r"^(?:would you )?mind (\w+ing)\b", lambda m: lemma(m[1]), s, steps, "politeness")
     # An arm said as a sentence of its own ("With both hands: pour ..."); a third-person verb after an arm.
     s = _sub(r"^((?:with|using) (?:both|the left|the right|your left|your right) (?:arm|hand|gripper)s?)$", r"\1 ,", s, steps, "arm")
     s = _sub(r"\b(arm|hand|gripper) (\w+)\b", lambda m: f"{m[1]} {lemma(m[2]) if lemma(m[2]) in _VERB_WORDS and lemma(m[2]) != 'leave' else m[2]}", s, steps, "arm")

@@ -18,6 +18,8 @@ of such phrasing to the one place or direction it means:
   right" -> ``to the right of X``; "to the left (side), near X" and "to the left so it's beside X"
   -> ``next to X`` (the way there is not the side it ends on);
 - **back where it was**: "where you found them", "where you got it from" -> ``where they were``;
+- **a learner's prepositions**: "next of X" -> ``next to X``; "beside of", "inside of", "into of" -> the preposition;
+  "the target place" -> the target; "the far right (side)" -> the right side (the far right corner stays the back one);
 - **a place said again** alone after the step ("..., like right beside it", "..., just beside"): no
   step of its own (:func:`restates`);
 - **what a move is for is where it goes**: "so it's (lying) right next to the plate" -> ``next to
@@ -129,8 +131,23 @@ def restates(clause: str, before: str) -> bool:
     return _RESTATED.fullmatch(clause.strip()) is not None and _BESIDE.search(before) is not None
 
 
+#: Prepositions as a learner says them: "next of", "beside of", "inside of", "near of" (the ``of`` doubled with
+#: a preposition that takes none, or takes ``to``).
+_LEARNER_PREP = [(re.compile(r"\bnext of\b"), "next to"), (re.compile(r"\b(beside|inside|near|behind|onto|into) of\b"), r"\1"),
+                 (re.compile(r"\bin the front of\b"), "in front of")]
+#: "the far right side", "the far left": the extreme of that side, not the back ("far" alone is the far edge; "the far
+#: right corner" stays the back corner).
+_FAR_SIDE = re.compile(r"\b(?:far|very|extreme|outer) (left|right)(?! corner)\b")
+#: "the target place", "the target position": the scene's target region, a generic place noun after its name.
+_NAMED_PLACE = re.compile(r"\b(the (?:target|marked|goal)) (?:place|position|location)\b")
+
+
 def read_places(s: str, note: Note) -> str:
     """``s`` (one sentence) with its place and direction phrases in the grammar's words (see the module)."""
+    for pattern, repl in _LEARNER_PREP:
+        s = sub(pattern, repl, s, note, "place")
+    s = sub(_NAMED_PLACE, r"\1", s, note, "place")
+    s = sub(_FAR_SIDE, r"\1", s, note, "place")
     s = sub(_EXACTLY, "", s, note, "place")
     s = sub(_ROW, "", s, note, "place")
     s = sub(_NOT_ON, r"\1", s, note, "place")

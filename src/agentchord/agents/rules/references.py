@@ -91,6 +91,9 @@ class Context:
         self.sides: dict[str, str] = {}
         #: The object last placed beside (``on the right`` later in the instruction is its right).
         self.last_anchor: str | None = None
+        #: The container each object was put into so far: beside it is beside its container ("put the red block in
+        #: the cup and the blue one beside the red one": the red one is in the cup, so beside the cup).
+        self.inside: dict[str, str] = {}
 
     def note(self, words: str, role: str, what: str) -> None:
         if (words, role, what) not in self.read:

@@ -6,7 +6,9 @@ possible", "I'm done eating", "it's quite long") state no goal and are dropped; 
 nothing the scene or the rules know (no object, colour, arm, place, direction or action verb) is talk
 (:func:`is_talk`). A remark may still say what the next sentence's ``it`` is ("The blue one is in the
 way. Move it to the right": :func:`topic_of`, :func:`it_is_topic`), and a sentence that only names an
-object already named insists on it ("... Just the fork.": :func:`named_again`).
+object already named insists on it ("... Just the fork.": :func:`named_again`). A likeness with a subject ("like when
+we are eating dinner", "the way we do at home") says how it should look, not what goes where (:func:`drop_likeness`),
+unless it names a scene object.
 """
 
 from __future__ import annotations
@@ -33,19 +35,36 @@ _ACTION_STEMS = ("pour", "empt", "fill", "pick", "grab", "grasp", "take", "took"
                  "pop", "stick", "nudge", "drag", "turn", "rotate", "spread", "line", "pile", "collect", "fetch",
                  "deposit", "toss", "plop", "release", "let", "pinch", "clean", "tidy", "clear")
 #: Interjections and courtesies that open or close a sentence.
-OPENERS = re.compile(r"^(?:(?:hi|hello|hey|hiya|yo|ok|okay|alright|so|actually|um+|uh+|hmm+|oh|ah|well|sorry|excuse me|"
-                      r"good (?:morning|afternoon|evening)|dear robot|robot|hey robot|hi robot|hello robot)(?: ,)? )+")
-CLOSERS = re.compile(r"(?:^|(?: ,)? )(?:thanks|thank you|thx|ty|cheers)(?: (?:so|very) much| a lot| in advance)?(?: ,)?"
+OPENERS = re.compile(r"^(?:(?:(?:hi|hello|hey) there|hi|hello|hey|hiya|yo|ok|okay|alright|so|actually|um+|uh+|hmm+|oh|ah|well|sorry|excuse me|"
+                      r"good (?:morning|afternoon|evening)|dear robot|robot|hey robot|hi robot|hello robot)(?: ,)?(?: |$))+")
+CLOSERS = re.compile(r"(?:^|(?: ,)? )(?:thanks|thank you|thx|ty|cheers)(?: (?:so|very) much| a lot| a bunch| a ton| heaps| in advance)?(?: ,)?"
                       r"(?: (?:robot|buddy|friend))?$")
 #: Hesitations anywhere ("and uh pour it") and tags that end a clause ("... a bit yeah", "... lol", "and that's it").
 HEDGES = re.compile(r"\b(?:uh+|um+|uhm+|erm+|er)\b(?: ,)?|(?: ,)? (?:yeah|yep|yup|lol|haha|you know|ok\?|and that(?:'s| is) (?:it|all)|"
-                    r"that(?:'s| is) (?:it|all)|and that (?:it|all)|if you would|this time)(?= ,|$)|"
+                    r"that(?:'s| is) (?:it|all)|and that (?:it|all)|if you would|this time|for now|for the moment|for the time being)(?= ,|$)|"
                     # "then you can just put it back": a permission or a question that is the step itself.
                     r"(?:(?<=then )|(?<=and )|(?<=, ))(?:you can|you could|can you|could you|would you) "
                     r"(?!(?:hold|do|use|take)\b)(?=[a-z]+ (?:the|it|them|both|your)\b)")  # "you can hold ...": permission (TALK_SENTENCES)
 #: How a table setting is meant ("like for dinner", "like a proper place setting", "like at a restaurant").
 SETTING_MANNER = (r"(?:just )?like (?:for (?:dinner|lunch|breakfast|a meal)|(?:a |an )?(?:proper |normal |usual |formal |nice )?"
                    r"(?:place|table|dinner) setting|(?:they do |you'd see |you see |you would see )?(?:at|in) a restaurant)")
+#: A likeness said after a step: "like when we are eating dinner", "the way you'd do it at home", "as if you were
+#: serving guests": how it should look, never what goes where (a clause with a subject, up to the clause's end).
+_LIKENESS = re.compile(r"(?: ,)? (?:just )?(?:like|as if|as though|the way) (?:when |how )?(?:we|you|i|people|they|someone|one)"
+                       r"(?:'re|'d|'m| are| am| were| was| would| do| did| usually)? [a-z' ]+?(?= ,| ;|$)")
+
+
+def drop_likeness(text: str, objects: frozenset[str], note: Callable[[str], None]) -> str:
+    """``text`` without its likenesses (:data:`_LIKENESS`); one that names a scene object ("like you did with the fork")
+    may say what to do, so it stays (and the grammar refuses it rather than drop it)."""
+    def keep(m: re.Match[str]) -> str:
+        if any(w in objects or w.rstrip("s") in objects for w in m[0].split()):
+            return m[0]
+        note("how")
+        return ""
+    return re.sub(r"\s+", " ", _LIKENESS.sub(keep, text)).strip()
+
+
 #: Whole sentences or clauses that are talk though they name things: permission, questions about the ask, remarks.
 TALK_SENTENCES = [re.compile(p) for p in (
     r"(?:is it|is that|would that be) (?:possible|ok|okay|alright)",
@@ -68,6 +87,10 @@ TALK_SENTENCES = [re.compile(p) for p in (
     r"(?:and )?(?:both|they|them|each|all)(?: of them)? (?:should |must |need to )?(?:point|face|pointing|facing|be pointing|be facing)"
     r" (?:forwards?|away(?: from (?:me|you))?|ahead|up|the same way)",
     SETTING_MANNER,
+    r"(?:hi|hello|hey|hiya)(?: there| robot| everyone| all| buddy| friend)?",
+    # "nothing knocked over", "without spilling anything": what must not happen, which no planned step does.
+    r"(?:and )?(?:with )?(?:nothing|none of it|no water) (?:else )?(?:knocked over|spilled|broken|dropped|falling over|fallen over|tipped over|"
+    r"on the floor)",
 )]
 
 

@@ -18,6 +18,8 @@ arms and places are read. Each rule maps a kind of verb frame to the imperative 
 - **a pour said by its motion**: "tip the bottle over the cup so some water goes in" -> ``pour the bottle into the
   cup``; a bare "... and pour" pours into the vessel in hand (chosen at grounding);
 - **particles**: "drop it off in the cup" -> ``drop it in the cup``;
+- **a topic said first**: "the blue cube, put it beside the red one", "and the bottle pour it into the cup" -> the
+  verb with the topic in the pronoun's place (never an arm: "and the right hand put it in the tray");
 - **phrasal verbs of arranging**: "line them up beside the plate" -> ``put them beside the plate``;
   "tidy up the cutlery so it's laid out around the plate" -> ``arrange the cutlery around the plate``
   (tidying with a place said is arranging there; with none it is refused);
@@ -66,8 +68,8 @@ _SOME_OF_IT = re.compile(r"\b(pour|tip|empty|decant) (?:just |only )?(?:some|a l
 #: "a splash of water into the cup", "some water in the cup, please": a pour said without its verb.
 _WATER_INTO = re.compile(r"(?:^|(?<= , ))(?:and )?(?:then )?(?:just )?(?:a (?:little|splash|drop|bit|dash|touch)(?: of)?|some) water (?=(?:into|in)\b)")
 #: "tip the bottle over the cup (so some water goes in)": a pour from one into the other.
-_TIP_OVER = re.compile(r"\b(?:tip|tilt|pour|hold) (the [a-z]+|it) over (the [a-z]+|it)(?: (?:so|until) (?:that )?(?:some )?(?:water|it) "
-                       r"(?:goes|runs|pours|flows|gets) in(?:to it|side)?)?(?= ,|$| then\b| and\b| with\b)")
+_TIP_OVER = re.compile(r"\b(?:tip|tilt|pour|hold) (the [a-z]+|it) over (the [a-z]+|it)(?: (?:so|until) (?:that )?(?:some |the )?(?:water|it) "
+                       r"(?:goes|runs|pours|flows|gets|comes out and goes) in(?:to it|side)?)?(?= ,|$| then\b| and\b| with\b)")
 #: "place it on the blue block so they're stacked": what the step is for, said again.
 _SO_DONE = re.compile(r"(?: ,)? so (?:that )?(?:they|it)(?:'re|'s| are| is| end up| ends up) (?:stacked|on top|inside|in there|together|folded|"
                       r"side by side|next to each other|in place)$")
@@ -115,8 +117,19 @@ def read_swap(s: str, note: Note) -> str:
     return f"put {m[1]} where {m[2]} was , put {m[2]} where {m[1]} was"
 
 
+#: A topic said first and taken up by a pronoun: "the blue cube, put it beside the red one", "and the bottle pour it
+#: into the cup" -> the verb, then the topic in the pronoun's place.
+_TOPIC_FIRST = re.compile(r"(?:^|(?<= , )|(?<=\band ))((?:the |that |this )[a-z]+(?: [a-z]+)?)(?: ,)? ([a-z]+) (?:it|them)\b(?! (?:and|with)\b)")
+
+
+def _topic_first(m: re.Match[str], verb: Callable[[str], str | None]) -> str:
+    said = verb(m[2])
+    return m[0] if said is None or m[1].split()[-1] in ("arm", "hand", "gripper", "one") else f"{said} {m[1]}"
+
+
 def read_verbs(s: str, note: Note, verb: Callable[[str], str | None]) -> str:
     """``s`` (one sentence) with its verb frames as the grammar's imperatives (see the module)."""
+    s = sub(_TOPIC_FIRST, lambda m: _topic_first(m, verb), s, note, "verb")
     s = sub(_TURN_AWAY, "", s, note, "how")
     s = sub(_BRING_TO_POUR, "", s, note, "how")
     s = sub(_GIVE_WATER, r"pour water into \1", s, note, "verb")
