@@ -3,7 +3,9 @@
 - a word that names a scene object is never dropped from a noun phrase (``the fork n spoon`` read as the spoon);
 - a direction said after a move verb (``push it back``) is a way to move, the same way as the table's back,
   never a put-back or the way towards the robot;
-- an arm said as ``the other one`` is the arm not holding what is in hand, or refused.
+- an arm said as ``the other one`` is the arm not holding what is in hand, or refused;
+- an arm said not to be used (``but don't use your left arm``) gives the step to the other arm, or the
+  instruction is refused: it is never dropped as a negated step that states no goal.
 """
 
 from __future__ import annotations
@@ -14,7 +16,7 @@ from agentchord.agents.exceptions import InstructionNotGroundedError
 from agentchord.agents.rules.instructions import ground_instruction
 from grounding import goal, same, scene
 
-P2, T, C, B = "dual_arm_pour_water", "rearrange_table", "setup_coffee_tray", "blocks_and_cup"
+P2, T, H, C, B = "dual_arm_pour_water", "rearrange_table", "handover_block", "setup_coffee_tray", "blocks_and_cup"
 
 
 def refused(task: str, text: str) -> None:
@@ -56,3 +58,12 @@ def test_the_other_arm_is_the_one_not_holding_what_is_in_hand() -> None:
     assert pour["arm"] == "left"
     # Nothing in hand: no arm to be the other of; refused, not left to the planner.
     refused(B, "put the red block in the cup with the other hand")
+
+
+def test_an_arm_said_not_to_be_used_is_read_or_refused_never_dropped() -> None:
+    assert goal(H, "move the block onto the target, but don't use your left arm") == goal(H, "move the block onto the target with the right arm")
+    same(B, "put the red block in the cup with the right arm", ["put the red block in the cup without using the left hand",
+                                                               "put the red block in the cup and never use the left arm"])
+    refused(H, "Move the block onto the target. Don't use your left arm.")  # said on its own: not read, so refused
+    refused(H, "pick up the block with the left arm, don't use your left arm")  # contradicts the arm named
+    refused(B, "don't use the right hand")

@@ -710,6 +710,22 @@ def test_an_object_too_big_for_its_container_is_refused():
     assert goal_problems(GoalSpec(goals=[{"kind": "inside", "obj": "cup", "container": "box"}]), scene) == []
 
 
+def test_an_object_nearly_as_wide_as_a_cup_does_not_fit_through_its_walls():
+    """The walls take a share of the outer size perception sees: a 4.9 cm bottle does not go into a 5.2 cm cup."""
+    from agentchord.agents.scene import Scene, SceneObject
+    from agentchord.agents.rules.feasibility import goal_problems
+    from agentchord.agents.rules.goals import GoalSpec
+
+    scene = Scene(objects=[
+        SceneObject(name="bottle", pos=(0, 0.4, 0.08), extent=(0.049, 0.049, 0.17)),
+        SceneObject(name="cup", pos=(0.1, 0.4, 0.05), extent=(0.052, 0.052, 0.1)),
+        SceneObject(name="block", pos=(-0.1, 0.4, 0.02), extent=(0.03, 0.03, 0.03)),
+    ])
+    (problem,) = goal_problems(GoalSpec(goals=[{"kind": "inside", "obj": "bottle", "container": "cup"}]), scene)
+    assert "'bottle' (4.9 cm across) does not fit into 'cup'" in problem
+    assert goal_problems(GoalSpec(goals=[{"kind": "inside", "obj": "block", "container": "cup"}]), scene) == []
+
+
 @pytest.mark.parametrize("content", ['{"task": "blocks_and_cup", "nodes": [{"id": "v\\ud800"}]}',
                                      '{"task": "blocks_and_cup", "nodes": [{"id": "v\ud800"}]}'],
                          ids=["escaped in the reply's JSON", "raw in the content"])

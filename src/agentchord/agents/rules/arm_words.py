@@ -131,7 +131,9 @@ def read_arms(s: str, note: Note) -> str:
 
 
 #: "..., not the right one", "but not with your left hand": the arm the step is not done with.
-_NOT_ARM = re.compile(r"(?: ,)? (?:and |but )?not (?:with |using )?(?:the |your )?(left|right)(?: one| arm| hand| gripper)?(?= ,|$)")
+_NOT_ARM = re.compile(r"(?: ,)? (?:and |but )?(?:please )?(?:not (?:with |using )?|(?:do not|don't|dont|never) (?:use|move) |without (?:using )?)"
+                      r"(?:the |your )?(left|right)(?: one| arm| hand| gripper)(?: (?:at all|for (?:this|that|it)))?(?= ,|$)|"
+                      r"(?: ,)? (?:and |but )?not (?:with |using )?(?:the |your )?(left|right)(?= ,|$)")
 _ARM_NAMED = re.compile(r"\b(left|right) (?:arm|hand|gripper)\b")
 
 
@@ -145,9 +147,10 @@ def not_this_arm(s: str, note: Note) -> str:
     m = _NOT_ARM.search(s)
     if m is None:
         return s
+    arm = m[1] or m[2]
     named = set(_ARM_NAMED.findall(s[: m.start()] + s[m.end():]))
-    if m[1] in named:
-        raise NotAGoalError(f"says to use the {m[1]} arm and not to use it")
+    if arm in named:
+        raise NotAGoalError(f"says to use the {arm} arm and not to use it")
     note("arm")
-    other = "" if named else f" with the {'right' if m[1] == 'left' else 'left'} arm"
+    other = "" if named else f" with the {'right' if arm == 'left' else 'left'} arm"
     return (s[: m.start()] + other + s[m.end():]).strip()

@@ -63,7 +63,8 @@ _LEFT_AS_IS = [
     re.compile(r"^(?:and )?(?:but )?(?:do not|don't|dont|no need to|you don't need to|you do not need to|you dont need to)"
                r" (?:touch|move|bother with|bother|worry about) [a-z ' ]+$"),
     # a negated step ("don't pour anything", "never drop it") states no goal; "don't forget to ..." does
-    re.compile(r"^(?:and )?(?:but )?(?:please )?(?:do not|don't|dont|never) (?!forget\b|fail\b)[a-z ' ]+$"),
+    # (never one that names an arm: "don't use your left arm" says who does the work, it is read or refused, not dropped)
+    re.compile(r"^(?:and )?(?:but )?(?:please )?(?:do not|don't|dont|never) (?!forget\b|fail\b)(?![a-z ' ]*\b(?:arm|hand|gripper)s?\b)[a-z ' ]+$"),
     re.compile(r"^(?:and )?(?:the |that )?[a-z ]+? (?:stays|stay|remains|should stay|can stay) (?:where it is|put|as it is|there)$"),
     re.compile(r"^(?:just |only )?(?:the \w+ )?(?:and )?(?:don't|do not|dont) (?:just )?(?:slide|drag|push) it$"),
 ]

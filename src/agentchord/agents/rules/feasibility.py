@@ -19,8 +19,9 @@ from agentchord.solvers.reach import BASE, table_distance
 from agentchord.graph.models import TaskGraph
 from agentchord.graph.validation import Problem
 
-#: Fraction of the container's smaller horizontal size an object's smaller horizontal size may fill.
-FIT_FRACTION = 0.95
+#: Fraction of the container's smaller horizontal size an object's smaller horizontal size may fill: what its
+#: walls leave of the outer size seen (a 5 cm cup with 5 mm walls opens 4 cm; a 4.9 cm bottle does not go in).
+FIT_FRACTION = 0.8
 
 
 def goal_problems(goal: GoalSpec, scene: Scene) -> list[str]:
