@@ -1,6 +1,6 @@
 """Label the blind evaluation set (issue 59): the goal each instruction means, written to labels.yaml.
 
-The eleven writers' files (writer_A.yaml ... writer_K.yaml) hold 630 instructions, each with the
+The twelve writers' files (writer_A.yaml ... writer_L.yaml) hold 690 instructions, each with the
 writer's own ``meaning`` (the intended end state) and ``possible``. This script states, per id, the
 goal the instruction means as a goal spec's goals (``agentchord schema goal``), written with the
 label helpers of ../build_corpus.py and its conventions (docs/language.md): ``put X down``/``back``
@@ -985,6 +985,107 @@ LABELS: dict[str, object] = {
     # "right arm, grab the blue block and set it down to the left of the red block": the address heads the
     # sentence, said for both steps.
     "K-060": [rel(B, "blue_block", "red_block", "left", "right")],
+    # --- writer L ----------------------------------------------------------------------------
+    "L-001": POUR1,  # "Pour some water ..., then stand the bottle back up where it was": no arm said (the meaning's "natural" right is not in the words)
+    "L-002": REFUSE,
+    # "take the bottle with right hand and make water go in the cup, after put bottle standing again": taken by a
+    # said arm, so the pour and the put-back are the right arm's (as E-005).
+    "L-003": [pour(arm="right"), put("bottle", "right")],
+    "L-004": POUR1,  # "give the cup a drink of water ... pour it in": a pour (as H-009); the bottle back by the convention
+    # End state: "a bit of water" (a vague amount) and "the bottle standing up next to it again": "again" restores the
+    # bottle's own place (it stood next to the cup at the start; the writer's meaning agrees), not rel() beside the
+    # cup, which would move it ~10 cm: the bottle put back (as E-004).
+    "L-005": POUR1,
+    "L-006": REFUSE,
+    "L-007": REFUSE,
+    # "Use whichever arm is closest to the bottle": an arm said by a description the scene resolves (the bottle is
+    # right of centre, the right arm's corner; as H-055 resolves "closest to me"): the right arm pours. The put-down
+    # is unsaid and the bottle was not taken in a clause of its own: no arm (as G-002).
+    "L-008": [pour(arm="right"), put("bottle")],
+    # "Left hand, lift the cup up. Right hand, pour ... Then put them both back down.": the put-down is a sentence
+    # of its own with no arm (as D-009, K-009).
+    "L-009": POUR2_LR,
+    # "Raise the red cup with the left arm ... With the right arm, pour ..., and afterwards set both down": the
+    # fronted "With the right arm" is the pour's arm (as D-001 "Using your right arm, pour ..., then stand ..."),
+    # not a vocative heading (H-010); the cup goes down by the left arm that lifted it, the bottle with no arm.
+    "L-010": POUR2_LR,
+    "L-011": POUR2,  # "just hold the cup up and pour some water in it, then put everything down": held cup, arms unsaid
+    "L-012": POUR2_LR,  # "Left arm take cup up in the air, right arm pour water to it. Then both down" (as G-010)
+    # "Step 1: left arm picks up cup. Step 2: right arm picks up bottle and pours ...": both taken by said arms, the
+    # cup not put down before the pour: held (as K-014); the put-downs in the order said, bottle first (as I-014).
+    "L-013": [pour(arm="right", hold=True), put("bottle", "right"), put("cup", "left")],
+    # End state plus "Don't pour with the cup sitting on the table": held cup, arms unsaid (as H-017, K-011).
+    "L-014": POUR2,
+    "L-015": POUR2_LR,  # "Hold the cup up with your left hand ..., and pour into it with the right. Put them down ...": as F-010
+    # "pour me a little water? Hold the cup for it yourself": a vague amount; held cup, arms unsaid (the meaning's
+    # "natural" left/right is not in the words); the put-downs by the convention.
+    "L-016": POUR2,
+    "L-017": SETTING,  # "both pointing away from you": the setting convention (turned along y)
+    "L-018": SETTING,  # "next to the plate": each on the side it is on (as E-017)
+    "L-019": SETTING_ARMS,  # "Left arm, bring the fork ... Right arm, do the same with the spoon"
+    "L-020": SETTING,  # "make it look like a restaurant! fork and spoon go by the plate": a place setting (as G-021)
+    # "to the left of the plate, about three centimetres from the rim, tines pointing away ... do the same for the
+    # spoon on the right": the stated gap is sayable as the offset (plate radius 8.1 cm + 3 cm + the utensil's half
+    # width 1 cm = 12.1 cm from the plate's centre), not the setting convention's 17 cm (5 cm farther, beyond
+    # rearrange's 3 cm tolerance); turned along y. The writer's meaning ("just left of the plate") drops the
+    # distance; the instruction's words decide. Which end points away is not sayable (as E-021).
+    "L-021": [{**FORK_L, "offset": [-0.121, 0.0]}, {**SPOON_R, "offset": [0.121, 0.0]}],
+    "L-022": SETTING,  # "Turn them so they point to far": the setting convention
+    "L-023": [SPOON_R],  # "Leave the fork alone": no goal; the meaning's "natural" right arm is not in the words
+    "L-024": REFUSE,
+    # "First the fork, then the spoon - line each one up beside the plate with the handle towards you": each on its own
+    # side, turned along y (which end is the handle is not sayable; as E-021).
+    "L-025": SETTING,
+    "L-026": HANDOVER,
+    "L-027": TARGET,  # "the marked circle on the right": the target; method open (the meaning's "natural" handover is not in the words)
+    "L-028": HANDOVER,  # "hand it across in the air": left to right (the block is on the left, the target on the right; as A-024)
+    # "lift it roughly fifteen centimetres", "above the middle of the table": how high and where the hand-over happens
+    # are manner, not an end state (as E-033, H-034); "Left arm: ... Right arm: lower it ... onto the target".
+    "L-029": HANDOVER,
+    "L-030": HANDOVER,  # "from one hand to your other hand": left to right (as F-032); "the circle spot": the target
+    "L-031": HANDOVER,  # "have the left one pick it up and hand it over. Then the right one can put it on the target"
+    "L-032": HANDOVER,  # "hand it off to the right": the giver is the other, the left (as I-031)
+    "L-033": REFUSE,
+    "L-034": COFFEE,  # "carry the tray a bit further away with both hands": the forward spot
+    "L-035": COFFEE_LEFT,  # "Left arm," heads the capsule sentence only; "move the tray forward a little": the forward spot (as G-037)
+    "L-036": COFFEE,  # "pod": the capsule; "tray back a bit": back = away from the robot, the forward spot (as A-031, I-035)
+    "L-037": COFFEE,  # "with two hands move the tray more far from you": the forward spot (as E-039)
+    "L-038": COFFEE,  # end state: "a few inches further up the table": the forward spot (as G-040's "a few centimetres")
+    # "using the left gripper"; "about twelve centimetres farther from you, still centred": the forward spot (12 cm
+    # farther, x 0.00; as A-034); "lift it level so the capsule doesn't slide": manner.
+    "L-039": COFFEE_LEFT,
+    # "Use both hands on the tray ... before you move it, pop the capsule in": where the tray goes is unsaid; the scene
+    # has one place for it, its forward spot (as H-032 takes "the circle thing" for the scene's one region; the
+    # writer's meaning agrees): the capsule first, then the tray there.
+    "L-040": COFFEE,
+    "L-041": REFUSE,
+    "L-042": FOLD,  # "the near edge over to the far edge"
+    "L-043": FOLD,  # direction unsaid: the natural fold (as A-038)
+    "L-044": FOLD,  # bottom (near) corners up to the top (far) ones, one arm each (as F-047)
+    # "lay them exactly on the two far corners, ... about 28 by 11 centimetres": what folded is (near corners on far
+    # corners) and the size a fold in half of the 28 x 23 cm towel has: nothing beyond the fold.
+    "L-045": FOLD,
+    "L-046": FOLD,  # "bring the close side on top of the far side"
+    "L-047": FOLD,  # "like a taco": in half, direction unsaid: the natural fold (as H-046 "like a sandwich")
+    "L-048": FOLD,  # "fold in half towards the back, corners lined up": near corners onto far corners (as I-050)
+    "L-049": REFUSE,
+    "L-050": [into("red_block", "cup")],
+    "L-051": [on("red_block", "blue_block")],
+    "L-052": [into("red_block", "cup"), into("blue_block", "cup")],  # "red first and then blue"
+    "L-053": [rel(B, "blue_block", "red_block", "left")],
+    "L-054": [into("blue_block", "cup")],  # "the bowl thing": the bowl-like white cup (as C-048)
+    # Picked up by the said right hand, passed to the left, which puts it in the cup (as B-049, right to left).
+    "L-055": [hand("blue_block", "right", "left"), into("blue_block", "cup", "left")],
+    "L-056": [on("red_block", "blue_block")],  # "leave the cup where it is": no goal
+    # "the little red box": the red cube; "the bowl": the white cup (as C-048); "the blue one next to it": beside the
+    # cup (or the red cube in it: anchored on the container, as K-058); side unsaid: the side the blue block is on
+    # (1.5 cm right of the cup: right; as F-055).
+    "L-057": [into("red_block", "cup"), rel(B, "blue_block", "cup")],
+    # "over to the right side": the table's right side point (as A-050), not a nudge ("a bit"); it leaves the space
+    # in front of the cup clear.
+    "L-058": [at("blue_block", "right")],
+    "L-059": REFUSE,
+    "L-060": REFUSE,
 }
 
 #: Why each refused entry is refused.
@@ -1088,11 +1189,21 @@ WHY = {
     "and an end with something held in the air cannot be said",
     "K-048": "one corner laid on another by one arm (a partial fold): folded is both near corners onto the far corners",
     "K-059": "no yellow block in the scene (only a red and a blue block)",
+    "L-002": "'fill the cup about halfway': a stated amount; poured states no amount",
+    "L-006": "'until roughly a third of the water has gone in': a stated fraction of the water; poured states no amount",
+    "L-007": "no teapot in the scene (only the bottle and the red cup)",
+    "L-024": "no knife in the scene",
+    "L-033": "no green block in the scene (only the orange block)",
+    "L-041": "no coffee machine in the scene; pressing start is not a goal",
+    "L-049": "no drawer in the scene (the fold alone would be sayable, not the whole)",
+    "L-059": "'set it squarely on the red cube, edges aligned': on_top_of states no yaw, so the alignment of the edges "
+    "(the cubes stand 7 degrees apart) cannot be said (the stack alone would be sayable, not the whole)",
+    "L-060": "no green block in the scene (only a red and a blue block)",
 }
 
 HEADER = """# Labels of the blind evaluation set (issue 59). Built by build_labels.py; do not edit by hand.
 #
-# For each instruction of writer_A.yaml ... writer_K.yaml (eleven writers, 630): its scene, and the
+# For each instruction of writer_A.yaml ... writer_L.yaml (twelve writers, 690): its scene, and the
 # goal it means as a goal spec's goals (`agentchord schema goal`), or expect: refused with why (the
 # scene cannot do it, or the goal language cannot say it). Written from the instruction and the writer's `meaning` by a labeller who
 # did not write them, following build_corpus.py's label conventions (docs/language.md), without
@@ -1108,10 +1219,10 @@ def _scene_obs(task: str):
 
 def main() -> None:
     entries = []
-    for name in ("A", "B", "C", "D", "E", "F", "G", "H", "I", "J", "K"):
+    for name in ("A", "B", "C", "D", "E", "F", "G", "H", "I", "J", "K", "L"):
         entries += yaml.safe_load((HERE / f"writer_{name}.yaml").read_text(encoding="utf-8"))["entries"]
     ids = [e["id"] for e in entries]
-    assert len(ids) == len(set(ids)) == 630, len(ids)
+    assert len(ids) == len(set(ids)) == 690, len(ids)
     assert set(LABELS) == set(ids), (set(ids) - set(LABELS), set(LABELS) - set(ids))
     assert set(WHY) == {k for k, v in LABELS.items() if v == REFUSE}, set(WHY) ^ {k for k, v in LABELS.items() if v == REFUSE}
     scenes: dict = {}
@@ -1135,7 +1246,7 @@ def main() -> None:
         counts[eid[0], "labelled"] += 1
     text = yaml.dump({"labels": labels}, Dumper=_Dumper, sort_keys=False, width=200, allow_unicode=True)
     (HERE / "labels.yaml").write_text(HEADER + text, encoding="utf-8")
-    for name in "ABCDEFGHIJK":
+    for name in "ABCDEFGHIJKL":
         print(f"writer {name}: {counts[name, 'labelled']} labelled, {counts[name, 'refused']} refused")
     print(f"labels.yaml: {len(labels)} entries")
 
