@@ -48,7 +48,8 @@ def _percentile(values: list[float], q: float) -> float:
 def main() -> None:
     args_parser = argparse.ArgumentParser(description=__doc__)
     args_parser.add_argument("--part", choices=("test", "dev", "all", "blind", "blind-final"), default="test",
-                             help="blind: the blind set's development writers (read for kinds of failure); blind-final: its held-out writer H")
+                             help="blind: the blind set's development writers (read for kinds of failure); "
+                                  "blind-final: its held-out writer (corpus.BLIND_FINAL)")
     args_parser.add_argument("--repeats", type=int, default=3, help="timed passes after the warm-up (best of)")
     args_parser.add_argument("-v", "--verbose", action="store_true", help="list what is refused or wrong")
     args = args_parser.parse_args()

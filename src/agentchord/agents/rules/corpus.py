@@ -58,8 +58,8 @@ def load(path: Path) -> list[dict]:
 
 
 #: The blind set's writers read while the rules grow (their failures read by kind), and the one held out for the final measurement.
-BLIND_DEVELOPMENT = "ABCDEFGIJK"
-BLIND_FINAL = "H"
+BLIND_DEVELOPMENT = "ABCDEFGHIJK"
+BLIND_FINAL = "L"
 
 
 def load_blind(folder: Path, writers: Iterable[str]) -> list[dict]:

@@ -38,6 +38,7 @@ from collections.abc import Callable
 
 from agentchord.agents.rules.arm_words import each_arm, not_this_arm, read_arms
 from agentchord.agents.rules.cloth_parts import FOLD, drop_fold_way, read_cloth_parts, refuse_fold_across
+from agentchord.agents.rules.ellipsis import again, is_again
 from agentchord.agents.rules.end_states import END_STATE, read_end_state
 from agentchord.agents.rules.ordinals import ANY_ORDER, each_in_order, each_of_list, first_before, first_of_both
 from agentchord.agents.rules.held_pour import hold_before_pour, take_conditions
@@ -89,12 +90,13 @@ _HOW = [
 _ARM_SUBJECT = re.compile(
     r"^(?:and )?(?:(?:can|could|will|would|should|let|have|make) )?(?:the |your )?(left|right)(?: (?:arm|hand|gripper|one|side))?"
     r"(?: ,| :)? (?!(?:arm|hand|gripper)\b)(\w+)\b(.*)$")
-_BOTH_SUBJECT = re.compile(r"^(?:and )?(?:then )?(?:both (?:of you|arms|hands|grippers)|both|the two arms|the arms|"
+_BOTH_SUBJECT = re.compile(r"^(?:and )?(?:then )?(?:both (?:of you|arms?|hands?|grippers?)|both|(?:the )?two (?:arms|hands|grippers)|the arms|"
                            r"(?:the )?left and (?:the )?right(?: (?:arms?|hands?|grippers?|ones?))?|"
                            r"(?:the )?right and (?:the )?left(?: (?:arms?|hands?|grippers?|ones?))?) (\w+)\b(.*)$")
 #: Ordinal words that open a step.
 _ORDINAL = re.compile(r"^(?:and )?(?:first(?:ly)?|second(?:ly)?|third(?:ly)?|fourth|next|after that|afterwards|after this|"
-                      r"after(?= (?:put|set|place|lay|stand|move|give|hand|pour|take|grab|pick|carry|bring|fold)\b)|"
+                      r"after(?= (?:(?:both|(?:the )?two) (?:(?:arms?|hands?) )?)?"
+                      r"(?:put|set|place|lay|stand|move|give|hand|pour|take|grab|pick|carry|bring|fold|lift)\b)|"
                       r"then after that|finally|lastly|last|to finish|and finally|and then|and after that)(?: ,)? ")
 _TRAILING_ORDER = re.compile(r" (?:first|afterwards|after that|after it|after them|at the end|in the end|when (?:you(?:'re| are)?|ur|your) done|"
                              r"when finished|after|last|this time|for me)$")
@@ -103,11 +105,6 @@ _MARKED_ON_SIDE = re.compile(r"\b((?:the )?(?:marked |taped |drawn |painted |tar
                              r"(?:left|right)(?: side| half)?(?: of the table)?(?= ,|$| then\b| and\b| with\b)")
 #: "with one hand ... with the other": two arms, the planner's to choose.
 _ONE_AND_OTHER = (re.compile(r" with one (?:hand|arm|gripper)\b"), re.compile(r" with the other arm\b"))
-#: "and the bottle too", "then the red one as well": the step before, for another object.
-_TOO = re.compile(r"^(then |and |and then )?(?:also )?((?:the )?[a-z]+(?: [a-z]+)?|it|them) (?:too|as well|also)$")
-#: "do the same with the spoon (on the right)": the step before, for another object (and side).
-_SAME = re.compile(r"^(then |and |and then )?(?:do|repeat) (?:the same|that|the same thing|it) (?:with|for|to) ((?:the )?[a-z]+(?: [a-z]+)?)"
-                   r"(?: (?:on|to|at) (?:the )?(left|right)(?: side)?(?: of it)?)?$")
 _POINTING = re.compile(r"(?: ,)? (?:and )?(?:both |each )?(?:of them )?"
                        r"(?:(?:with )?(?:the )?handles? (?:towards?|facing|nearest|closest to|to) (?:you|me|the robot)|"
                        r"(?:pointing|facing|oriented|aimed|tips?|handles?)"
@@ -124,7 +121,7 @@ _UP_AND_DOWN = re.compile(r"(?: ,)? (?:and )?(?:both |each |all )?(?:of them )?(
 
 
 #: Shorthand people type -> the word.
-_SHORTHAND = [(re.compile(r"\b(?:pls|plz|plse)\b"), ""), (re.compile(r"\bw/ ?|\bw (?=the |your |my |both |left |right )"), "with "),
+_SHORTHAND = [(re.compile(r"\b(?:pls|plz|plse|ple+a+s+e+)\b"), ""), (re.compile(r"\bw/ ?|\bw (?=the |your |my |both |left |right )"), "with "),
               (re.compile(r"\bur\b"), "your"), (re.compile(r"\bu\b"), "you"), (re.compile(r"\bthx\b"), "thanks"),
               (re.compile(r"\bem\b"), "them"), (re.compile(r"\bfwd\b"), "forward"),
               (re.compile(r"\bl (?=arm|hand|gripper)\b"), "left "), (re.compile(r"\br (?=arm|hand|gripper)\b"), "right ")]
@@ -235,10 +232,10 @@ def read_sentences(sentences: list[str], objects: frozenset[str], note: Callable
         if out and restates(sentence, out[-1]):
             note("place")  # "Move the cup next to the bottle. Like right beside it."
             continue
-        if out and (_TOO.match(sentence) or _SAME.match(sentence)):
-            again = _again(sentence, re.split(r" , | then ", out[-1])[-1], objects, note)
-            if again != sentence:  # "Put the red block in the cup. Then the blue one as well."
-                out.append(again if again.startswith("then ") else f"then {again}")
+        if out and is_again(sentence):
+            said = again(sentence, re.split(r" , | then ", out[-1])[-1], objects, note)
+            if said != sentence:  # "Put the red block in the cup. Then the blue one as well."
+                out.append(said if said.startswith("then ") else f"then {said}")
                 continue
         if out and (ordered := first_of_both(out[-1], sentence)) is not None:
             out[-1] = ordered  # "Put both blocks in the cup. Red one first, then the blue one."
@@ -317,7 +314,8 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
     s = _drop(CLOSERS, s, note, "talk")
     s = _drop(HEDGES, s, note, "talk")
     s = not_this_arm(s, note)
-    s = _drop(re.compile(r"\b(?:for me|for you|if you can|if possible|if that's ok|if that's easier(?: for you)?|though)\b"), s, note, "talk")
+    s = _drop(re.compile(r"\b(?:for me|for you|if you can|if possible|if that's ok|if it(?:'s| is)? no (?:trouble|bother|problem)|"
+                         r"if you don't mind|if that's easier(?: for you)?|though)\b"), s, note, "talk")
     s = _drop(re.compile(r"(?: ,)? (?:is|would be|'s|will be) (?:fine|good|ok|okay|enough|great|perfect|all)(?= ,|$)"), s, note, "talk")
     if re.fullmatch(r"(?:go|do it|start|begin|go ahead|that's all|that is all|done)", s) or any(t.fullmatch(s) for t in TALK_SENTENCES):
         note("talk")
@@ -370,7 +368,7 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
     if all(p.search(s) for p in _ONE_AND_OTHER):
         for pattern in _ONE_AND_OTHER:
             s = _drop(pattern, s, note, "how")
-    s = _drop(re.compile(r"(?: ,)? while (?:you(?:'re| are)? holding it|it(?:'s| is)? (?:up|held|in the air))(?= ,|$)"), s, note, "how")
+    s = _drop(re.compile(r"(?: ,)? while (?:you(?:'re| are)? holding it|it(?:'s| is)? (?:held )?(?:up|held|in the air|off the table))(?= ,|$)"), s, note, "how")
     s = _sub(re.compile(r"\bpour (?:me |us |him |her )?(?:a|some) (glass|cup|mug) of water\b"), r"pour water into the \1", s, note, "verb")
     s = _sub(_AMOUNT, " ", s, note, "amount")
     s = _sub(_AMOUNT_TAIL, "", s, note, "amount")
@@ -415,7 +413,7 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
         clause = _drop(_TRAILING_ORDER, clause, note, "order")
         clause = _sub(_BY_HANDOVER, "hand it over", clause, note, "order")
         if clauses:
-            clause = _again(clause, clauses[-1], objects, note)
+            clause = again(clause, clauses[-1], objects, note)
         clause = _arm_subject(clause, note, verb)
         clause = read_end_state(clause, objects, note, verb)
         if _TITLE.fullmatch(clause):
@@ -458,31 +456,6 @@ def _handover_first(clauses: list[str], note: Callable[[str], None]) -> list[str
         out[k - 1], out[k] = f"hand {obj} over", "then " + out[k - 1].removeprefix("then ")
         note("order")
     return out
-
-
-def _again(clause: str, before: str, objects: frozenset[str], note: Callable[[str], None]) -> str:
-    """``the bottle too`` / ``do the same with the spoon on the right`` after a step: that step again, for the
-    object named (and on the side named)."""
-    too, same = _TOO.match(clause), _SAME.match(clause)
-    match = too or same
-    if match is None:
-        return clause
-    lead, new = match[1] or "", match[2]
-    if new not in ("it", "them") and not new.startswith("the "):
-        new = "the " + new
-    if not any(w in objects or w == "one" for w in new.split()[1:]) and new not in ("it", "them"):
-        return clause
-    step = before.removeprefix("then ")
-    names = "|".join(sorted((re.escape(w) for w in objects), key=len, reverse=True)) or "(?!)"
-    found = re.search(rf"\bthe (?:[a-z]+ )*?(?:{names}|one)\b|\b(?:it|them)\b", step)
-    if found is None:
-        return clause
-    again = step[: found.start()] + new + step[found.end():]
-    if same is not None and same[3]:
-        other = "left" if same[3] == "right" else "right"
-        again = re.sub(rf"\b{other}\b", same[3], again) if re.search(rf"\b{other}\b", again) else again
-    note("ellipsis")
-    return (lead + again).strip()
 
 
 def _arm_subject(clause: str, note: Callable[[str], None], verb: Callable[[str], str | None]) -> str:

@@ -36,10 +36,20 @@ _CONDITIONS = [
                rf"{_NOT_ON}(?= ,|$)"),
     re.compile(rf"(?:^|(?<= , ))(?:and |but )?(?P<np>{_NP}) (?:should|must|needs? to|has to|will) be (?:held|lifted|kept){_UP} "
                rf"{_WHILE_POUR}{_NOT_ON}(?= ,|$)"),
-    re.compile(rf"(?:^|(?<= , ))(?:and |but )?(?:please )?(?:do|make) (?:the|your) pour with (?P<np>{_NP}) (?:held|lifted|kept|up){_UP}"
+    re.compile(rf"(?:^|(?<= , ))(?:and |but )?(?:please )?(?:do|make) (?:the|your) pour(?:ing)? with (?P<np>{_NP}) (?:held|lifted|kept|up){_UP}"
                rf"{_NOT_ON}(?= ,|$)"),
     re.compile(rf"(?: ,)? (?:while|whilst) (?:you(?:'re| are)? )?(?:holding|lifting|you hold) (?P<np>{_NP}){_UP}{_ARM}{_NOT_ON}(?= ,| then\b|$)"),
     re.compile(rf"(?: ,)? (?:while|whilst|as) (?P<np>it|the [a-z]+)(?:'s| is) (?:held|lifted|raised|kept){_UP}{_ARM}{_NOT_ON}(?= ,| then\b|$)"),
+    # "don't put the cup down while you're pouring, just hold it up": the vessel not put down is held.
+    re.compile(rf"(?:^|(?<= , ))(?:and |but )?(?:don't|do not|dont|never) (?:put|set|place|rest) (?P<np>{_NP}) down {_WHILE_POUR}"
+               rf"(?: , (?:just |only )?(?:hold|keep) (?:it|them)(?: held)?{_UP})?(?= ,|$)"),
+    # "don't pour while the cup's sitting on the table, lift it up first": the pour not to be done on the table.
+    re.compile(r"(?:^|(?<= , ))(?:and |but )?(?:don't|do not|dont|never) (?:pour|fill it|tip) (?:while|when|with) (?P<np>it|the [a-z]+)"
+               r"(?:'s| is)? (?:sitting |standing |resting |still )?on the table"
+               r"(?: , (?:just |only )?(?:lift|hold|pick|keep) (?:it|them) up(?: first)?)?(?= ,|$)"),
+    # "pour while the cup's off the table, not on it": the condition said after the pour's verb (the pour stays).
+    re.compile(rf"(?<=\bpour)(?: water)? (?:while|with|when) (?P<np>it|the [a-z]+)(?:'s| is)? (?:held |lifted |kept |raised )?"
+               rf"(?:up|off the table|in the air|above the table|lifted|held up){_NOT_ON}(?= ,|$)"),
 ]
 _POUR = re.compile(r"\b(?:the [a-z]+ )?(?:pour|fill|tip|empty|decant)(?:s|ed|ing)?\b")
 

@@ -29,7 +29,7 @@ from functools import lru_cache
 from agentchord.agents.rules.corrections import read_corrections
 from agentchord.agents.rules.discourse import read_sentences
 from agentchord.agents.rules.english import is_word
-from agentchord.agents.rules.talk import drop_likeness
+from agentchord.agents.rules.talk import drop_likeness, drop_purpose
 
 #: Verbs people use -> the verb the grammar reads (only where a clause starts with them).
 VERB_SYNONYMS = {
@@ -37,7 +37,7 @@ VERB_SYNONYMS = {
     "pop": "put", "stick": "put", "rest": "put", "toss": "put", "position": "put", "situate": "put", "plop": "put",
     "pile": "stack", "pile up": "stack", "stack up": "stack", "shove": "push", "relocate": "move", "reposition": "move",
     "double over": "fold", "double": "fold", "fold up": "fold", "halve": "fold", "collect": "pick up", "fetch": "pick up",
-    "swap": "switch", "load": "put", "slot": "put", "tuck": "put", "lower": "put",
+    "swap": "switch", "scoot": "move", "scooch": "move", "budge": "move", "load": "put", "slot": "put", "tuck": "put", "lower": "put",
 }
 #: Verbs whose inflections are read (the grammar's verbs and the synonyms').
 VERBS = (
@@ -312,6 +312,7 @@ def rewrite(text: str, vocabulary: frozenset[str] = frozenset(), objects: frozen
     text = read_corrections(text, objects, _verb, steps.append)
     text = " ; ".join(_mind(sentence, steps) for sentence in text.split(" ; "))
     text = drop_likeness(text, objects, steps.append)
+    text = drop_purpose(text, objects, steps.append)
     if objects:
         # "move that orange block", "this cup": a demonstrative before what names an object is its determiner.
         names = "|".join(sorted(map(re.escape, objects), key=len, reverse=True))

@@ -35,19 +35,21 @@ from agentchord.agents.rules.rewrite_steps import Note, sub
 #: Verbs that move an object some way.
 _MOVES = r"(?:move|slide|shift|push|nudge|bring|carry|drag|scoot)"
 #: How far, said before a direction or a place: dropped (the rules' nudge, or the place itself).
-_HOW_FAR = (r"(?:(?:a (?:little |tiny |wee )?bit|a little|slightly|somewhat|way|just|a tad|"
+_HOW_FAR = (r"(?:(?:a (?:little |tiny |wee )?bit|a little|slightly|somewhat|way|just|a tad|a touch|"
             r"(?:about |roughly |around )?(?:a few|a couple of|\d+|one|two|three|five|ten) ?(?:cm|centimet(?:er|re)s|inch(?:es)?|mm))(?: more)? )")
 #: Words that start an amount (never the last word of the object before it: "carry the tray about ten cm forward").
 _AMOUNT_WORD = r"(?:about|roughly|around|a|just|slightly|way|one|two|three|five|ten|\d+)\b"
 #: Direction phrases that mean "away from the robot".
-_AWAY = re.compile(rf"\b{_HOW_FAR}?(?:further|farther|more far)(?: away)?(?: back)?(?: from (?:me|you|the robot))?"
+_AWAY = re.compile(rf"\b{_HOW_FAR}?(?:further|farther|more far)(?: away| out)?(?: back)?(?: from (?:me|you|the robot))?"
                    r"(?: than (?:it is|it does|it was|they are)(?: now| right now| at the moment)?)?\b|\baway from (?:me|you|the robot)\b|"
                    r"\btowards? the (?:back|far side|far end)\b|\bto the back\b(?! of the table| edge| of the)")
 #: "a little closer to you", "towards the robot": the robot's side of the table.
 _TOWARD_YOU = re.compile(rf"\b{_HOW_FAR}?(?:closer|nearer) (?:to|towards?) (?:you|me|the robot|yourself)\b|"
                          r"\btowards? (?:you|me|the robot|yourself)\b")
 #: "back a little , forward" (back, then said again as away from the robot): the one direction.
-_BACK_THEN_AWAY = re.compile(rf"\bback(?: {_HOW_FAR}| a little| a bit)?(?: ,)? forward\b")
+_BACK_THEN_AWAY = re.compile(rf"\bback (?:{_HOW_FAR}|a little |a bit )?(?:, )?forward\b")
+#: "pushed back a little, still centred": the side it stays on is where it is (how, not a place).
+_STILL_CENTRED = re.compile(r"(?: ,)? (?:and )?(?:still|staying|kept|keeping it) (?:centred|centered|in the (?:middle|centre|center))(?= ,|$)")
 #: "forward on the table than it is now": the comparison and the table add nothing to the direction.
 _THAN_NOW = re.compile(r"\b(forward|closer)(?: on the table)?(?: than (?:it is|it was|they are)(?: now)?)?(?= ,|$| then\b| and\b| with\b)")
 #: "so it's (lying) right next to the plate": what the move is for is where it goes.
@@ -156,6 +158,7 @@ def read_places(s: str, note: Note) -> str:
     s = sub(re.compile(r"\bforward(?: ,)? forwards?\b"), "forward", s, note, "direction")  # "a bit further forward": one way
     s = sub(_TOWARD_YOU, "closer", s, note, "direction")
     s = sub(_BACK_THEN_AWAY, "forward", s, note, "direction")
+    s = sub(_STILL_CENTRED, "", s, note, "how")
     s = sub(_THAN_NOW, r"\1", s, note, "direction")
     s = sub(_CLOSER, "next to", s, note, "direction")
     s = sub(_SO_IT, " ", s, note, "place")

@@ -50,8 +50,25 @@ SETTING_MANNER = (r"(?:just )?like (?:for (?:dinner|lunch|breakfast|a meal)|(?:a
                    r"(?:place|table|dinner) setting|(?:they do |you'd see |you see |you would see )?(?:at|in) a restaurant)")
 #: A likeness said after a step: "like when we are eating dinner", "the way you'd do it at home", "as if you were
 #: serving guests": how it should look, never what goes where (a clause with a subject, up to the clause's end).
-_LIKENESS = re.compile(r"(?: ,)? (?:just )?(?:like|as if|as though|the way) (?:when |how )?(?:we|you|i|people|they|someone|one)"
-                       r"(?:'re|'d|'m| are| am| were| was| would| do| did| usually)? [a-z' ]+?(?= ,| ;|$)")
+_LIKENESS = re.compile(r"(?: ,)? (?:just )?(?:like|as if|as though|the way) (?:when |how )?(?:we|you|i|people|they|someone|one|"
+                       r"(?:my|our|your|the|his|her) [a-z]+)"
+                       r"(?:'re|'d|'m| are| am| were| was| would| do| did| usually)? [a-z' ]+?(?= ,| ;|$)|"
+                       # "fold the towel like a sandwich", "like a book": a likeness of a thing (not "i'd like a ...").
+                       r"(?<!'d)(?<!\bwould)(?<!\bi)(?<!\bwe)(?<!\byou) (?:just )?like (?:a|an) (?:[a-z]+ )?[a-z]+(?= ,| ;|$)")
+#: A purpose said after a step ("so i can eat my soup", "so it's smaller", "so that we have room"): why, never what goes
+#: where (a place said in it, "so it's on the left", keeps it: it may be the step's place, and the grammar refuses it).
+_PURPOSE = re.compile(r"(?: ,)? (?:so|so that|in order that) (?:i|we|you|it|they|there|he|she)(?:'s|'re|'ll| is| are| can| could| will| have| has"
+                      r"| won't| don't| doesn't| takes?| looks?)?(?P<rest>(?: [a-z']+)+?)(?= ,| ;|$)")
+
+
+def drop_purpose(text: str, objects: frozenset[str], note: Callable[[str], None]) -> str:
+    """``text`` without its purposes (:data:`_PURPOSE`) that name nothing the task is about (:func:`is_talk`)."""
+    def keep(m: re.Match[str]) -> str:
+        if not is_talk(m["rest"].strip(), objects):
+            return m[0]
+        note("talk")
+        return ""
+    return re.sub(r"\s+", " ", _PURPOSE.sub(keep, text)).strip()
 
 
 def drop_likeness(text: str, objects: frozenset[str], note: Callable[[str], None]) -> str:

@@ -36,6 +36,7 @@ import re
 from collections.abc import Callable
 
 from agentchord.agents.rules.rewrite_steps import Note, sub
+from agentchord.agents.rules.telegraphic import read_telegraphic
 
 #: "you" as the subject of a clause's verb (not after "after", "before", "once", "while", "if", "when").
 _YOU = re.compile(r"(^|, |\band |\bthen |\b(?:arm|hand|gripper) (?:, )?)(?:you|u) (\w+)\b")
@@ -58,7 +59,9 @@ _TIDY = re.compile(r"\b(?:tidy|tidy up|straighten|straighten up|sort out|organi[
 _OFF = re.compile(r"\b(drop|put|set|leave|place) (it|them|the [a-z]+(?: [a-z]+)?) off (?=(?:in|into|inside|on|onto|at|by|next to|beside)\b)")
 #: "give the cup a splash of water": a pour into it (never a hand-over of the cup).
 _GIVE_WATER = re.compile(r"\b(?:give|hand|pass|offer) (it|them|the [a-z]+(?: (?!a\b|some\b|water\b)[a-z]+)?) (?:(?:a (?:little|splash|drop|bit|dash|touch)"
-                         r"(?: bit)?(?: of)?|some|a little bit of|more|a bit of) )?water\b")
+                         r"(?: bit)?(?: of)?|some|a little bit of|more|a bit of) )?water\b|"
+                         # "give the cup a drink (from the bottle)": a drink given to a vessel is water poured into it.
+                         r"\b(?:give|offer) (the [a-z]+(?: (?!a\b|some\b)[a-z]+)?) (?:a |some )?(?:little )?(?:drink|fill|top-up|refill)\b")
 #: "hand it off", "pass the block off": a hand-over (to the other arm).
 _HAND_OFF = re.compile(r"\b(hand|pass) (it|them|the [a-z]+(?: [a-z]+)?) off\b(?! to\b)")
 #: "tip some of it into the cup", "pour a little into the cup": a vague amount is a pour (the goal has no amount; a
@@ -129,10 +132,11 @@ def _topic_first(m: re.Match[str], verb: Callable[[str], str | None]) -> str:
 
 def read_verbs(s: str, note: Note, verb: Callable[[str], str | None]) -> str:
     """``s`` (one sentence) with its verb frames as the grammar's imperatives (see the module)."""
+    s = read_telegraphic(s, note, verb)
     s = sub(_TOPIC_FIRST, lambda m: _topic_first(m, verb), s, note, "verb")
     s = sub(_TURN_AWAY, "", s, note, "how")
     s = sub(_BRING_TO_POUR, "", s, note, "how")
-    s = sub(_GIVE_WATER, r"pour water into \1", s, note, "verb")
+    s = sub(_GIVE_WATER, lambda m: f"pour water into {m[1] or m[2]}", s, note, "verb")
     s = sub(_OFF, r"\1 \2 ", s, note, "particle")
     s = sub(_HAND_OFF, r"\1 \2 over", s, note, "particle")
     s = sub(_SO_DONE, "", s, note, "how")
