@@ -67,3 +67,20 @@ def test_an_arm_said_not_to_be_used_is_read_or_refused_never_dropped() -> None:
     refused(H, "Move the block onto the target. Don't use your left arm.")  # said on its own: not read, so refused
     refused(H, "pick up the block with the left arm, don't use your left arm")  # contradicts the arm named
     refused(B, "don't use the right hand")
+
+
+def test_a_step_said_again_by_an_addressed_arm_is_that_arms_with_its_own_side() -> None:
+    fork_left = "put the fork to the left of the plate with the left arm"
+    expected = goal(T, f"{fork_left}, then put the spoon to the right of the plate with the right arm")
+    for said in ("Left arm, bring the fork over next to the plate on its left side. Right arm, do the same with the spoon on the right side.",
+                 "Left arm, put the fork next to the plate on its left. Right arm, same thing with the spoon on the other side."):
+        assert goal(T, said) == expected
+    assert goal(B, "Left hand, put the red block in the cup. Right hand, do the same with the blue block.") == goal(
+        B, "put the red block in the cup with the left arm, then put the blue block in the cup with the right arm")
+
+
+def test_back_with_an_amount_and_no_verb_is_never_dropped() -> None:
+    # "tray back a bit": a way to move said without a verb; read as a move or refused, never a put-back that states nothing.
+    assert goal(C, "put the capsule in the tray, then push the tray back a little") == goal(
+        C, "put the capsule in the tray, then move the tray forward")
+    refused(C, "pod in the tray, then tray back a bit")

@@ -232,9 +232,13 @@ def read_sentences(sentences: list[str], objects: frozenset[str], note: Callable
         if out and restates(sentence, out[-1]):
             note("place")  # "Move the cup next to the bottle. Like right beside it."
             continue
-        if out and is_again(sentence):
-            said = again(sentence, re.split(r" , | then ", out[-1])[-1], objects, note)
-            if said != sentence:  # "Put the red block in the cup. Then the blue one as well."
+        heading = re.match(r"^(?:armheading (left|right|both)|(left|right|both) (?:arm|hand|gripper)s?) , ", sentence)
+        bare = sentence[heading.end():] if heading else sentence
+        if out and is_again(bare):
+            said = again(bare, re.split(r" , | then ", out[-1])[-1], objects, note)
+            if said != bare:  # "Put the red block in the cup. Then the blue one as well."
+                if heading is not None:  # "Right arm, do the same with the spoon": the step again, by the arm addressed
+                    said = re.sub(r" with the (?:left|right|both) arms?\b", "", said) + f" with the {heading[1] or heading[2]} arm"
                 out.append(said if said.startswith("then ") else f"then {said}")
                 continue
         if out and (ordered := first_of_both(out[-1], sentence)) is not None:
@@ -370,6 +374,9 @@ def read_sentence(sentence: str, objects: frozenset[str], note: Callable[[str], 
             s = _drop(pattern, s, note, "how")
     s = _drop(re.compile(r"(?: ,)? while (?:you(?:'re| are)? holding it|it(?:'s| is)? (?:held )?(?:up|held|in the air|off the table))(?= ,|$)"), s, note, "how")
     s = _sub(re.compile(r"\bpour (?:me |us |him |her )?(?:a|some) (glass|cup|mug) of water\b"), r"pour water into the \1", s, note, "verb")
+    # "tray back a bit": an amount after "back" makes it a way to move (farther back: away from you), not a put-back.
+    s = _sub(re.compile(r"\bback(?= (?:just )?(?:a (?:little |tiny |wee )?bit|a little|slightly|a touch|a tad)(?= ,|$| then\b| and\b))"),
+             "farther back", s, note, "direction")
     s = _sub(_AMOUNT, " ", s, note, "amount")
     s = _sub(_AMOUNT_TAIL, "", s, note, "amount")
     s = _sub(_IN_THE_AIR, "", s, note, "how")
