@@ -5,7 +5,9 @@ from __future__ import annotations
 from functools import cache
 
 import numpy as np
+import pytest
 
+from agentchord.agents.exceptions import InstructionNotGroundedError
 from agentchord.agents.observe import observe, task_regions
 from agentchord.agents.rules.corpus import canonical
 from agentchord.agents.rules.instructions import ground_instruction
@@ -31,3 +33,9 @@ def same(task: str, reference: str, variants: list[str]) -> None:
     want = canonical(ground_instruction(reference, scene(task)))
     for text in variants:
         assert canonical(ground_instruction(text, scene(task))) == want, text
+
+
+def refused(task: str, text: str) -> None:
+    """``text`` is refused in ``task``'s scene (not read as some goal)."""
+    with pytest.raises(InstructionNotGroundedError):
+        ground_instruction(text, scene(task))

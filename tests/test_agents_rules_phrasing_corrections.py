@@ -3,19 +3,11 @@
 
 from __future__ import annotations
 
-import pytest
 
-from agentchord.agents.exceptions import InstructionNotGroundedError
-from agentchord.agents.rules.instructions import ground_instruction
-from grounding import same, scene
+from grounding import refused, same
 
 P1, P2, T, H, W, B = ("single_arm_pour_water", "dual_arm_pour_water", "rearrange_table", "handover_block", "fold_towel",
                       "blocks_and_cup")
-
-
-def refused(task: str, text: str) -> None:
-    with pytest.raises(InstructionNotGroundedError):
-        ground_instruction(text, scene(task))
 
 
 def test_a_corrected_phrase_replaces_the_phrase_of_its_kind() -> None:

@@ -6,19 +6,11 @@ variants across verbs, objects and scenes, and a near miss refused."""
 
 from __future__ import annotations
 
-import pytest
 
-from agentchord.agents.exceptions import InstructionNotGroundedError
-from agentchord.agents.rules.instructions import ground_instruction
-from grounding import goal, same, scene
+from grounding import goal, refused, same
 
 P1, P2, T, H, W, B, C = ("single_arm_pour_water", "dual_arm_pour_water", "rearrange_table", "handover_block", "fold_towel",
                          "blocks_and_cup", "setup_coffee_tray")
-
-
-def refused(task: str, text: str) -> None:
-    with pytest.raises(InstructionNotGroundedError):
-        ground_instruction(text, scene(task))
 
 
 def test_an_end_state_frame_after_a_time_clause() -> None:

@@ -8,19 +8,11 @@ that near misses are refused rather than read wrongly.
 
 from __future__ import annotations
 
-import pytest
 
-from agentchord.agents.exceptions import InstructionNotGroundedError
-from agentchord.agents.rules.instructions import ground_instruction
-from grounding import goal, same, scene
+from grounding import goal, refused, same
 
 P1, P2, T, H, C, W, B = ("single_arm_pour_water", "dual_arm_pour_water", "rearrange_table", "handover_block",
                          "setup_coffee_tray", "fold_towel", "blocks_and_cup")
-
-
-def refused(task: str, text: str) -> None:
-    with pytest.raises(InstructionNotGroundedError):
-        ground_instruction(text, scene(task))
 
 
 # --- places ---------------------------------------------------------------------------------------
