@@ -104,8 +104,8 @@ def _poured_into(c: Clause, ctx: Context) -> str:
         if c.target.pronoun and c.source is None and re.search(r"\bwater\b", c.text) \
                 and not any(kb.is_pourable(ctx.objects[o]) for o in ctx.held_by):
             # "move the cup next to the bottle, then pour some water in it": the water said and no source, the source is
-            # the scene's vessel to pour from, so "it" is not that vessel but what was named before it. (Bare "pour
-            # into it" is left refused: blind C-005's label reads "a bit closer to the bottle" as a nudge, not beside.)
+            # the scene's vessel to pour from, so "it" is not that vessel but what was named before it. (Without the
+            # water said, "pour into it" keeps the plain reading: "it" may be the vessel just named, to pour from.)
             return ctx.resolve(c.target, exclude=tuple(o.name for o in ctx.scene.objects if kb.is_pourable(o)))
         return ctx.resolve(c.target)
     held = [o for o in [*ctx.held_by, *ctx.in_hand] if kb.is_container(ctx.objects[o]) and not kb.is_pourable(ctx.objects[o])]
